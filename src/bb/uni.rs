@@ -1,0 +1,1 @@
+//! Univariate Bernstein polynomials on [0, 1]: evaluation, subdivision, product, first root.

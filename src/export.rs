@@ -1,0 +1,1 @@
+//! `export` module (see ARCHITECTURE.md).

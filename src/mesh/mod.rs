@@ -1,0 +1,1 @@
+//! Mesh input, validation, topology and vertex normals.

@@ -1,0 +1,1 @@
+//! `scene` module (see ARCHITECTURE.md).

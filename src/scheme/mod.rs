@@ -1,0 +1,1 @@
+//! Schemes: the weights of every patch, producing a `PatchComplex`.

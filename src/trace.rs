@@ -1,0 +1,1 @@
+//! `trace` module (see ARCHITECTURE.md).
