@@ -23,6 +23,7 @@ pub mod check;
 pub mod complex;
 pub mod error;
 pub mod export;
+pub mod fixtures;
 pub mod hull;
 pub mod mesh;
 pub mod scene;

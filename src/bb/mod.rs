@@ -36,20 +36,14 @@ pub fn multi_indices(n: usize) -> Vec<[u8; 4]> {
 pub fn index_of(lambda: [u8; 4]) -> usize {
     let [a, b, c, _] = lambda.map(usize::from);
     let n: usize = lambda.iter().map(|&x| usize::from(x)).sum();
-    // Entries before first component a: all with first component > a.
-    let m = n - a; // remaining degree for (b, c, d)
-    let before_a = num_coeffs(n) - num_coeffs_tri(m);
-    // Within first = a: triangles of degree m, second component > b come first.
-    let r = m - b;
-    let before_b = num_coeffs_tri(m) - num_coeffs_tri(r);
-    // Within second = b: third component > c first.
-    let before_c = r - c;
+    // Indices whose first component exceeds a: C(n-a+2, 3) of them.
+    let before_a = (n - a) * (n - a + 1) * (n - a + 2) / 6;
+    // Among first = a, those whose second component exceeds b.
+    let m = n - a;
+    let before_b = (m - b) * (m - b + 1) / 2;
+    // Among first = a, second = b, those whose third component exceeds c.
+    let before_c = m - b - c;
     before_a + before_b + before_c
-}
-
-/// Number of bivariate multi-indices of degree m: C(m+2, 2).
-const fn num_coeffs_tri(m: usize) -> usize {
-    (m + 1) * (m + 2) / 2
 }
 
 /// A trivariate polynomial of degree `degree` in BB form over barycentric coordinates.

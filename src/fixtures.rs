@@ -1,0 +1,191 @@
+//! Test complexes built from one global polynomial: the independent truth for the checker and
+//! the tracer (every shared face is exactly continuous, hits have analytic answers).
+
+use crate::bb::{multi_indices, num_coeffs};
+use crate::complex::{Patch, PatchComplex, Role, SheetRule};
+use glam::{DMat3, DVec3};
+
+/// A quadric F(x) = xᵀ A x + bᵀ x + c (A symmetric).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quadric {
+    /// Symmetric matrix A.
+    pub a: DMat3,
+    /// Linear part b.
+    pub b: DVec3,
+    /// Constant c.
+    pub c: f64,
+}
+
+impl Quadric {
+    /// The sphere |x − center|² − r² (negative inside).
+    #[must_use]
+    pub fn sphere(center: DVec3, r: f64) -> Self {
+        Quadric {
+            a: DMat3::IDENTITY,
+            b: -2.0 * center,
+            c: center.length_squared() - r * r,
+        }
+    }
+
+    /// The axis-aligned ellipsoid Σ ((x_i − c_i)/r_i)² − 1 (negative inside).
+    #[must_use]
+    pub fn ellipsoid(center: DVec3, radii: DVec3) -> Self {
+        let d = DVec3::ONE / (radii * radii);
+        Quadric {
+            a: DMat3::from_diagonal(d),
+            b: -2.0 * d * center,
+            c: (d * center * center).element_sum() - 1.0,
+        }
+    }
+
+    /// F(x).
+    #[must_use]
+    pub fn value(&self, x: DVec3) -> f64 {
+        x.dot(self.a * x) + self.b.dot(x) + self.c
+    }
+
+    /// ∇F(x) = 2 A x + b.
+    #[must_use]
+    pub fn gradient(&self, x: DVec3) -> DVec3 {
+        2.0 * (self.a * x) + self.b
+    }
+
+    /// The degree-`n` blossom (n ≥ 2) of F at the points `args`: the symmetric multi-affine
+    /// form whose diagonal is F. For n = 2, B(x, y) = xᵀAy + bᵀ(x+y)/2 + c; in general the
+    /// quadratic part averages over all pairs and the linear part over all points.
+    #[must_use]
+    pub fn blossom(&self, args: &[DVec3]) -> f64 {
+        let n = args.len();
+        assert!(n >= 2, "a quadric needs a blossom of degree ≥ 2");
+        let mut quad = 0.0;
+        for i in 0..n {
+            for j in i + 1..n {
+                quad += args[i].dot(self.a * args[j]);
+            }
+        }
+        let pairs = (n * (n - 1) / 2) as f64;
+        let lin: f64 = args.iter().map(|x| self.b.dot(*x)).sum::<f64>() / n as f64;
+        quad / pairs + lin + self.c
+    }
+}
+
+/// BB weights of degree `n` (≥ 2) of the quadric on tetrahedron `tet`: w_λ = blossom at
+/// (v1 λ1 times, v2 λ2 times, …).
+#[must_use]
+pub fn quadric_weights(q: &Quadric, tet: &[DVec3; 4], n: usize) -> Vec<f64> {
+    let mut w = Vec::with_capacity(num_coeffs(n));
+    let mut args = Vec::with_capacity(n);
+    for l in multi_indices(n) {
+        args.clear();
+        for (k, &m) in l.iter().enumerate() {
+            args.extend(std::iter::repeat_n(tet[k], m as usize));
+        }
+        w.push(q.blossom(&args));
+    }
+    w
+}
+
+/// The six tetrahedra of the Kuhn subdivision of the cube [lo, hi]: they share faces exactly
+/// with the neighbouring cubes' tetrahedra, so a grid of cubes is a conforming complex.
+#[must_use]
+pub fn kuhn_tets(lo: DVec3, hi: DVec3) -> [[DVec3; 4]; 6] {
+    let corner = |bits: [bool; 3]| {
+        DVec3::new(
+            if bits[0] { hi.x } else { lo.x },
+            if bits[1] { hi.y } else { lo.y },
+            if bits[2] { hi.z } else { lo.z },
+        )
+    };
+    const PERMS: [[usize; 3]; 6] = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    PERMS.map(|p| {
+        let mut bits = [false; 3];
+        let v0 = corner(bits);
+        bits[p[0]] = true;
+        let v1 = corner(bits);
+        bits[p[1]] = true;
+        let v2 = corner(bits);
+        bits[p[2]] = true;
+        let v3 = corner(bits);
+        [v0, v1, v2, v3]
+    })
+}
+
+/// A complex representing the quadric `q` exactly on the box [lo, hi] split into `cells`³
+/// cubes of six tetrahedra each, with degree-`degree` weights (≥ 2). Every shared face is
+/// continuous to rounding, so it is the checker's and the tracer's reference.
+#[must_use]
+pub fn quadric_complex(
+    q: &Quadric,
+    lo: DVec3,
+    hi: DVec3,
+    cells: usize,
+    degree: usize,
+) -> PatchComplex {
+    let mut c = PatchComplex::new("test-quadric");
+    let step = (hi - lo) / cells as f64;
+    let mut element = 0u32;
+    for i in 0..cells {
+        for j in 0..cells {
+            for k in 0..cells {
+                let a = lo + step * DVec3::new(i as f64, j as f64, k as f64);
+                let b = if i + 1 == cells { hi.x } else { a.x + step.x };
+                let bb = DVec3::new(
+                    b,
+                    if j + 1 == cells { hi.y } else { a.y + step.y },
+                    if k + 1 == cells { hi.z } else { a.z + step.z },
+                );
+                for tet in kuhn_tets(a, bb) {
+                    c.patches.push(Patch {
+                        tet: tet.map(|v| v.to_array()),
+                        degree: degree as u8,
+                        weights: quadric_weights(q, &tet, degree),
+                        rational: Vec::new(),
+                        sheet: SheetRule::Any,
+                        role: Role::Other,
+                        element,
+                    });
+                }
+                element += 1;
+            }
+        }
+    }
+    c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blossom_diagonal_is_value() {
+        let q = Quadric::ellipsoid(DVec3::new(0.1, -0.2, 0.3), DVec3::new(1.0, 2.0, 0.5));
+        let x = DVec3::new(0.7, -1.1, 0.25);
+        for n in 2..=7 {
+            let v = q.blossom(&vec![x; n]);
+            // Rounding only: a handful of products of O(1) numbers.
+            assert!(
+                (v - q.value(x)).abs() < 1e-13,
+                "n={n}: {v} vs {}",
+                q.value(x)
+            );
+        }
+    }
+
+    #[test]
+    fn kuhn_tets_fill_the_cube() {
+        let tets = kuhn_tets(DVec3::ZERO, DVec3::ONE);
+        let vol: f64 = tets
+            .iter()
+            .map(|t| ((t[1] - t[0]).cross(t[2] - t[0]).dot(t[3] - t[0]) / 6.0).abs())
+            .sum();
+        // Six tets of volume 1/6 each; 1/6 is inexact in binary, so allow a few ulps.
+        assert!((vol - 1.0).abs() < 1e-15, "{vol}");
+    }
+}
