@@ -31,12 +31,13 @@ pub const DEGENERATE_TET_RATIO: f64 = 1e-12;
 /// Reads and validates a patch complex from a JSON file.
 ///
 /// # Errors
-/// [`Error::Io`] when the file cannot be opened, [`Error::Input`] (naming the file, and the
-/// patch index where one is at fault) for malformed JSON or invalid data.
+/// [`Error::Input`] naming the file (and the patch index where one is at fault) when it cannot
+/// be opened, is malformed JSON or holds invalid data.
 pub fn read_json_file(path: &Path) -> Result<PatchComplex> {
-    let file = std::fs::File::open(path).map_err(|source| Error::Io {
+    // `Input` rather than `Io`: the latter's message repeats its cause in `{:#}` chains.
+    let file = std::fs::File::open(path).map_err(|e| Error::Input {
         path: path.to_path_buf(),
-        source,
+        message: format!("cannot open: {e}"),
     })?;
     read_json(BufReader::new(file), path)
 }
@@ -75,11 +76,12 @@ pub fn from_json_str(text: &str, path: &Path) -> Result<PatchComplex> {
 /// Writes `complex` as JSON to `path` (validated first, so the file always reads back).
 ///
 /// # Errors
-/// [`Error::Invalid`] when the complex fails [`validate`], [`Error::Io`] on write failure.
+/// [`Error::Invalid`] when the complex fails [`validate`], [`Error::Input`] naming the file on
+/// write failure.
 pub fn write_json_file(complex: &PatchComplex, path: &Path) -> Result<()> {
-    let io = |source: std::io::Error| Error::Io {
+    let io = |e: std::io::Error| Error::Input {
         path: path.to_path_buf(),
-        source,
+        message: format!("cannot write: {e}"),
     };
     validate(complex).map_err(Error::Invalid)?;
     let file = std::fs::File::create(path).map_err(io)?;
