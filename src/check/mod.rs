@@ -335,6 +335,19 @@ mod tests {
     }
 
     #[test]
+    fn fixture_grid_is_conforming_for_inexact_steps() {
+        // Step 2/7 is inexact: neighbouring cubes must still share corners bit for bit, so every
+        // interior face is matched and no T-junction is seen.
+        let q = Quadric::sphere(DVec3::ZERO, 0.9);
+        let cells = 7;
+        let c = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), cells, 2);
+        let r = check(&c, &CheckOptions::default());
+        assert_eq!(r.faces.boundary, 6 * 2 * cells * cells, "{r}");
+        assert_eq!(r.faces.t_junctions, 0, "{r}");
+        assert!(r.passed(), "{r}");
+    }
+
+    #[test]
     fn perturbed_weight_is_reported() {
         let mut c = sphere_complex(3);
         // Weight (2,1,0,0) lies on the faces opposite vertices 3 and 4 of patch 40.
