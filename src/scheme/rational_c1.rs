@@ -363,7 +363,16 @@ pub fn build(
     let mut refined = 0;
     let mut rounds = 0;
     let hull = loop {
-        let hull = outer::build(&mesh.positions, &mesh.triangles, &mesh.normals, &hopts)?;
+        let hull = outer::build(&mesh.positions, &mesh.triangles, &mesh.normals, &hopts)
+            .map_err(|e| {
+                if rounds == 0 {
+                    e
+                } else {
+                    Error::Invalid(format!(
+                        "after {refined} edges were refined because adjacent face tetrahedra intersected (§3.1): {e}"
+                    ))
+                }
+            })?;
         let bad = hull.bad_edges(&mesh.positions, &mesh.triangles);
         if bad.is_empty() {
             break hull;
