@@ -249,8 +249,8 @@ fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> anyhow::Error {
 /// # Errors
 /// Unreadable files, TOML syntax, unknown keys and bad values, each naming the file and key.
 pub fn load(path: &Path) -> anyhow::Result<Scene> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
     parse(&text, path)
 }
 
@@ -278,10 +278,16 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
             "{}: `model`: give either `file` or `patches`, not both",
             path.display()
         ),
-        (None, None) => bail!("{}: `model`: `file` or `patches` is required", path.display()),
+        (None, None) => bail!(
+            "{}: `model`: `file` or `patches` is required",
+            path.display()
+        ),
         (None, Some(p)) => {
             if m.normals.is_some() {
-                return Err(bad("model.normals", "only applies with `model.file`".into()));
+                return Err(bad(
+                    "model.normals",
+                    "only applies with `model.file`".into(),
+                ));
             }
             if file.scheme.is_some() {
                 return Err(bad("scheme", "only applies with `model.file`".into()));
@@ -296,10 +302,12 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     format!("`{normals}` is not one of angle, area, loop, file"),
                 ));
             }
-            let scheme = file
-                .scheme
-                .clone()
-                .ok_or_else(|| bad("scheme", "a [scheme] table is required with `model.file`".into()))?;
+            let scheme = file.scheme.clone().ok_or_else(|| {
+                bad(
+                    "scheme",
+                    "a [scheme] table is required with `model.file`".into(),
+                )
+            })?;
             Model::Mesh {
                 file: dir.join(f),
                 normals,
@@ -315,7 +323,10 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
         .parse()
         .map_err(|e: String| bad("camera.fov_axis", e))?;
     if !(c.fov > 0.0 && c.fov < 180.0) {
-        return Err(bad("camera.fov", format!("{} is outside (0, 180) degrees", c.fov)));
+        return Err(bad(
+            "camera.fov",
+            format!("{} is outside (0, 180) degrees", c.fov),
+        ));
     }
     if c.width == 0 || c.height == 0 {
         return Err(bad("camera.width/height", "must be positive".into()));
@@ -346,7 +357,10 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
     // Material and lights.
     let albedo = file.material.albedo.rgb();
     if !(albedo.is_finite() && albedo.min_element() >= 0.0 && albedo.max_element() <= 1.0) {
-        return Err(bad("material.albedo", "components must lie in [0, 1]".into()));
+        return Err(bad(
+            "material.albedo",
+            "components must lie in [0, 1]".into(),
+        ));
     }
     let mut lights = Vec::new();
     for (i, l) in file.lights.iter().enumerate() {
@@ -407,7 +421,12 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
         options.isophote_light = match s.as_str() {
             "light" => true,
             "view" => false,
-            _ => return Err(bad("render.isophote", format!("`{s}` is not light or view"))),
+            _ => {
+                return Err(bad(
+                    "render.isophote",
+                    format!("`{s}` is not light or view"),
+                ))
+            }
         };
     }
     if let Some(s) = &r.over {
@@ -421,7 +440,12 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
         options.gaussian = match s.as_str() {
             "mean" => false,
             "gaussian" => true,
-            _ => return Err(bad("render.curvature", format!("`{s}` is not mean or gaussian"))),
+            _ => {
+                return Err(bad(
+                    "render.curvature",
+                    format!("`{s}` is not mean or gaussian"),
+                ))
+            }
         };
     }
     if let Some(b) = r.patch_boundaries {
@@ -471,10 +495,12 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
     match &scene.model {
         Model::Patches(p) => read_patches(p),
         Model::Mesh { scheme, .. } => {
-            let ty = scheme
-                .get("type")
-                .and_then(|v| v.as_str())
-                .ok_or_else(|| anyhow!("{}: `scheme.type` is required (a string)", scene.path.display()))?;
+            let ty = scheme.get("type").and_then(|v| v.as_str()).ok_or_else(|| {
+                anyhow!(
+                    "{}: `scheme.type` is required (a string)",
+                    scene.path.display()
+                )
+            })?;
             match ty {
                 "rational-c1" => bail!(
                     "{}: scheme `rational-c1` is not available in this build yet (mesh loading and the 2001 scheme have not landed)",
@@ -498,8 +524,8 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
 /// # Errors
 /// Unreadable files, JSON errors (with line), a wrong `format`.
 pub fn read_patches(path: &Path) -> anyhow::Result<PatchComplex> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
     let c: PatchComplex = serde_json::from_str(&text).map_err(|e| {
         anyhow!(
             "{}:{}: {}",

@@ -109,7 +109,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         _ => (scene.output.clone(), scene.output.with_extension("exr")),
     };
     if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create", dir.display()))?;
     }
     trace::write_exr(&frame, &exr)?;
     trace::write_png(&frame, &png)?;
@@ -126,7 +127,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     if s.mode == Mode::Curvature {
         eprintln!(
             "{} curvature colour range: ±{:.6}",
-            if s.options.gaussian { "Gaussian" } else { "mean" },
+            if s.options.gaussian {
+                "Gaussian"
+            } else {
+                "mean"
+            },
             frame.range
         );
     }

@@ -68,7 +68,11 @@ impl Bvh {
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(l, h), b| (l.min(b.min), h.max(b.max)),
         );
-        let extent = if boxes.is_empty() { 0.0 } else { (hi - lo).max_element() };
+        let extent = if boxes.is_empty() {
+            0.0
+        } else {
+            (hi - lo).max_element()
+        };
         let prims: Vec<Prim> = boxes
             .iter()
             .map(|b| {

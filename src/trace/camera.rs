@@ -45,7 +45,11 @@ impl FromStr for FovAxis {
             "diagonal" => FovAxis::Diagonal,
             "smaller" => FovAxis::Smaller,
             "larger" => FovAxis::Larger,
-            _ => return Err(format!("`{s}` is not one of x, y, diagonal, smaller, larger")),
+            _ => {
+                return Err(format!(
+                    "`{s}` is not one of x, y, diagonal, smaller, larger"
+                ))
+            }
         })
     }
 }

@@ -93,25 +93,25 @@ pub fn render(
     progress: &(dyn Fn() + Sync),
     cancel: &AtomicBool,
 ) -> Result<Frame, Interrupted> {
-    let (w, h) = (settings.camera.width as usize, settings.camera.height as usize);
+    let (w, h) = (
+        settings.camera.width as usize,
+        settings.camera.height as usize,
+    );
     let mut pixels = vec![Pixel::default(); w * h];
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads)
         .build()
         .map_err(|_| Interrupted)?;
     pool.install(|| {
-        pixels
-            .par_chunks_mut(w)
-            .enumerate()
-            .for_each(|(y, row)| {
-                if cancel.load(Ordering::Relaxed) {
-                    return;
-                }
-                for (x, px) in row.iter_mut().enumerate() {
-                    *px = render_pixel(geo, settings, x as u32, y as u32);
-                }
-                progress();
-            });
+        pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            if cancel.load(Ordering::Relaxed) {
+                return;
+            }
+            for (x, px) in row.iter_mut().enumerate() {
+                *px = render_pixel(geo, settings, x as u32, y as u32);
+            }
+            progress();
+        });
     });
     if cancel.load(Ordering::Relaxed) {
         return Err(Interrupted);
@@ -247,7 +247,11 @@ fn finish(frame: &mut Frame, opts: &ModeOptions) {
             let range = if range > 0.0 { range } else { 1.0 };
             for p in frame.pixels.iter_mut().filter(|p| p.alpha > 0.0) {
                 let c = shade::diverging(f64::from(p.value[k] / range));
-                p.rgb = [c.x as f32 * p.alpha, c.y as f32 * p.alpha, c.z as f32 * p.alpha];
+                p.rgb = [
+                    c.x as f32 * p.alpha,
+                    c.y as f32 * p.alpha,
+                    c.z as f32 * p.alpha,
+                ];
             }
             frame.range = f64::from(range);
         }
@@ -317,7 +321,13 @@ fn phase_gradient(phase: &[f64], hit: &[bool], w: usize, h: usize, x: usize, y: 
             (None, None) => 0.0,
         }
     };
-    let gx = diff(x.checked_sub(1).map(|k| y * w + k), (x + 1 < w).then(|| i + 1));
-    let gy = diff(y.checked_sub(1).map(|k| k * w + x), (y + 1 < h).then(|| i + w));
+    let gx = diff(
+        x.checked_sub(1).map(|k| y * w + k),
+        (x + 1 < w).then(|| i + 1),
+    );
+    let gy = diff(
+        y.checked_sub(1).map(|k| k * w + x),
+        (y + 1 < h).then(|| i + w),
+    );
     gx.hypot(gy)
 }

@@ -101,7 +101,10 @@ impl Geometry {
     /// Bytes used by compiled patches and the BVH.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
-        self.patches.iter().map(CompiledPatch::memory_bytes).sum::<usize>()
+        self.patches
+            .iter()
+            .map(CompiledPatch::memory_bytes)
+            .sum::<usize>()
             + self.roles.len() * std::mem::size_of::<Role>()
             + self.elements.len() * 4
             + self.bvh.memory_bytes()
@@ -138,8 +141,9 @@ impl Geometry {
     /// True when `o + t·d` meets the surface for some `tmin ≤ t < tmax`.
     #[must_use]
     pub fn occluded(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> bool {
-        self.bvh
-            .any(o, d, tmax, |prim| self.patch_hit(prim, o, d, tmin, tmax).is_some())
+        self.bvh.any(o, d, tmax, |prim| {
+            self.patch_hit(prim, o, d, tmin, tmax).is_some()
+        })
     }
 
     /// The first accepted root of patch `i` on `o + t·d`, tmin ≤ t ≤ tmax.

@@ -96,7 +96,11 @@ pub fn write_exr(frame: &Frame, path: &Path) -> anyhow::Result<()> {
 /// The sRGB transfer curve of a linear value in [0, 1].
 #[must_use]
 pub fn srgb(x: f32) -> f32 {
-    let x = if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 };
+    let x = if x.is_finite() {
+        x.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     if x <= 0.003_130_8 {
         12.92 * x
     } else {

@@ -176,7 +176,9 @@ impl CompiledPatch {
                 return Err(format!("patch {index}: rational term {r} has |κ| ≠ {n}"));
             }
             if term.terms.is_empty() || term.terms.iter().any(|(w, _)| !w.is_finite()) {
-                return Err(format!("patch {index}: rational term {r} is empty or not finite"));
+                return Err(format!(
+                    "patch {index}: rational term {r} is empty or not finite"
+                ));
             }
             let mut denom: Vec<[u8; 4]> = term.terms.iter().map(|t| t.1).collect();
             denom.sort_unstable();
@@ -224,7 +226,9 @@ impl CompiledPatch {
                 };
                 let (b, t) = (mask(base)?, mask(top)?);
                 if b == 0 || t == 0 || b & t != 0 {
-                    return Err(format!("patch {index}: sheet base and top must be disjoint and non-empty"));
+                    return Err(format!(
+                        "patch {index}: sheet base and top must be disjoint and non-empty"
+                    ));
                 }
                 Sheet::Shooting { base: b, top: t }
             }
@@ -568,8 +572,19 @@ mod tests {
             let (v, g, h) = c.derivatives(&c.bary(x));
             // Rounding only: exact representation of a quadric.
             assert!((v - q.value(x)).abs() < 1e-13);
-            assert!((g - q.gradient(x)).length() < 1e-12, "{g} vs {}", q.gradient(x));
-            assert!((h - 2.0 * q.a).abs().to_cols_array().iter().all(|e| *e < 1e-11), "{h}");
+            assert!(
+                (g - q.gradient(x)).length() < 1e-12,
+                "{g} vs {}",
+                q.gradient(x)
+            );
+            assert!(
+                (h - 2.0 * q.a)
+                    .abs()
+                    .to_cols_array()
+                    .iter()
+                    .all(|e| *e < 1e-11),
+                "{h}"
+            );
         }
     }
 
@@ -612,7 +627,11 @@ mod tests {
             let gp = c.derivatives(&c.bary(x + dx)).1;
             let gm = c.derivatives(&c.bary(x - dx)).1;
             let hd = (gp - gm) / (2.0 * e);
-            assert!((hd - h.col(axis)).length() < 1e-7, "{hd} vs {}", h.col(axis));
+            assert!(
+                (hd - h.col(axis)).length() < 1e-7,
+                "{hd} vs {}",
+                h.col(axis)
+            );
         }
     }
 }

@@ -209,7 +209,13 @@ const SHADOW_OFFSET: f64 = 1e-7;
 
 /// Radiance reflected towards `-d` at `s` (Mitsuba `direct` with `diffuse`).
 #[must_use]
-pub fn radiance(geo: &Geometry, lighting: &Lighting, s: &Surface, d: DVec3, rnd: [f64; 2]) -> DVec3 {
+pub fn radiance(
+    geo: &Geometry,
+    lighting: &Lighting,
+    s: &Surface,
+    d: DVec3,
+    rnd: [f64; 2],
+) -> DVec3 {
     if s.n.dot(-d) <= 0.0 {
         return DVec3::ZERO;
     }
@@ -283,7 +289,11 @@ pub fn patch_colour(role: Role, index: u32) -> DVec3 {
 /// A diverging colour map on x ∈ [−1, 1]: blue, white at 0, red.
 #[must_use]
 pub fn diverging(x: f64) -> DVec3 {
-    let x = if x.is_finite() { x.clamp(-1.0, 1.0) } else { 0.0 };
+    let x = if x.is_finite() {
+        x.clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
     let white = DVec3::splat(0.95);
     if x < 0.0 {
         white.lerp(DVec3::new(0.05, 0.2, 0.75), -x)
