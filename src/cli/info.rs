@@ -31,14 +31,13 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     let method = args
         .normals
         .unwrap_or_else(|| NormalMethod::default_for(&m));
-    let s = mesh::summary(&m, &report, method)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
+    let s = mesh::summary(&m, &report, method);
     if args.json {
         println!("{}", serde_json::to_string_pretty(&s)?);
     } else {
         print_text(&args.input, &s);
     }
-    Ok(if report.has_warnings() {
+    Ok(if report.has_warnings() || s.normals_error.is_some() {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS
@@ -84,30 +83,40 @@ fn print_text(path: &std::path::Path, s: &Summary) {
     } else {
         ""
     };
-    let c = |c: &mesh::ClassCounts| {
-        format!(
+    let c = |c: &Option<mesh::ClassCounts>| match c {
+        Some(c) => format!(
             "{} positive, {} zero, {} negative convex, {} nonconvex",
             c.positive, c.zero, c.negative, c.nonconvex
-        )
+        ),
+        None => "unknown (no normals)".into(),
     };
+    if let Some(e) = &s.normals_error {
+        println!("  warning: normals: {e}");
+    }
     println!("  2001 edges{tri}: {}", c(&s.edges_2001));
     println!("  2001 triangles{tri}: {}", c(&s.triangles_2001));
     println!(
         "  1994 faces        {} convex, {} non-convex polygons",
         s.convex_faces_1994, s.nonconvex_faces_1994
     );
-    let list: Vec<String> = s
-        .above_face_failures
-        .iter()
-        .take(mesh::LISTED_ELEMENTS)
-        .map(u32::to_string)
-        .collect();
-    println!(
-        "  1994 above-face   {} vertices fail{}{}",
-        s.above_face_failures.len(),
-        if list.is_empty() { "" } else { ": " },
-        list.join(", ")
-    );
+    if let Some(fails) = &s.above_face_failures {
+        let list: Vec<String> = fails
+            .iter()
+            .take(mesh::LISTED_ELEMENTS)
+            .map(u32::to_string)
+            .collect();
+        println!(
+            "  1994 above-face   {} vertices fail{}{}{}",
+            fails.len(),
+            if list.is_empty() { "" } else { ": " },
+            list.join(", "),
+            if fails.len() > list.len() {
+                ", …"
+            } else {
+                ""
+            }
+        );
+    }
     if s.report.findings.is_empty() {
         println!("  findings          none");
     }

@@ -95,3 +95,100 @@ pub fn polygon_is_convex(positions: &[DVec3], face: &[u32]) -> bool {
     // Rounding of n angles: a relative 1e-9 of the total is ample.
     (sum - (n as f64 - 2.0) * PI).abs() <= 1e-9 * n as f64 * PI
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use Convexity::*;
+
+    #[test]
+    fn edge_classes_from_analytic_configurations() {
+        let (pi, pj) = (DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0));
+        // Unit sphere, radial normals: a = b = 1 − pi·pj > 0.
+        assert_eq!(edge_convexity(pi, pi, pj, pj), Positive);
+        // Inward normals: both negative.
+        assert_eq!(edge_convexity(pi, -pi, pj, -pj), Negative);
+        // A plane with its normal: both exactly zero.
+        let z = DVec3::Z;
+        assert_eq!(edge_convexity(pi, z, pj, z), Zero);
+        // One normal tilted towards the other end, one away: a > 0 > b.
+        let d = (pj - pi).normalize();
+        let ni = (z + 0.5 * d).normalize();
+        let nj = (z + 0.5 * d).normalize();
+        // a = (pj − pi)·nj > 0, b = (pi − pj)·ni < 0.
+        assert_eq!(edge_convexity(pi, ni, pj, nj), Nonconvex);
+        // One zero, one positive: positive; one zero, one negative: negative.
+        assert_eq!(
+            edge_convexity(pi, z, pj, (z + 0.5 * d).normalize()),
+            Positive
+        );
+        assert_eq!(
+            edge_convexity(pi, z, pj, (z - 0.5 * d).normalize()),
+            Negative
+        );
+    }
+
+    #[test]
+    fn zero_tolerance_is_relative() {
+        // A tilt of 1e-12 rad is "zero" at every scale; 1e-6 rad never is.
+        for scale in [1e-6, 1.0, 1e6] {
+            let (pi, pj) = (DVec3::ZERO, DVec3::X * scale);
+            let tiny = DVec3::new(1e-12, 0.0, 1.0).normalize();
+            assert_eq!(
+                edge_convexity(pi, DVec3::Z, pj, tiny),
+                Zero,
+                "scale {scale}"
+            );
+            let small = DVec3::new(1e-6, 0.0, 1.0).normalize();
+            assert_eq!(
+                edge_convexity(pi, DVec3::Z, pj, small),
+                Positive,
+                "scale {scale}"
+            );
+        }
+    }
+
+    #[test]
+    fn face_classes() {
+        assert_eq!(face_convexity([Positive, Zero, Positive]), Positive);
+        assert_eq!(face_convexity([Zero, Zero, Zero]), Zero);
+        assert_eq!(face_convexity([Negative, Zero, Negative]), Negative);
+        assert_eq!(face_convexity([Positive, Negative, Zero]), Nonconvex);
+        assert_eq!(face_convexity([Positive, Positive, Nonconvex]), Nonconvex);
+        let p = [DVec3::X, DVec3::Y, DVec3::Z];
+        assert_eq!(triangle_convexity(p, p), Positive);
+        assert_eq!(triangle_convexity(p, p.map(|v| -v)), Negative);
+    }
+
+    #[test]
+    fn polygon_convexity() {
+        let pts = |xy: &[(f64, f64)]| -> Vec<DVec3> {
+            xy.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect()
+        };
+        let square = pts(&[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
+        assert!(polygon_is_convex(&square, &[0, 1, 2, 3]));
+        assert!(
+            polygon_is_convex(&square, &[3, 2, 1, 0]),
+            "orientation does not matter"
+        );
+        let with_straight = pts(&[(0.0, 0.0), (0.5, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
+        assert!(polygon_is_convex(&with_straight, &[0, 1, 2, 3, 4]));
+        let l = pts(&[
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 2.0),
+        ]);
+        assert!(!polygon_is_convex(&l, &[0, 1, 2, 3, 4, 5]));
+        // Pentagram: every corner turns the same way, but it winds twice.
+        let star: Vec<DVec3> = (0..5)
+            .map(|k| {
+                let a = std::f64::consts::TAU * (2 * k) as f64 / 5.0;
+                DVec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        assert!(!polygon_is_convex(&star, &[0, 1, 2, 3, 4]));
+    }
+}

@@ -118,9 +118,9 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
                     face.push(vi);
                     let ni = match vn {
                         Some(t) => {
-                            let (ni, fwd) = resolve(t, raw.normals.len())
+                            let (ni, _) = resolve(t, raw.normals.len())
                                 .map_err(|m| at(format!("face normal {}: {m}", face.len())))?;
-                            if fwd {
+                            if ni as usize >= raw.normals.len() {
                                 return Err(at(format!(
                                     "face normal {} refers to normal {} but only {} are defined",
                                     face.len(),

@@ -5,7 +5,6 @@ use super::convexity::{edge_convexity, polygon_is_convex, triangle_convexity, Co
 use super::normals::{above_face_failures, vertex_normals, NormalMethod};
 use super::topology::Topology;
 use super::{triangulate, Mesh, Report};
-use crate::error::Result;
 use glam::DVec3;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -71,10 +70,12 @@ pub struct Summary {
     pub non_manifold_vertices: usize,
     /// The normals the classes below use.
     pub normals: NormalMethod,
+    /// Why the normals could not be computed (then the normal-dependent fields are `None`).
+    pub normals_error: Option<String>,
     /// 2001 classes of the edges of the (ear-clipped, if needed) triangle mesh.
-    pub edges_2001: ClassCounts,
+    pub edges_2001: Option<ClassCounts>,
     /// 2001 classes of the triangles of the (ear-clipped, if needed) triangle mesh.
-    pub triangles_2001: ClassCounts,
+    pub triangles_2001: Option<ClassCounts>,
     /// True when the 2001 classes were computed on an ear-clipped triangulation.
     pub triangulated_for_2001: bool,
     /// 1994: polygon faces that are convex in their plane.
@@ -82,14 +83,16 @@ pub struct Summary {
     /// 1994: polygon faces that are not convex.
     pub nonconvex_faces_1994: usize,
     /// 1994: vertices failing the above-face condition (n · n_f ≤ 0 for an incident face).
-    pub above_face_failures: Vec<u32>,
+    pub above_face_failures: Option<Vec<u32>>,
     /// The validation report.
     pub report: Report,
 }
 
-/// Summarises `mesh` (as returned by `load` with `report`) for the chosen `normals`.
-pub fn summary(mesh: &Mesh, report: &Report, normals: NormalMethod) -> Result<Summary> {
-    let n = vertex_normals(mesh, normals)?;
+/// Summarises `mesh` (as returned by `load` with `report`) for the chosen `normals`. When the
+/// normals cannot be computed the summary says why and omits what depends on them.
+#[must_use]
+pub fn summary(mesh: &Mesh, report: &Report, normals: NormalMethod) -> Summary {
+    let n = vertex_normals(mesh, normals);
     let topo = Topology::new(mesh.positions.len(), &mesh.faces);
     let mut faces_by_valence = BTreeMap::new();
     for f in &mesh.faces {
@@ -134,24 +137,27 @@ pub fn summary(mesh: &Mesh, report: &Report, normals: NormalMethod) -> Result<Su
     } else {
         mesh
     };
-    let tt = Topology::new(tm.positions.len(), &tm.faces);
-    let p = &tm.positions;
-    let mut edges_2001 = ClassCounts::default();
-    for [i, j] in &tt.edges {
-        let (i, j) = (*i as usize, *j as usize);
-        edges_2001.add(edge_convexity(p[i], n[i], p[j], n[j]));
-    }
-    let mut triangles_2001 = ClassCounts::default();
-    for f in &tm.faces {
-        let [a, b, c] = [f[0] as usize, f[1] as usize, f[2] as usize];
-        triangles_2001.add(triangle_convexity([p[a], p[b], p[c]], [n[a], n[b], n[c]]));
-    }
+    let classes = n.as_ref().ok().map(|n| {
+        let tt = Topology::new(tm.positions.len(), &tm.faces);
+        let p = &tm.positions;
+        let mut edges = ClassCounts::default();
+        for [i, j] in &tt.edges {
+            let (i, j) = (*i as usize, *j as usize);
+            edges.add(edge_convexity(p[i], n[i], p[j], n[j]));
+        }
+        let mut triangles = ClassCounts::default();
+        for f in &tm.faces {
+            let [a, b, c] = [f[0] as usize, f[1] as usize, f[2] as usize];
+            triangles.add(triangle_convexity([p[a], p[b], p[c]], [n[a], n[b], n[c]]));
+        }
+        (edges, triangles)
+    });
     let convex = mesh
         .faces
         .iter()
         .filter(|f| polygon_is_convex(&mesh.positions, f))
         .count();
-    Ok(Summary {
+    Summary {
         vertices: mesh.positions.len(),
         faces: mesh.faces.len(),
         faces_by_valence,
@@ -169,12 +175,13 @@ pub fn summary(mesh: &Mesh, report: &Report, normals: NormalMethod) -> Result<Su
         boundary_vertices: bnd,
         non_manifold_vertices: nm,
         normals,
-        edges_2001,
-        triangles_2001,
+        normals_error: n.as_ref().err().map(ToString::to_string),
+        edges_2001: classes.map(|c| c.0),
+        triangles_2001: classes.map(|c| c.1),
         triangulated_for_2001: triangulated,
         convex_faces_1994: convex,
         nonconvex_faces_1994: mesh.faces.len() - convex,
-        above_face_failures: above_face_failures(mesh, &n),
+        above_face_failures: n.as_ref().ok().map(|n| above_face_failures(mesh, n)),
         report: report.clone(),
-    })
+    }
 }
