@@ -22,7 +22,7 @@
 //! 3. Intervals narrower than 2⁻³⁰ of [0, 1] that survive are touches: their midpoint is
 //!    reported (or their root, if their ends differ in sign).
 
-use super::{eval_with_derivative, subdivide_into, STACK_LEN};
+use super::STACK_LEN;
 
 /// Relative tolerance τ/max|ck| under which a coefficient counts as touching zero. Rounding in
 /// a restricted segment polynomial is a few ulps of the largest weight; 1e-13 leaves ~500×
@@ -38,8 +38,10 @@ const MAX_SPLITS: usize = 4096;
 /// Newton iterations at most in the polish (bisection guarantees ≥ 1 bit per two steps).
 const MAX_POLISH: usize = 100;
 
-/// The smallest root of f in [0, 1] under the policy of this module; no heap allocation for
-/// up to [`STACK_LEN`] coefficients.
+/// The smallest root of f in [0, 1] under the policy of this module; no heap allocation.
+///
+/// # Panics
+/// When `c` has more than [`STACK_LEN`] coefficients.
 #[inline]
 #[must_use]
 pub fn first_root(c: &[f64]) -> Option<f64> {
@@ -50,11 +52,25 @@ pub fn first_root(c: &[f64]) -> Option<f64> {
 /// when lo > hi or either is NaN). Used to continue the search after rejecting a root.
 ///
 /// # Panics
-/// When `c` has more than 64 coefficients.
+/// When `c` has more than [`STACK_LEN`] coefficients.
 #[must_use]
 pub fn first_root_in(c: &[f64], lo: f64, hi: f64) -> Option<f64> {
-    let len = c.len();
-    if len == 0 || lo.is_nan() || hi.is_nan() || lo > hi {
+    macro_rules! dispatch {
+        ($($n:literal)*) => {
+            match c.len() {
+                0 => None,
+                $($n => first_root_fixed::<$n>(c.try_into().expect("length checked"), lo, hi),)*
+                len => panic!("first_root supports at most {STACK_LEN} coefficients, got {len}"),
+            }
+        };
+    }
+    dispatch!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+}
+
+/// [`first_root_in`] for exactly N coefficients: every loop has a constant trip count.
+#[inline]
+fn first_root_fixed<const N: usize>(c: &[f64; N], lo: f64, hi: f64) -> Option<f64> {
+    if lo.is_nan() || hi.is_nan() {
         return None;
     }
     let (lo, hi) = (lo.max(0.0), hi.min(1.0));
@@ -69,48 +85,59 @@ pub fn first_root_in(c: &[f64], lo: f64, hi: f64) -> Option<f64> {
         return None;
     }
     let tol = TOUCH_TOL * scale;
-    if len <= STACK_LEN {
-        first_root_fixed::<STACK_LEN>(c, lo, hi, tol)
-    } else {
-        assert!(
-            len <= 64,
-            "first_root supports at most 64 coefficients, got {len}"
-        );
-        first_root_fixed::<64>(c, lo, hi, tol)
-    }
-}
-
-#[inline]
-fn first_root_fixed<const N: usize>(c: &[f64], lo: f64, hi: f64, tol: f64) -> Option<f64> {
-    let len = c.len();
     if lo == 0.0 && hi == 1.0 {
         if excluded(c, tol) {
             return None;
         }
-        let mut ctx = Search { tol, splits: 0 };
-        return ctx.search::<N>(c, 0.0, 1.0);
+        return Search { tol, splits: 0 }.search(c, 0.0, 1.0);
     }
     if lo == hi {
-        let (f, _) = eval_with_derivative(c, lo);
+        let (f, _) = eval_d(c, lo);
         return (f.abs() <= tol).then_some(lo);
     }
     // Coefficients on [lo, hi]: split at hi, then the left part at lo/hi.
-    let mut left = [0.0; N];
-    let mut right = [0.0; N];
-    let mut part = [0.0; N];
-    subdivide_into(c, hi, &mut left, &mut right);
-    subdivide_into(&left[..len], lo / hi, &mut right, &mut part);
-    let b = &part[..len];
-    if excluded(b, tol) {
+    let (left, _) = split(c, hi);
+    let (_, b) = split(&left, lo / hi);
+    if excluded(&b, tol) {
         return None;
     }
-    let mut ctx = Search { tol, splits: 0 };
-    ctx.search::<N>(b, lo, hi - lo)
+    Search { tol, splits: 0 }.search(&b, lo, hi - lo)
+}
+
+/// (f(t), f′(t)) by de Casteljau on exactly N coefficients.
+#[inline(always)]
+fn eval_d<const N: usize>(c: &[f64; N], t: f64) -> (f64, f64) {
+    if N == 1 {
+        return (c[0], 0.0);
+    }
+    let mut b = *c;
+    let s = 1.0 - t;
+    for r in (2..N).rev() {
+        for i in 0..r {
+            b[i] = s * b[i] + t * b[i + 1];
+        }
+    }
+    (s * b[0] + t * b[1], (N - 1) as f64 * (b[1] - b[0]))
+}
+
+/// De Casteljau subdivision at t into the pieces on [0, t] and [t, 1].
+#[inline(always)]
+fn split<const N: usize>(c: &[f64; N], t: f64) -> ([f64; N], [f64; N]) {
+    let mut right = *c;
+    let mut left = *c;
+    let s = 1.0 - t;
+    for r in 1..N {
+        for i in 0..N - r {
+            right[i] = s * right[i] + t * right[i + 1];
+        }
+        left[r] = right[0];
+    }
+    (left, right)
 }
 
 /// True when every coefficient is beyond τ on the same side: no root, no touch.
-#[inline]
-fn excluded(b: &[f64], tol: f64) -> bool {
+#[inline(always)]
+fn excluded<const N: usize>(b: &[f64; N], tol: f64) -> bool {
     let (mut mn, mut mx) = (f64::INFINITY, f64::NEG_INFINITY);
     for &x in b {
         mn = mn.min(x);
@@ -120,8 +147,8 @@ fn excluded(b: &[f64], tol: f64) -> bool {
 }
 
 /// Number of sign changes in the sequence, exact zeros skipped.
-#[inline]
-fn variations(b: &[f64]) -> usize {
+#[inline(always)]
+fn variations<const N: usize>(b: &[f64; N]) -> usize {
     let mut v = 0;
     let mut last = 0.0;
     for &x in b {
@@ -136,11 +163,11 @@ fn variations(b: &[f64]) -> usize {
 }
 
 /// True when every control-polygon slope b_{i+1} − b_i is beyond τ on the same side.
-#[inline]
-fn monotone(b: &[f64], tol: f64) -> bool {
+#[inline(always)]
+fn monotone<const N: usize>(b: &[f64; N], tol: f64) -> bool {
     let (mut up, mut down) = (true, true);
-    for w in b.windows(2) {
-        let d = w[1] - w[0];
+    for i in 0..N - 1 {
+        let d = b[i + 1] - b[i];
         up &= d > tol;
         down &= d < -tol;
     }
@@ -154,8 +181,8 @@ struct Search {
 
 impl Search {
     /// First root of the polynomial with coefficients `b` on [a, a+w] (global parameter).
-    fn search<const N: usize>(&mut self, b: &[f64], a: f64, w: f64) -> Option<f64> {
-        let n = b.len() - 1;
+    fn search<const N: usize>(&mut self, b: &[f64; N], a: f64, w: f64) -> Option<f64> {
+        let n = N - 1;
         if b[0] == 0.0 {
             return Some(a);
         }
@@ -179,28 +206,31 @@ impl Search {
             return Some(a + 0.5 * w);
         }
         self.splits += 1;
-        let mut left = [0.0; N];
-        let mut right = [0.0; N];
-        subdivide_into(b, 0.5, &mut left, &mut right);
+        let (left, right) = split(b, 0.5);
         let h = 0.5 * w;
-        if !excluded(&left[..=n], self.tol) {
-            if let Some(t) = self.search::<N>(&left[..=n], a, h) {
+        if !excluded(&left, self.tol) {
+            if let Some(t) = self.search(&left, a, h) {
                 return Some(t);
             }
         }
-        if !excluded(&right[..=n], self.tol) {
-            return self.search::<N>(&right[..=n], a + h, h);
+        if !excluded(&right, self.tol) {
+            return self.search(&right, a + h, h);
         }
         None
     }
 }
 
+/// Below this Newton correction (in the interval's own parameter) the iteration has reached
+/// its quadratic phase: the error after the step is ~|f″/f′|·step² ≲ 1e-18·|f″/f′|.
+const NEWTON_DONE: f64 = 1e-9;
+
 /// The root in (0, 1) of a polynomial whose first and last coefficients are non-zero with
 /// opposite signs: Newton from the control polygon's first crossing, kept inside the sign
 /// bracket; a bisection replaces any step that leaves the bracket or that would not halve the
 /// step before last (the `rtsafe` safeguard).
-fn polish(b: &[f64]) -> f64 {
-    let n = b.len() - 1;
+#[inline]
+fn polish<const N: usize>(b: &[f64; N]) -> f64 {
+    let n = N - 1;
     let positive_at_lo = b[0] > 0.0;
     // Start at the control polygon's first crossing of zero.
     let mut u = 0.5;
@@ -212,8 +242,9 @@ fn polish(b: &[f64]) -> f64 {
     }
     let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
     let (mut dx, mut dx_old) = (1.0_f64, 1.0_f64);
+    let mut newton_steps = 0;
     for _ in 0..MAX_POLISH {
-        let (f, df) = eval_with_derivative(b, u);
+        let (f, df) = eval_d(b, u);
         if f == 0.0 {
             return u;
         }
@@ -222,17 +253,28 @@ fn polish(b: &[f64]) -> f64 {
         } else {
             hi = u;
         }
-        let newton = u - f / df;
+        let step = f / df;
+        if step.abs() <= 2.0 * f64::EPSILON * u {
+            // Converged: the correction is below the resolution of u.
+            return u;
+        }
+        let newton = u - step;
         if !(newton > lo && newton < hi) || (2.0 * f).abs() > (dx_old * df).abs() {
             dx_old = dx;
             dx = 0.5 * (hi - lo);
             u = lo + dx;
+            newton_steps = 0;
         } else {
             dx_old = dx;
-            dx = u - newton;
+            dx = step;
             u = newton;
+            newton_steps += 1;
+            // Two successive Newton steps, the last one tiny: quadratic convergence.
+            if newton_steps >= 2 && step.abs() <= NEWTON_DONE {
+                return u;
+            }
         }
-        if dx.abs() <= 2.0 * f64::EPSILON * u || hi - lo <= 2.0 * f64::EPSILON * hi {
+        if hi - lo <= 2.0 * f64::EPSILON * hi {
             return u;
         }
     }
