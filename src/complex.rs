@@ -264,12 +264,21 @@ impl Patch {
         let Some(t) = self.tet() else {
             return 0;
         };
+        self.segment_poly_bary(t.bary(x0), t.bary(x1), out)
+    }
+
+    /// [`Patch::segment_poly`] for a segment given by the barycentric coordinates of its ends
+    /// (for callers that keep the tetrahedron's barycentric map).
+    ///
+    /// # Panics
+    /// As [`Patch::segment_poly`].
+    pub fn segment_poly_bary(&self, a0: [f64; 4], a1: [f64; 4], out: &mut [f64; 16]) -> usize {
         rational::segment_poly(
             usize::from(self.degree),
             &self.weights,
             &self.rational,
-            t.bary(x0),
-            t.bary(x1),
+            a0,
+            a1,
             out,
         )
     }

@@ -571,3 +571,62 @@ fn quadric_fixture_is_reproduced() {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(config(64))]
+
+    /// A line tangent to a sphere touches F = 0 in a double root: the policy reports the
+    /// touching point, whichever way rounding tips the coefficients.
+    #[test]
+    fn tangent_rays_report_the_touching_point(
+        dir in proptest::array::uniform3(-1.0f64..1.0), normal in proptest::array::uniform3(-1.0f64..1.0),
+        n in 2usize..=7, s0 in 0.2f64..0.8,
+    ) {
+        use apatch::fixtures::{quadric_weights, Quadric};
+        let (dir, normal) = (DVec3::from_array(dir), DVec3::from_array(normal));
+        prop_assume!(dir.length() > 0.1 && normal.cross(dir).length() > 0.1);
+        let (center, r) = (DVec3::new(0.1, 0.2, 0.3), 0.4);
+        let dir = dir.normalize();
+        let normal = (normal - dir * normal.dot(dir)).normalize();
+        let touch = center + normal * r;
+        // The segment passes through `touch` at parameter s0, tangent to the sphere.
+        let (x0, x1) = (touch - dir * s0, touch + dir * (1.0 - s0));
+        let v = [
+            DVec3::new(-2.0, -2.0, -2.0),
+            DVec3::new(3.0, -2.0, -2.0),
+            DVec3::new(-2.0, 3.0, -2.0),
+            DVec3::new(-2.0, -2.0, 3.0),
+        ];
+        let q = Quadric::sphere(center, r);
+        let p = Patch {
+            tet: v.map(|x| x.to_array()),
+            degree: n as u8,
+            weights: quadric_weights(&q, &v, n),
+            rational: Vec::new(),
+            sheet: SheetRule::Any,
+            role: Role::Other,
+            element: 0,
+        };
+        let mut out = [0.0; 16];
+        let len = p.segment_poly(x0, x1, &mut out);
+        let got = uni::first_root(&out[..len]);
+        // Policy: touches are placed to √(τ/|f″|) with τ = 1e-13·max|c|; here f″ = 2 and
+        // max|c| ≲ 10, so within ~1e-6.
+        prop_assert!(got.is_some_and(|t| (t - s0).abs() < 1e-6), "got {:?}, want {}", got, s0);
+        // Moving the line off the sphere by 1e-3 removes the root.
+        let off = normal * 1e-3;
+        let len = p.segment_poly(x0 + off, x1 + off, &mut out);
+        prop_assert_eq!(uni::first_root(&out[..len]), None);
+    }
+}
+
+#[test]
+fn first_root_in_degenerate_intervals() {
+    let c = from_roots(&[0.25, 0.75]);
+    assert_eq!(uni::first_root_in(&c, 0.6, 0.4), None);
+    assert_eq!(uni::first_root_in(&c, f64::NAN, 1.0), None);
+    assert_eq!(uni::first_root_in(&c, 0.25, 0.25), Some(0.25));
+    assert_eq!(uni::first_root_in(&c, 0.3, 0.3), None);
+    // Clamped to [0, 1].
+    assert!((uni::first_root_in(&c, -3.0, 0.5).unwrap() - 0.25).abs() < 1e-15);
+}
