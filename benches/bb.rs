@@ -132,6 +132,22 @@ fn bench<M: Measurement + 'static>(c: &mut Criterion<M>) {
         });
     }
 
+    // A segment through the whole sphere: two roots, so the search must subdivide.
+    for n in [3usize, 5] {
+        let v = tet();
+        let t = Tet::new(v).expect("tetrahedron");
+        let w = quadric_weights(&Quadric::sphere(DVec3::ZERO, 0.5), &v, n);
+        let a0 = t.bary(DVec3::new(-0.45, -0.3, -0.2));
+        let a1 = t.bary(DVec3::new(0.45, 0.3, 0.2));
+        c.bench_function(&format!("restrict+first_root two roots degree {n}"), |b| {
+            b.iter(|| {
+                let mut out = [0.0; 16];
+                let len = poly::restrict(n, black_box(&w), black_box(a0), black_box(a1), &mut out);
+                uni::first_root(&out[..len])
+            })
+        });
+    }
+
     // The 2001 face patch: cubic plus one rational term (degree 5 once cleared).
     let (w, a0, a1) = sphere_case(3);
     let mut w = w;
