@@ -21,6 +21,13 @@
 //!    and whose ends share a sign are dropped.
 //! 3. Intervals narrower than 2⁻³⁰ of [0, 1] that survive are touches: their midpoint is
 //!    reported (or their root, if their ends differ in sign).
+//!
+//! Simple roots come out to a few ulps (Newton stops once in its quadratic phase). The search
+//! is monomorphised for each length 1..=16, so its loops unroll and nothing allocates.
+//!
+//! # Continuing after a rejected root
+//! An exact root at `lo` is reported again: to look past a root r, call
+//! `first_root_in(c, r + δ, hi)` with some δ > 0 suited to the caller's scale.
 
 use super::STACK_LEN;
 
