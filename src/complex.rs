@@ -253,7 +253,7 @@ impl Patch {
         rational::segment_degree(usize::from(self.degree), &self.rational)
     }
 
-    /// Univariate Bernstein coefficients in s ∈ [0,1] of F((1−s)·x0 + s·x1) times the
+    /// Univariate Bernstein coefficients in s ∈ \[0, 1\] of F((1−s)·x0 + s·x1) times the
     /// (positive inside the tetrahedron) rational denominators; returns their number,
     /// [`Patch::segment_degree`] + 1, or 0 when the tetrahedron is degenerate. Inside the
     /// tetrahedron its roots and signs are those of F. No heap allocation.

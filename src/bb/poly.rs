@@ -136,7 +136,7 @@ pub fn eval(n: usize, c: &[f64], a: [f64; 4]) -> f64 {
     })
 }
 
-/// The blossom b(args[0], …, args[n−1]) (symmetric, multi-affine, b(α,…,α) = F(α)).
+/// The blossom b(`args[0]`, …, `args[n−1]`) (symmetric, multi-affine, b(α,…,α) = F(α)).
 ///
 /// # Panics
 /// When `args.len() != n` or `c` has the wrong length.
@@ -216,7 +216,7 @@ pub fn elevate(n: usize, c: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Restriction of F to the segment α(s) = (1−s)·a0 + s·a1, s ∈ [0,1]: writes the n+1
+/// Restriction of F to the segment α(s) = (1−s)·a0 + s·a1, s ∈ \[0, 1\]: writes the n+1
 /// univariate Bernstein coefficients b_k = blossom(a0 ×(n−k), a1 ×k) to `out[..n+1]` and
 /// returns n+1. No heap allocation up to degree [`STACK_DEGREE`].
 ///

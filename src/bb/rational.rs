@@ -216,7 +216,7 @@ fn sum_on_segment(
     out
 }
 
-/// Bernstein coefficients in s ∈ [0,1] of F(α(s))·Π_g D_g(α(s)), α(s) = (1−s)a0 + s·a1, where
+/// Bernstein coefficients in s ∈ \[0, 1\] of F(α(s))·Π_g D_g(α(s)), α(s) = (1−s)a0 + s·a1, where
 /// F is the polynomial (degree `degree`, `weights`) plus the `rational` terms and the product
 /// runs over their distinct denominators. Writes them to `out` and returns their number
 /// (degree + 1 without rational terms). No heap allocation.
