@@ -630,3 +630,29 @@ fn first_root_in_degenerate_intervals() {
     // Clamped to [0, 1].
     assert!((uni::first_root_in(&c, -3.0, 0.5).unwrap() - 0.25).abs() < 1e-15);
 }
+
+proptest! {
+    #![proptest_config(config(128))]
+
+    /// World-space segments through random tetrahedra: the first root of `segment_poly`
+    /// against F sampled along the segment (polynomial and rational patches alike).
+    #[test]
+    fn segment_poly_first_root_matches_sampled_value(
+        p in rational_patch(), keep_rational in proptest::bool::ANY,
+        a0 in bary_inside(), a1 in bary_inside(),
+    ) {
+        let mut p = p;
+        if !keep_rational {
+            p.rational.clear();
+        }
+        let t = p.tet().unwrap();
+        let (x0, x1) = (t.point(a0), t.point(a1));
+        let mut out = [0.0; 16];
+        let len = p.segment_poly(x0, x1, &mut out);
+        // Inside the tetrahedron the denominators are positive: the roots are F's.
+        let f = |s: f64| patch_value(&p, lerp4(a0, a1, s));
+        let truth = sampled_first_root(f, 2000);
+        let g = |s: f64| uni::eval(&out[..len], s);
+        check_first_root(uni::first_root(&out[..len]), truth, g, max_abs(&out[..len]))?;
+    }
+}
