@@ -7,8 +7,9 @@
 //! - f *touches* zero at t: |f| ≤ τ around a point where f is not monotone (a tangency or
 //!   double root that rounding may have lifted slightly above zero or pushed slightly below).
 //!
-//! So tangential touches are **reported** (at the touching point, to within ≈ √(τ/|f″|) in t),
-//! whichever side rounding puts them on. Where f stays within τ of zero over a stretch (roots of
+//! So tangential touches are **reported**, whichever side rounding puts them on: at the
+//! touching point (the extremum of f), or at the first of the two roots rounding split it into
+//! (≈ √(rounding/|f″|) ≈ 1e-8 before it). Where f stays within τ of zero over a stretch (roots of
 //! high multiplicity), the first point of that stretch is reported. An identically zero
 //! polynomial (s = 0), an empty slice, or non-finite coefficients give `None`.
 //!
@@ -19,8 +20,9 @@
 //!    Bernstein basis), which is polished by Newton's method safeguarded by bisection inside
 //!    the sign bracket. Intervals where f is monotone (all control-polygon slopes beyond ±τ)
 //!    and whose ends share a sign are dropped.
-//! 3. Intervals narrower than 2⁻³⁰ of [0, 1] that survive are touches: their midpoint is
-//!    reported (or their root, if their ends differ in sign).
+//! 3. Intervals narrower than 2⁻³⁰ of [0, 1] that survive are touches (or their root is
+//!    polished, if their ends differ in sign): Newton on f′ of the whole polynomial refines
+//!    the touch to the nearby extremum, and a sign change between the two is bisected.
 //!
 //! Simple roots come out to a few ulps (Newton stops once in its quadratic phase). The search
 //! is monomorphised for each length 1..=16, so its loops unroll and nothing allocates.
@@ -33,7 +35,7 @@ use super::STACK_LEN;
 
 /// Relative tolerance τ/max|ck| under which a coefficient counts as touching zero. Rounding in
 /// a restricted segment polynomial is a few ulps of the largest weight; 1e-13 leaves ~500×
-/// headroom over that while placing tangencies to ≈ 3e-7 of the interval.
+/// headroom over that. A touch is detected within √(τ/|f″|) of it, then refined.
 pub const TOUCH_TOL: f64 = 1e-13;
 
 /// Width (relative to [0, 1]) below which an unresolved interval is reported as a touch.
@@ -96,7 +98,14 @@ fn first_root_fixed<const N: usize>(c: &[f64; N], lo: f64, hi: f64) -> Option<f6
         if excluded(c, tol) {
             return None;
         }
-        return Search { tol, splits: 0 }.search(c, 0.0, 1.0);
+        return Search {
+            tol,
+            splits: 0,
+            top: c,
+            top_a: 0.0,
+            top_w: 1.0,
+        }
+        .search(c, 0.0, 1.0);
     }
     if lo == hi {
         let (f, _) = eval_d(c, lo);
@@ -108,7 +117,14 @@ fn first_root_fixed<const N: usize>(c: &[f64; N], lo: f64, hi: f64) -> Option<f6
     if excluded(&b, tol) {
         return None;
     }
-    Search { tol, splits: 0 }.search(&b, lo, hi - lo)
+    Search {
+        tol,
+        splits: 0,
+        top: &b,
+        top_a: lo,
+        top_w: hi - lo,
+    }
+    .search(&b, lo, hi - lo)
 }
 
 /// (f(t), f′(t)) by de Casteljau on exactly N coefficients.
@@ -181,14 +197,23 @@ fn monotone<const N: usize>(b: &[f64; N], tol: f64) -> bool {
     up || down
 }
 
-struct Search {
+struct Search<'a, const N: usize> {
     tol: f64,
     splits: usize,
+    /// The whole polynomial on [top_a, top_a + top_w] (for refining touches).
+    top: &'a [f64; N],
+    top_a: f64,
+    top_w: f64,
 }
 
-impl Search {
+/// How far (in the whole interval's parameter) a touch leaf may be from the extremum it is
+/// refined to: the stretch where |f| ≤ τ around a tangency is √(τ/|f″|) wide, 3e-4 even for
+/// |f″| = 1e-6·max|c|.
+const TOUCH_WINDOW: f64 = 1e-2;
+
+impl<const N: usize> Search<'_, N> {
     /// First root of the polynomial with coefficients `b` on [a, a+w] (global parameter).
-    fn search<const N: usize>(&mut self, b: &[f64; N], a: f64, w: f64) -> Option<f64> {
+    fn search(&mut self, b: &[f64; N], a: f64, w: f64) -> Option<f64> {
         let n = N - 1;
         if b[0] == 0.0 {
             return Some(a);
@@ -210,7 +235,7 @@ impl Search {
             if b[n] != 0.0 && (b[0] > 0.0) != (b[n] > 0.0) {
                 return Some(a + w * polish(b));
             }
-            return Some(a + 0.5 * w);
+            return Some(self.touch(a + 0.5 * w));
         }
         self.splits += 1;
         let (left, right) = split(b, 0.5);
@@ -225,6 +250,84 @@ impl Search {
         }
         None
     }
+}
+
+impl<const N: usize> Search<'_, N> {
+    /// Refines a touch leaf at global `t`: Newton on f′ of the whole polynomial finds the
+    /// nearby extremum; a sign change between the leaf and the extremum is bisected to the
+    /// first root, otherwise the extremum is the touching point (when |f| ≤ τ there). Falls
+    /// back to `t` when the refinement does not settle within [`TOUCH_WINDOW`].
+    fn touch(&self, t: f64) -> f64 {
+        if N < 3 {
+            return t;
+        }
+        let to_global = |u: f64| self.top_a + u * self.top_w;
+        let u0 = (t - self.top_a) / self.top_w;
+        let (f0, _, _) = eval_d2(self.top, u0);
+        let mut u = u0;
+        let mut settled = false;
+        for _ in 0..40 {
+            let (_, d1, d2) = eval_d2(self.top, u);
+            if d2 == 0.0 {
+                break;
+            }
+            let step = d1 / d2;
+            u -= step;
+            if !((u - u0).abs() <= TOUCH_WINDOW && (0.0..=1.0).contains(&u)) {
+                return t;
+            }
+            if step.abs() <= 4.0 * f64::EPSILON * u.abs().max(1e-3) {
+                settled = true;
+                break;
+            }
+        }
+        if !settled {
+            return t;
+        }
+        let (fe, _, _) = eval_d2(self.top, u);
+        if fe == 0.0 {
+            return to_global(u);
+        }
+        if f0 != 0.0 && (fe > 0.0) != (f0 > 0.0) {
+            // A genuine crossing between the leaf and the extremum: bisect to it.
+            let (mut lo, mut hi) = (u0.min(u), u0.max(u));
+            let lo_positive = eval_d2(self.top, lo).0 > 0.0;
+            for _ in 0..80 {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                if (eval_d2(self.top, mid).0 > 0.0) == lo_positive {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return to_global(0.5 * (lo + hi));
+        }
+        if fe.abs() <= self.tol {
+            return to_global(u);
+        }
+        t
+    }
+}
+
+/// (f, f′, f″) at t by de Casteljau down to the quadratic level (N ≥ 3).
+#[inline]
+fn eval_d2<const N: usize>(c: &[f64; N], t: f64) -> (f64, f64, f64) {
+    let n = (N - 1) as f64;
+    let mut b = *c;
+    let s = 1.0 - t;
+    for r in (3..N).rev() {
+        for i in 0..r {
+            b[i] = s * b[i] + t * b[i + 1];
+        }
+    }
+    let (b0, b1, b2) = (b[0], b[1], b[2]);
+    let f = s * s * b0 + 2.0 * s * t * b1 + t * t * b2;
+    let d1 = n * (s * (b1 - b0) + t * (b2 - b1));
+    let d2 = n * (n - 1.0) * (b0 - 2.0 * b1 + b2);
+    (f, d1, d2)
 }
 
 /// Below this Newton correction (in the interval's own parameter) the iteration has reached
@@ -302,8 +405,9 @@ mod tests {
 
     /// Simple roots are polished to a few ulps.
     const SIMPLE: f64 = 1e-14;
-    /// Tangencies are placed to √(τ/|f″|) ≈ √(1e-13) ≈ 3e-7 (policy of the module).
-    const TOUCH: f64 = 1e-6;
+    /// Tangencies are refined to the extremum (or to the first of two roots rounding split
+    /// them into): √(rounding/|f″|) ≈ √(1e-15) ≈ 3e-8.
+    const TOUCH: f64 = 1e-7;
 
     #[test]
     fn simple_roots() {
