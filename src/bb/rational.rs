@@ -181,10 +181,10 @@ fn monomial_on_segment(mu: [u8; 4], a0: [f64; 4], a1: [f64; 4], e: usize, out: &
     for i in 0..4 {
         for _ in 0..mu[i] {
             // Multiply by the linear factor with Bernstein coefficients [a0_i, a1_i].
-            let k = len as f64; // new degree
+            let inv = 1.0 / len as f64; // 1/(new degree)
             out[len] = a1[i] * out[len - 1];
             for j in (1..len).rev() {
-                let w = j as f64 / k;
+                let w = j as f64 * inv;
                 out[j] = w * a1[i] * out[j - 1] + (1.0 - w) * a0[i] * out[j];
             }
             out[0] *= a0[i];
@@ -216,7 +216,7 @@ fn sum_on_segment(
     out
 }
 
-/// Bernstein coefficients in s ∈ [0,1] of F(α(s))·Π_g D_g(α(s)), α(s) = (1−s)a0 + s·a1, where
+/// Bernstein coefficients in s ∈ \[0, 1\] of F(α(s))·Π_g D_g(α(s)), α(s) = (1−s)a0 + s·a1, where
 /// F is the polynomial (degree `degree`, `weights`) plus the `rational` terms and the product
 /// runs over their distinct denominators. Writes them to `out` and returns their number
 /// (degree + 1 without rational terms). No heap allocation.
