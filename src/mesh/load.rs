@@ -5,7 +5,6 @@ use super::report::{Element, FindingKind, Report};
 use super::{obj, off, orient, validate, Mesh};
 use crate::error::{Error, Result};
 use glam::DVec3;
-use std::collections::HashMap;
 use std::path::Path;
 
 /// File formats `load` reads.
@@ -78,8 +77,8 @@ pub fn load_bytes(bytes: &[u8], format: Format, path: &Path) -> Result<(Mesh, Re
         path: path.into(),
         message,
     })?;
-    orient::orient(&mut mesh, &mut report);
-    validate::validate(&mesh, &mut report);
+    let topology = orient::orient(&mut mesh, &mut report);
+    validate::validate(&mesh, topology, &mut report);
     Ok((mesh, report))
 }
 
@@ -105,17 +104,30 @@ fn from_raw(raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, Stri
     let n_file = raw.positions.len();
     // Weld: canonical file vertex of each file vertex (first with the same coordinates;
     // +0.0 turns −0.0 into 0.0 so both weld).
-    let mut canon: Vec<u32> = Vec::with_capacity(n_file);
-    let mut seen: HashMap<[u64; 3], u32> = HashMap::with_capacity(n_file);
-    for (i, p) in raw.positions.iter().enumerate() {
-        let key = [
+    // Sorting by the coordinates' bits groups exact duplicates; the smallest index of each
+    // group is its canonical vertex.
+    let key = |p: DVec3| {
+        [
             (p.x + 0.0).to_bits(),
             (p.y + 0.0).to_bits(),
             (p.z + 0.0).to_bits(),
-        ];
-        canon.push(*seen.entry(key).or_insert(i as u32));
+        ]
+    };
+    let mut order: Vec<u32> = (0..n_file as u32).collect();
+    order.sort_unstable_by_key(|&i| (key(raw.positions[i as usize]), i));
+    let mut canon: Vec<u32> = vec![0; n_file];
+    let mut g = 0;
+    while g < order.len() {
+        let first = order[g];
+        let k = key(raw.positions[first as usize]);
+        let mut h = g;
+        while h < order.len() && key(raw.positions[order[h] as usize]) == k {
+            canon[order[h] as usize] = first;
+            h += 1;
+        }
+        g = h;
     }
-    drop(seen);
+    drop(order);
     let mut referenced = vec![false; n_file];
     for face in &raw.faces {
         for &v in face {
@@ -141,10 +153,8 @@ fn from_raw(raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, Stri
             out.pop();
         }
         let line = raw.face_lines[f];
-        let mut sorted = out.clone();
-        sorted.sort_unstable();
-        sorted.dedup();
-        if sorted.len() < 3 || sorted.len() != out.len() {
+        let repeats = (1..out.len()).any(|i| out[..i].contains(&out[i]));
+        if out.len() < 3 || repeats {
             dropped.push(Element::Face {
                 index: f as u32,
                 line,
