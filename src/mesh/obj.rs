@@ -51,9 +51,12 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
     let mut max_index: u64 = 0;
     let mut max_index_line = 0u32;
     for (line_no, line) in lines(bytes) {
-        let first = line.iter().position(|b| !b.is_ascii_whitespace());
-        let Some(first) = first else { continue };
-        if line[first] == b'#' {
+        // Comments run from `#` to the end of the line.
+        let line = match line.iter().position(|&b| b == b'#') {
+            Some(i) => &line[..i],
+            None => line,
+        };
+        if line.iter().all(u8::is_ascii_whitespace) {
             continue;
         }
         let text = std::str::from_utf8(line)
