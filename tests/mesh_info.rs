@@ -44,6 +44,9 @@ fn json_of_models_matches_known_topology() {
     assert_eq!(j["normals"], "area");
     assert_eq!(j["edges_2001"]["positive"], 30);
     assert_eq!(j["triangles_2001"]["positive"], 20);
+    // 1994 pairs the normals the other way round: the same edges are negatively convex.
+    assert_eq!(j["edges_1994"]["negative"], 30);
+    assert_eq!(j["triangles_1994"]["negative"], 20);
     assert_eq!(j["trihedral_vertices"], 0);
     assert_eq!(j["above_face_failures"].as_array().unwrap().len(), 0);
 }
