@@ -56,19 +56,31 @@ pub fn load(path: &Path) -> Result<(Mesh, Report)> {
         source,
     })?;
     let format = Format::detect(path, &bytes)?;
-    load_bytes(&bytes, format, path)
+    let raw = parse(&bytes, format, path)?;
+    // The text is no longer needed: free it before building the mesh.
+    drop(bytes);
+    finish(raw, path)
 }
 
 /// [`load`] from bytes already in memory; `path` only names the source in messages.
 pub fn load_bytes(bytes: &[u8], format: Format, path: &Path) -> Result<(Mesh, Report)> {
+    finish(parse(bytes, format, path)?, path)
+}
+
+/// Reads the polygon soup.
+fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<RawMesh> {
     let parsed = match format {
         Format::Obj => obj::parse(bytes),
         Format::Off => off::parse(bytes),
     };
-    let raw = parsed.map_err(|message| Error::Input {
+    parsed.map_err(|message| Error::Input {
         path: path.into(),
         message,
-    })?;
+    })
+}
+
+/// Welds, cleans, orients and validates a polygon soup.
+fn finish(raw: RawMesh, path: &Path) -> Result<(Mesh, Report)> {
     let mut report = Report {
         path: path.display().to_string(),
         findings: Vec::new(),
