@@ -289,6 +289,13 @@ fn file_normals_obj_corners_and_noff() {
     let off = "NOFF\n3 1 0\n0 0 0 0 0 2\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n";
     let (m, _) = mesh::load_bytes(off.as_bytes(), Format::Off, Path::new("n.off")).unwrap();
     assert_eq!(m.file_normals.unwrap()[0], glam::DVec3::Z);
+    // One unreferenced `vn` per `v`: per-vertex normals.
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 3\nvn 0 0 1\nvn 1 0 0\nf 1 2 3\n";
+    let (m, _) = mesh::load_bytes(obj.as_bytes(), Format::Obj, Path::new("n.obj")).unwrap();
+    assert_eq!(
+        m.file_normals.unwrap(),
+        vec![glam::DVec3::Z, glam::DVec3::Z, glam::DVec3::X]
+    );
 }
 
 #[test]

@@ -107,7 +107,7 @@ pub fn validate(mesh: &Mesh, topology: Option<Topology>, report: &mut Report) ->
         report.add(
             FindingKind::NonManifoldVertex,
             format!(
-                "{} vertices are non-manifold (their faces do not form one fan)",
+                "{} vertices are non-manifold (their faces do not form one consistently oriented fan)",
                 bad_vertices.len()
             ),
             bad_vertices,
