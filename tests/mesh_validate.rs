@@ -327,3 +327,21 @@ fn fans_are_counter_clockwise_from_outside() {
         }
     }
 }
+
+#[test]
+fn from_polygons_runs_the_same_pipeline() {
+    let (m, _) = corpus("inward_orientation.obj");
+    // Reverse every face again: the pipeline must flip them back.
+    let faces: Vec<Vec<u32>> = m
+        .faces
+        .iter()
+        .map(|f| f.iter().rev().copied().collect())
+        .collect();
+    let (fixed, r) = mesh::from_polygons(m.positions.clone(), faces).unwrap();
+    assert_eq!(fixed.faces, m.faces);
+    assert_eq!(elements(&r, FindingKind::InwardOrientation).len(), 4);
+    let e = mesh::from_polygons(m.positions.clone(), vec![vec![0, 1, 7]]).unwrap_err();
+    assert!(e.to_string().contains("face 0 refers to vertex 7"), "{e}");
+    let e = mesh::from_polygons(vec![glam::DVec3::NAN; 3], vec![vec![0, 1, 2]]).unwrap_err();
+    assert!(e.to_string().contains("vertex 0: non-finite"), "{e}");
+}

@@ -67,6 +67,37 @@ pub fn load_bytes(bytes: &[u8], format: Format, path: &Path) -> Result<(Mesh, Re
     finish(parse(bytes, format, path)?, path)
 }
 
+/// The [`load`] pipeline (weld, clean, orient, validate) for a mesh built in memory: `faces`
+/// index `positions` (0-based). Errors name the offending face or vertex; lines in the result
+/// and its findings are 0.
+pub fn from_polygons(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> Result<(Mesh, Report)> {
+    let invalid = |m: String| Error::Invalid(format!("polygon mesh: {m}"));
+    for (i, p) in positions.iter().enumerate() {
+        for c in p.to_array() {
+            super::raw::check_coordinate(c).map_err(|m| invalid(format!("vertex {i}: {m}")))?;
+        }
+    }
+    for (f, face) in faces.iter().enumerate() {
+        if face.len() < 3 {
+            return Err(invalid(format!("face {f} has {} vertices", face.len())));
+        }
+        if let Some(v) = face.iter().find(|&&v| v as usize >= positions.len()) {
+            return Err(invalid(format!(
+                "face {f} refers to vertex {v} but there are {}",
+                positions.len()
+            )));
+        }
+    }
+    let raw = RawMesh {
+        position_lines: vec![0; positions.len()],
+        face_lines: vec![0; faces.len()],
+        positions,
+        faces,
+        ..RawMesh::default()
+    };
+    finish(raw, Path::new("<memory>"))
+}
+
 /// Reads the polygon soup.
 fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<RawMesh> {
     let parsed = match format {
