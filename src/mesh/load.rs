@@ -127,7 +127,7 @@ fn finish(raw: RawMesh, path: &Path) -> Result<(Mesh, Report)> {
 
 /// Welds exactly coincident vertices, removes repeated corners and degenerate faces, drops
 /// unreferenced vertices and gathers file normals.
-fn from_raw(raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, String> {
+fn from_raw(mut raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, String> {
     if raw.ignored > 0 {
         report.add(
             FindingKind::IgnoredStatements,
@@ -178,20 +178,21 @@ fn from_raw(raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, Stri
         }
     }
 
-    // Clean faces: canonical ids, consecutive repeats removed, degenerate faces dropped.
-    let mut faces = Vec::with_capacity(raw.faces.len());
-    let mut face_lines = Vec::with_capacity(raw.faces.len());
-    let mut kept_from = Vec::with_capacity(raw.faces.len());
+    // File normals are gathered per canonical file vertex before the faces are rewritten.
+    let normals = accumulate_normals(&raw, &canon);
+
+    // Clean faces in place: canonical ids, consecutive repeats removed, degenerate faces dropped.
+    let n_raw_faces = raw.faces.len();
+    let mut faces = Vec::with_capacity(n_raw_faces);
+    let mut face_lines = Vec::with_capacity(n_raw_faces);
     let mut repeated = Vec::new();
     let mut dropped = Vec::new();
-    for (f, face) in raw.faces.iter().enumerate() {
-        let mut out: Vec<u32> = Vec::with_capacity(face.len());
-        for &v in face {
-            let c = canon[v as usize];
-            if out.last() != Some(&c) {
-                out.push(c);
-            }
+    for (f, mut out) in std::mem::take(&mut raw.faces).into_iter().enumerate() {
+        let original_len = out.len();
+        for v in out.iter_mut() {
+            *v = canon[*v as usize];
         }
+        out.dedup();
         while out.len() > 1 && out.first() == out.last() {
             out.pop();
         }
@@ -204,7 +205,7 @@ fn from_raw(raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, Stri
             });
             continue;
         }
-        if out.len() != face.len() {
+        if out.len() != original_len {
             repeated.push(Element::Face {
                 index: faces.len() as u32,
                 line,
@@ -212,12 +213,10 @@ fn from_raw(raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, Stri
         }
         faces.push(out);
         face_lines.push(line);
-        kept_from.push(f);
     }
     if faces.is_empty() {
         return Err(format!(
-            "all {} faces are degenerate (fewer than 3 distinct vertices)",
-            raw.faces.len()
+            "all {n_raw_faces} faces are degenerate (fewer than 3 distinct vertices)"
         ));
     }
 
@@ -300,15 +299,7 @@ fn from_raw(raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, Stri
         );
     }
 
-    let file_normals = gather_normals(
-        &raw,
-        &kept_from,
-        &canon,
-        &new_id,
-        &positions,
-        &vertex_lines,
-        report,
-    );
+    let file_normals = normals.and_then(|acc| finish_normals(acc, &new_id, &vertex_lines, report));
     let n_faces = faces.len() as u32;
     Ok(Mesh {
         positions,
@@ -320,56 +311,74 @@ fn from_raw(raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, Stri
     })
 }
 
-/// Per-vertex file normals: the normalised mean of the unit normals given for the vertex
-/// (OBJ corners, or NOFF vertices welded into it). `None` when the file has none or some vertex
-/// lacks one (reported).
-fn gather_normals(
-    raw: &RawMesh,
-    kept_from: &[usize],
-    canon: &[u32],
-    new_id: &[u32],
-    positions: &[DVec3],
-    vertex_lines: &[u32],
-    report: &mut Report,
-) -> Option<Vec<DVec3>> {
-    let n = positions.len();
-    let mut sum = vec![DVec3::ZERO; n];
-    let mut first = vec![None::<DVec3>; n];
-    let mut differs = vec![false; n];
+/// Unit file normals summed per canonical file vertex, the first one seen, and whether later
+/// ones differed from it.
+struct NormalSums {
+    sum: Vec<DVec3>,
+    first: Vec<Option<DVec3>>,
+    differs: Vec<bool>,
+}
+
+/// Gathers the file's normals (OBJ corners, or per-vertex OBJ/NOFF normals) onto canonical file
+/// vertices; `None` when the file has none.
+fn accumulate_normals(raw: &RawMesh, canon: &[u32]) -> Option<NormalSums> {
+    let n = raw.positions.len();
+    let mut acc = NormalSums {
+        sum: vec![DVec3::ZERO; n],
+        first: vec![None; n],
+        differs: vec![false; n],
+    };
     let mut add = |v: u32, normal: DVec3| {
         let u = normal.normalize_or_zero();
         let v = v as usize;
-        match first[v] {
-            None => first[v] = Some(u),
-            Some(f) if (f - u).length() > 1e-6 => differs[v] = true,
+        match acc.first[v] {
+            None => acc.first[v] = Some(u),
+            Some(f) if (f - u).length() > 1e-6 => acc.differs[v] = true,
             Some(_) => {}
         }
-        sum[v] += u;
+        acc.sum[v] += u;
     };
     if let Some(vn) = &raw.vertex_normals {
         for (i, &nrm) in vn.iter().enumerate() {
-            let m = new_id[canon[i] as usize];
-            if m != u32::MAX {
-                add(m, nrm);
-            }
+            add(canon[i], nrm);
         }
     } else if !raw.corner_normals.is_empty() {
-        let mut offsets = Vec::with_capacity(raw.faces.len() + 1);
-        let mut o = 0usize;
+        let mut c = 0;
         for face in &raw.faces {
-            offsets.push(o);
-            o += face.len();
-        }
-        for &f in kept_from {
-            for (k, &v) in raw.faces[f].iter().enumerate() {
-                let ni = raw.corner_normals[offsets[f] + k];
+            for &v in face {
+                let ni = raw.corner_normals[c];
+                c += 1;
                 if ni != NO_NORMAL {
-                    add(new_id[canon[v as usize] as usize], raw.normals[ni as usize]);
+                    add(canon[v as usize], raw.normals[ni as usize]);
                 }
             }
         }
     } else {
         return None;
+    }
+    Some(acc)
+}
+
+/// Per-vertex file normals of the mesh: the normalised mean of the unit normals given for the
+/// vertex (its corners, or the file vertices welded into it). `None` when some vertex lacks one
+/// (reported).
+fn finish_normals(
+    acc: NormalSums,
+    new_id: &[u32],
+    vertex_lines: &[u32],
+    report: &mut Report,
+) -> Option<Vec<DVec3>> {
+    let n = vertex_lines.len();
+    let mut sum = vec![DVec3::ZERO; n];
+    let mut first = vec![None::<DVec3>; n];
+    let mut differs = vec![false; n];
+    for (i, &m) in new_id.iter().enumerate() {
+        if m != u32::MAX {
+            let m = m as usize;
+            sum[m] = acc.sum[i];
+            first[m] = acc.first[i];
+            differs[m] = acc.differs[i];
+        }
     }
     let missing: Vec<Element> = (0..n)
         .filter(|&v| first[v].is_none() || sum[v].length() < 1e-12)
