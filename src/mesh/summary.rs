@@ -145,7 +145,13 @@ pub fn summary(mesh: &Mesh, report: &Report, normals: NormalMethod) -> Summary {
         mesh
     };
     let classes = n.as_ref().ok().map(|n| {
-        let tt = Topology::new(tm.positions.len(), &tm.faces);
+        let rebuilt;
+        let tt = if triangulated {
+            rebuilt = Topology::new(tm.positions.len(), &tm.faces);
+            &rebuilt
+        } else {
+            &topo
+        };
         let p = &tm.positions;
         let mut edges = ClassCounts::default();
         for [i, j] in &tt.edges {
