@@ -21,6 +21,7 @@
 pub mod bb;
 pub mod check;
 pub mod complex;
+pub mod complex_io;
 pub mod error;
 pub mod export;
 pub mod fixtures;

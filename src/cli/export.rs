@@ -14,7 +14,7 @@ pub enum ExportCommand {
 /// Arguments of `apatch export patches`.
 #[derive(Args, Debug)]
 pub struct PatchesArgs {
-    /// A scene (.toml) or a model file.
+    /// A scene (.toml), a model file, or a patch complex (.json, re-validated and rewritten).
     pub input: PathBuf,
     /// Output JSON file.
     #[arg(short, long)]
@@ -25,10 +25,9 @@ pub struct PatchesArgs {
 pub fn run(cmd: ExportCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         ExportCommand::Patches(a) => {
-            anyhow::bail!(
-                "{}: `apatch export patches` is not available yet",
-                a.input.display()
-            )
+            let complex = super::check::load_complex(&a.input)?;
+            apatch::complex_io::write_json_file(&complex, &a.output)?;
+            Ok(ExitCode::SUCCESS)
         }
     }
 }

@@ -1,1 +1,0 @@
-//! `check` module (see ARCHITECTURE.md).

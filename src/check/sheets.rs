@@ -1,0 +1,243 @@
+//! Sheet uniqueness, by sampling lines through the patches that can vanish.
+//!
+//! - Shooting patches ([`SheetRule::Shooting`]): lines from lattice points q of the base simplex
+//!   to lattice points u of the top simplex, φ(t) = F((1−t)q + t·u). The minimal root in [0, 1)
+//!   must be simple: |φ′| > tolerance · S there (S = the patch's largest weight). Roots are found
+//!   from sign changes between samples (refined by bisection) and from sampled local minima of
+//!   |φ| whose critical point (bisection on φ′) has |φ| ≤ tolerance · S (touching roots).
+//! - Single-sheet patches ([`SheetRule::Any`], degree ≥ 2): lines from each tetrahedron vertex to
+//!   lattice points of the opposite face; a line whose samples change sign more than once crosses
+//!   F = 0 more than once. (Touching roots and pairs of roots between two samples are not seen.)
+
+use super::eval::PatchEval;
+use super::{CheckOptions, Location, SheetStats};
+use crate::complex::SheetRule;
+use rayon::prelude::*;
+
+/// Bisection steps on [0, 1]-subintervals: 2⁻⁶⁰ is below f64 resolution of t.
+const BISECTIONS: usize = 60;
+
+/// Measures every patch.
+pub(super) fn measure(evals: &[PatchEval<'_>], opts: &CheckOptions) -> SheetStats {
+    evals
+        .par_iter()
+        .enumerate()
+        .map(|(pi, e)| patch_sheets(pi, e, opts, SheetStats::default()))
+        .reduce(SheetStats::default, merge)
+}
+
+fn merge(a: SheetStats, b: SheetStats) -> SheetStats {
+    let b_smaller = match (a.min_root_slope, b.min_root_slope) {
+        (None, Some(_)) => true,
+        (Some(x), Some(y)) => y < x || (y.is_nan() && !x.is_nan()),
+        _ => false,
+    };
+    let (min_root_slope, min_root_slope_at) = if b_smaller {
+        (b.min_root_slope, b.min_root_slope_at)
+    } else {
+        (a.min_root_slope, a.min_root_slope_at)
+    };
+    SheetStats {
+        shooting_patches: a.shooting_patches + b.shooting_patches,
+        shooting_lines: a.shooting_lines + b.shooting_lines,
+        non_simple: a.non_simple + b.non_simple,
+        min_root_slope,
+        min_root_slope_at,
+        vertex_lines: a.vertex_lines + b.vertex_lines,
+        multi_root_lines: a.multi_root_lines + b.multi_root_lines,
+        multi_root_at: a.multi_root_at.or(b.multi_root_at),
+    }
+}
+
+/// Interior lattice points of the simplex on `verts` (tetrahedron-local indices), `res` steps per
+/// edge, as barycentric 4-vectors; a single vertex gives itself.
+fn simplex_lattice(verts: &[u8], res: usize) -> Vec<[f64; 4]> {
+    let res = res.max(verts.len() + 1);
+    let mut out = Vec::new();
+    let mut put = |w: &[usize]| {
+        let mut a = [0.0; 4];
+        for (v, &k) in verts.iter().zip(w) {
+            a[usize::from(*v)] = k as f64 / res as f64;
+        }
+        out.push(a);
+    };
+    match verts.len() {
+        1 => put(&[res]),
+        2 => (1..res).for_each(|i| put(&[i, res - i])),
+        _ => {
+            for i in 1..res {
+                for j in 1..res - i {
+                    put(&[i, j, res - i - j]);
+                }
+            }
+        }
+    }
+    out
+}
+
+fn lerp(q: &[f64; 4], u: &[f64; 4], t: f64) -> [f64; 4] {
+    std::array::from_fn(|i| (1.0 - t) * q[i] + t * u[i])
+}
+
+fn point(e: &PatchEval<'_>, alpha: [f64; 4]) -> [f64; 3] {
+    let v = e.patch.tet_points();
+    (0..4)
+        .map(|i| alpha[i] * v[i])
+        .sum::<glam::DVec3>()
+        .to_array()
+}
+
+fn patch_sheets(
+    pi: usize,
+    e: &PatchEval<'_>,
+    opts: &CheckOptions,
+    mut stats: SheetStats,
+) -> SheetStats {
+    if e.has_no_zero() {
+        return stats;
+    }
+    let n = opts.line_samples.max(4);
+    match &e.patch.sheet {
+        SheetRule::Shooting { base, top } => {
+            stats.shooting_patches += 1;
+            let s = e.weight_scale().max(f64::MIN_POSITIVE);
+            let tol = opts.simple_root_tolerance;
+            for q in simplex_lattice(base, opts.sheet_resolution) {
+                for u in simplex_lattice(top, opts.sheet_resolution) {
+                    stats.shooting_lines += 1;
+                    if let Some((t, slope)) = minimal_root(e, &q, &u, n, tol * s) {
+                        let rel = slope / s;
+                        if rel <= tol || rel.is_nan() {
+                            stats.non_simple += 1;
+                        }
+                        let smaller = stats
+                            .min_root_slope
+                            .is_none_or(|m| rel < m || (rel.is_nan() && !m.is_nan()));
+                        if smaller {
+                            stats.min_root_slope = Some(rel);
+                            stats.min_root_slope_at = Some(Location {
+                                patches: vec![pi],
+                                point: point(e, lerp(&q, &u, t)),
+                                vertex: None,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        SheetRule::Any if e.patch.degree >= 2 => {
+            for apex in 0..4u8 {
+                let face: Vec<u8> = (0..4u8).filter(|&k| k != apex).collect();
+                let mut a = [0.0; 4];
+                a[usize::from(apex)] = 1.0;
+                for q in simplex_lattice(&face, opts.sheet_resolution) {
+                    stats.vertex_lines += 1;
+                    let (roots, first) = count_sign_changes(e, &a, &q, n);
+                    if roots > 1 {
+                        stats.multi_root_lines += 1;
+                        if stats.multi_root_at.is_none() {
+                            stats.multi_root_at = Some(Location {
+                                patches: vec![pi],
+                                point: point(e, lerp(&a, &q, first)),
+                                vertex: None,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        SheetRule::Any => {}
+    }
+    stats
+}
+
+/// Sign changes of F along the segment from `a` to `b` (N + 1 samples), and the parameter of
+/// the first.
+fn count_sign_changes(e: &PatchEval<'_>, a: &[f64; 4], b: &[f64; 4], n: usize) -> (usize, f64) {
+    let mut prev: Option<bool> = None;
+    let mut count = 0;
+    let mut first = 0.0;
+    for k in 0..=n {
+        let t = k as f64 / n as f64;
+        let f = e.value(lerp(a, b, t));
+        if f == 0.0 || f.is_nan() {
+            continue;
+        }
+        let pos = f > 0.0;
+        if prev.is_some_and(|p| p != pos) {
+            if count == 0 {
+                first = t;
+            }
+            count += 1;
+        }
+        prev = Some(pos);
+    }
+    (count, first)
+}
+
+/// The minimal root of φ(t) = F((1−t)q + t·u) in [0, 1) and |φ′| there; `touch` is the |φ| at
+/// a critical point below which it counts as a (double) root.
+fn minimal_root(
+    e: &PatchEval<'_>,
+    q: &[f64; 4],
+    u: &[f64; 4],
+    n: usize,
+    touch: f64,
+) -> Option<(f64, f64)> {
+    let phi = |t: f64| e.value(lerp(q, u, t));
+    let dphi = |t: f64| {
+        let j = e.bary_jet(lerp(q, u, t));
+        (0..4).map(|i| j.grad[i] * (u[i] - q[i])).sum::<f64>()
+    };
+    let ts: Vec<f64> = (0..=n).map(|k| k as f64 / n as f64).collect();
+    let f: Vec<f64> = ts.iter().map(|&t| phi(t)).collect();
+    let root_at = |t: f64| Some((t, dphi(t).abs()));
+    for k in 0..n {
+        if f[k] == 0.0 {
+            return root_at(ts[k]);
+        }
+        if f[k + 1] != 0.0 && (f[k] > 0.0) != (f[k + 1] > 0.0) {
+            return root_at(bisect(&phi, ts[k], ts[k + 1]));
+        }
+        // A sampled local minimum of |φ| at k + 1: look for a touching root (or two roots
+        // between samples) at the critical point.
+        if k + 2 <= n && f[k + 1].abs() <= f[k].abs() && f[k + 1].abs() <= f[k + 2].abs() {
+            let (d0, d1) = (dphi(ts[k]), dphi(ts[k + 2]));
+            if (d0 > 0.0) != (d1 > 0.0) {
+                let tc = bisect(&dphi, ts[k], ts[k + 2]);
+                let v = phi(tc);
+                if v == 0.0 {
+                    return root_at(tc);
+                }
+                if (v > 0.0) != (f[k] > 0.0) {
+                    return root_at(bisect(&phi, ts[k], tc));
+                }
+                if v.abs() <= touch {
+                    return root_at(tc);
+                }
+            }
+        }
+    }
+    None
+}
+
+/// A sign change of `g` in [lo, hi] (g(lo), g(hi) of opposite signs), by bisection.
+fn bisect(g: &dyn Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
+    let lo_pos = g(lo) > 0.0;
+    for _ in 0..BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        let v = g(mid);
+        if v == 0.0 {
+            return mid;
+        }
+        if (v > 0.0) == lo_pos {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}

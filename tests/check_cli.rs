@@ -1,0 +1,210 @@
+//! `apatch check` and `apatch export patches` from the command line: exit 0 on a good complex,
+//! 1 on a broken one (with the jump reported), 2 with one clear line on bad input.
+
+use apatch::complex_io::write_json_file;
+use apatch::fixtures::{quadric_complex, Quadric};
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tmp(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("check_cli_{name}"))
+}
+
+fn apatch(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_apatch"))
+        .args(args)
+        .output()
+        .expect("run apatch")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn sphere_file(name: &str, degree: usize) -> PathBuf {
+    let q = Quadric::sphere(DVec3::new(0.05, 0.1, -0.1), 0.7);
+    let c = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 3, degree);
+    let path = tmp(name);
+    write_json_file(&c, &path).unwrap();
+    path
+}
+
+#[test]
+fn good_complex_passes() {
+    let path = sphere_file("good.json", 3);
+    let o = apatch(&["check", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("PASSED"), "{out}");
+    assert!(out.contains("value jump"), "{out}");
+    assert!(out.contains("270 shared"), "{out}");
+}
+
+#[test]
+fn good_complex_json_report() {
+    let path = sphere_file("good_json.json", 2);
+    let o = apatch(&[
+        "check",
+        path.to_str().unwrap(),
+        "--json",
+        "--continuity",
+        "2",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("JSON report");
+    assert_eq!(v["passed"], true);
+    assert_eq!(v["continuity"], 2);
+    assert_eq!(v["faces"]["shared"], 270);
+    let jump = v["value_jump"]["worst"].as_f64().unwrap();
+    // One global quadric: rounding only.
+    assert!(jump < 1e-13, "{jump}");
+}
+
+#[test]
+fn broken_complex_fails_with_the_jump_named() {
+    let q = Quadric::sphere(DVec3::ZERO, 0.6);
+    let mut c = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 3);
+    // Weight (0,1,1,1) lies on the face opposite vertex 1 of patch 9.
+    let k = apatch::bb::index_of([0, 1, 1, 1]);
+    c.patches[9].weights[k] += 1e-4;
+    let path = tmp("broken.json");
+    write_json_file(&c, &path).unwrap();
+    let o = apatch(&["check", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
+    let out = stdout(&o);
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("value jump"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(line.contains("FAIL"), "{line}");
+    assert!(line.contains("patches") && line.contains('9'), "{line}");
+    assert!(out.contains("FAILED: value jump, gradient jump"), "{out}");
+
+    // Loosened tolerances accept it.
+    let o = apatch(&["check", path.to_str().unwrap(), "--jump-tolerance", "1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+
+    let o = apatch(&["check", path.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["passed"], false);
+    let patches = v["value_jump"]["at"]["patches"].as_array().unwrap();
+    assert!(patches.iter().any(|p| p == 9), "{v}");
+}
+
+/// Runs `apatch check` on `text` written to `name` and returns stderr (exit 2 required).
+fn bad_input(name: &str, text: &str) -> String {
+    let path = tmp(name);
+    std::fs::write(&path, text).unwrap();
+    let o = apatch(&["check", path.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+    assert_eq!(err.lines().count(), 1, "{name}: one line: {err}");
+    assert!(err.starts_with("apatch: error: "), "{err}");
+    assert!(
+        err.contains(path.to_str().unwrap()),
+        "names the file: {err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+const HEAD: &str =
+    r#"{"format":"apatch-patches","version":1,"scheme":"test","vertices":[],"patches":["#;
+const TET: &str = r#""tet":[[0,0,0],[1,0,0],[0,1,0],[0,0,1]],"role":"other","element":0"#;
+
+fn one_patch(degree: &str, weights: &str) -> String {
+    format!("{HEAD}{{{TET},\"degree\":{degree},\"weights\":{weights}}}]}}")
+}
+
+#[test]
+fn bad_inputs_exit_2_with_one_line() {
+    let e = bad_input("trailing.json", &(one_patch("1", "[1,2,3,4]") + "x"));
+    assert!(e.contains("trailing characters"), "{e}");
+    let e = bad_input("syntax.json", &one_patch("1", "[1,2,3,4]x"));
+    assert!(e.contains("patch 0: expected `,` or `}` at line 1"), "{e}");
+    let e = bad_input("truncated.json", &one_patch("1", "[1,2,3,4]")[..80]);
+    assert!(e.contains("EOF"), "{e}");
+    let e = bad_input("count.json", &one_patch("2", "[1,2,3,4]"));
+    assert!(e.contains("patch 0: 4 weights for degree 2"), "{e}");
+    let e = bad_input("nan_string.json", &one_patch("1", r#"[1,"NaN",3,4]"#));
+    assert!(e.contains("patch 0"), "{e}");
+    let e = bad_input("null.json", &one_patch("1", "[1,null,3,4]"));
+    assert!(e.contains("patch 0"), "{e}");
+    let e = bad_input("overflow.json", &one_patch("1", "[1,2e308,3,4]"));
+    assert!(e.contains("patch 0"), "{e}");
+    let e = bad_input(
+        "degree.json",
+        &one_patch("9", &format!("[{}]", vec!["1"; 220].join(","))),
+    );
+    assert!(e.contains("patch 0: degree 9"), "{e}");
+    let e = bad_input("scene.toml", "[camera]\n");
+    assert!(
+        e.contains("scene input needs a scheme; not available yet"),
+        "{e}"
+    );
+    let e = bad_input("model.obj", "v 0 0 0\n");
+    assert!(e.contains("not available yet"), "{e}");
+    let e = bad_input("what.xyz", "");
+    assert!(e.contains("unknown input type"), "{e}");
+}
+
+#[test]
+fn missing_file_exits_2() {
+    for name in ["missing.json", "missing.toml"] {
+        let path = tmp(name);
+        let o = apatch(&["check", path.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2));
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(path.to_str().unwrap()), "{err}");
+        // The cause appears once.
+        assert_eq!(err.matches("os error").count().max(1), 1, "{err}");
+        assert!(
+            err.contains("no such file") || err.contains("No such file"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn export_patches_rewrites_json() {
+    let src = sphere_file("export_src.json", 2);
+    let dst = tmp("export_dst.json");
+    let o = apatch(&[
+        "export",
+        "patches",
+        src.to_str().unwrap(),
+        "-o",
+        dst.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&src).unwrap(), std::fs::read(&dst).unwrap());
+
+    let o = apatch(&[
+        "export",
+        "patches",
+        "scene.toml",
+        "-o",
+        dst.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = apatch(&[
+        "export",
+        "patches",
+        src.to_str().unwrap(),
+        "-o",
+        "/nonexistent/dir/out.json",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("/nonexistent/dir/out.json"),
+        "{}",
+        stderr(&o)
+    );
+}
