@@ -118,6 +118,20 @@ fn random_soups_never_panic_and_keep_invariants() {
                     }
                 }
                 assert!(m.positions.iter().all(|p| p.is_finite()));
+                let mut sets: Vec<Vec<u32>> = m
+                    .faces
+                    .iter()
+                    .map(|f| {
+                        let mut s = f.clone();
+                        s.sort_unstable();
+                        s
+                    })
+                    .collect();
+                sets.sort();
+                assert!(
+                    sets.windows(2).all(|w| w[0] != w[1]),
+                    "duplicate face: {text}"
+                );
                 let t = mesh::triangulate(&m);
                 let want: usize = m.faces.iter().map(|f| f.len() - 2).sum();
                 assert_eq!(t.faces.len(), want);

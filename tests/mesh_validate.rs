@@ -345,3 +345,16 @@ fn from_polygons_runs_the_same_pipeline() {
     let e = mesh::from_polygons(vec![glam::DVec3::NAN; 3], vec![vec![0, 1, 2]]).unwrap_err();
     assert!(e.to_string().contains("vertex 0: non-finite"), "{e}");
 }
+
+#[test]
+fn duplicate_faces_are_dropped() {
+    // A closed tetrahedron plus the same face twice more (once reversed, once rotated).
+    let (m, r) = corpus("duplicate_face.obj");
+    assert_eq!(
+        elements(&r, FindingKind::DuplicateFace),
+        vec![face(2, 7), face(5, 10)]
+    );
+    assert_eq!(m.faces.len(), 4);
+    assert!(r.get(FindingKind::InconsistentOrientation).is_none());
+    assert!(r.require(true).is_ok());
+}

@@ -185,6 +185,7 @@ fn from_raw(mut raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, 
     let n_raw_faces = raw.faces.len();
     let mut faces = Vec::with_capacity(n_raw_faces);
     let mut face_lines = Vec::with_capacity(n_raw_faces);
+    let mut file_face: Vec<u32> = Vec::with_capacity(n_raw_faces);
     let mut repeated = Vec::new();
     let mut dropped = Vec::new();
     for (f, mut out) in std::mem::take(&mut raw.faces).into_iter().enumerate() {
@@ -213,11 +214,48 @@ fn from_raw(mut raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, 
         }
         faces.push(out);
         face_lines.push(line);
+        file_face.push(f as u32);
     }
     if faces.is_empty() {
         return Err(format!(
             "all {n_raw_faces} faces are degenerate (fewer than 3 distinct vertices)"
         ));
+    }
+
+    // Duplicate faces (same vertex set, either orientation): keep the first.
+    let dup = duplicate_faces(&faces);
+    let mut duplicates = Vec::new();
+    if dup.iter().any(|&d| d) {
+        let mut new_index = vec![u32::MAX; faces.len()];
+        let mut k = 0;
+        for (f, &d) in dup.iter().enumerate() {
+            if d {
+                duplicates.push(Element::Face {
+                    index: file_face[f],
+                    line: face_lines[f],
+                });
+            } else {
+                new_index[f] = k;
+                k += 1;
+            }
+        }
+        let mut i = 0;
+        faces.retain(|_| {
+            i += 1;
+            !dup[i - 1]
+        });
+        let mut i = 0;
+        face_lines.retain(|_| {
+            i += 1;
+            !dup[i - 1]
+        });
+        repeated.retain_mut(|e| match e {
+            Element::Face { index, .. } if new_index[*index as usize] != u32::MAX => {
+                *index = new_index[*index as usize];
+                true
+            }
+            _ => false,
+        });
     }
 
     // Compact: mesh ids for the canonical vertices the kept faces use, in file order.
@@ -299,6 +337,16 @@ fn from_raw(mut raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, 
         );
     }
 
+    if !duplicates.is_empty() {
+        report.add(
+            FindingKind::DuplicateFace,
+            format!(
+                "{} faces repeat the vertices of an earlier face and were dropped (element: file face number, 0-based)",
+                duplicates.len()
+            ),
+            duplicates,
+        );
+    }
     let file_normals = normals.and_then(|acc| finish_normals(acc, &new_id, &vertex_lines, report));
     let n_faces = faces.len() as u32;
     Ok(Mesh {
@@ -309,6 +357,59 @@ fn from_raw(mut raw: RawMesh, report: &mut Report) -> std::result::Result<Mesh, 
         face_lines,
         face_parent: (0..n_faces).collect(),
     })
+}
+
+/// Flags every face whose vertex set equals that of an earlier face. Faces are grouped by a hash
+/// of their sorted vertices (sorting the hashes, O(F log F)), and equal hashes are confirmed.
+fn duplicate_faces(faces: &[Vec<u32>]) -> Vec<bool> {
+    let sorted = |face: &[u32]| {
+        let mut s = face.to_vec();
+        s.sort_unstable();
+        s
+    };
+    let hash = |face: &[u32]| {
+        let mut buf = [0u32; 8];
+        let s: Vec<u32>;
+        let ids: &[u32] = if face.len() <= 8 {
+            buf[..face.len()].copy_from_slice(face);
+            buf[..face.len()].sort_unstable();
+            &buf[..face.len()]
+        } else {
+            s = sorted(face);
+            &s
+        };
+        // FNV-1a over the sorted ids.
+        ids.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &v| {
+            (h ^ u64::from(v)).wrapping_mul(0x0000_0100_0000_01b3)
+        })
+    };
+    let mut keyed: Vec<(u64, u32)> = faces
+        .iter()
+        .enumerate()
+        .map(|(f, face)| (hash(face), f as u32))
+        .collect();
+    keyed.sort_unstable();
+    let mut dup = vec![false; faces.len()];
+    let mut g = 0;
+    while g < keyed.len() {
+        let mut h = g + 1;
+        while h < keyed.len() && keyed[h].0 == keyed[g].0 {
+            h += 1;
+        }
+        // Within a run (in face order), compare each face with the earlier kept ones.
+        for i in g + 1..h {
+            let fi = keyed[i].1 as usize;
+            let si = sorted(&faces[fi]);
+            if (g..i).any(|j| {
+                let fj = keyed[j].1 as usize;
+                !dup[fj] && sorted(&faces[fj]) == si
+            }) {
+                dup[fi] = true;
+            }
+        }
+        g = h;
+    }
+    dup
 }
 
 /// Unit file normals summed per canonical file vertex, the first one seen, and whether later

@@ -27,7 +27,7 @@
 //! Findings in the [`Report`] (the mesh is still returned):
 //! - notes: welded duplicates, boundary edges, averaged file normals, ignored statements;
 //! - warnings, repaired: repeated vertices in a face (removed), faces with < 3 distinct
-//!   vertices (dropped), unreferenced vertices (dropped), inconsistent orientation (flipped),
+//!   vertices (dropped), duplicate faces (dropped), unreferenced vertices (dropped), inconsistent orientation (flipped),
 //!   inward closed surface (flipped);
 //! - warnings, kept: zero-area faces, non-planar polygons, non-manifold edges and vertices,
 //!   non-orientable components, incomplete file normals.
