@@ -151,9 +151,34 @@ fn patch_sheets(
     stats
 }
 
-/// Sign changes of F along the segment from `a` to `b` (N + 1 samples), and the parameter of
-/// the first.
+/// Sign changes of F along the segment from `a` to `b`, and the parameter of the first.
+///
+/// For polynomial patches the segment's Bernstein coefficients (blossom values) decide first:
+/// with at most one sign change among them there are that many roots in (0, 1) (Descartes'
+/// rule for the Bernstein basis); otherwise F is sampled at N + 1 points.
 fn count_sign_changes(e: &PatchEval<'_>, a: &[f64; 4], b: &[f64; 4], n: usize) -> (usize, f64) {
+    let p = e.patch;
+    if p.rational.is_empty() {
+        let deg = usize::from(p.degree);
+        let mut args = [*a; 7];
+        let mut changes = 0;
+        let mut prev: Option<bool> = None;
+        for k in 0..=deg {
+            if k > 0 {
+                args[k - 1] = *b;
+            }
+            let c = super::eval::poly_blossom(&p.weights, deg, &args[..deg]);
+            if c != 0.0 {
+                let pos = c > 0.0;
+                changes += usize::from(prev.is_some_and(|q| q != pos));
+                prev = Some(pos);
+            }
+        }
+        if changes <= 1 {
+            // At most one root: its position is never reported.
+            return (changes, 0.0);
+        }
+    }
     let mut prev: Option<bool> = None;
     let mut count = 0;
     let mut first = 0.0;
