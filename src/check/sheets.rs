@@ -21,8 +21,7 @@ const BISECTIONS: usize = 60;
 pub(super) fn measure(evals: &[PatchEval<'_>], opts: &CheckOptions) -> SheetStats {
     evals
         .par_iter()
-        .enumerate()
-        .map(|(pi, e)| patch_sheets(pi, e, opts, SheetStats::default()))
+        .map(|e| patch_sheets(e, opts, SheetStats::default()))
         .reduce(SheetStats::default, merge)
 }
 
@@ -87,12 +86,7 @@ fn point(e: &PatchEval<'_>, alpha: [f64; 4]) -> [f64; 3] {
         .to_array()
 }
 
-fn patch_sheets(
-    pi: usize,
-    e: &PatchEval<'_>,
-    opts: &CheckOptions,
-    mut stats: SheetStats,
-) -> SheetStats {
+fn patch_sheets(e: &PatchEval<'_>, opts: &CheckOptions, mut stats: SheetStats) -> SheetStats {
     if e.has_no_zero() {
         return stats;
     }
@@ -115,11 +109,8 @@ fn patch_sheets(
                             .is_none_or(|m| rel < m || (rel.is_nan() && !m.is_nan()));
                         if smaller {
                             stats.min_root_slope = Some(rel);
-                            stats.min_root_slope_at = Some(Location {
-                                patches: vec![pi],
-                                point: point(e, lerp(&q, &u, t)),
-                                vertex: None,
-                            });
+                            stats.min_root_slope_at =
+                                Some(Location::new(&[e], point(e, lerp(&q, &u, t)), None));
                         }
                     }
                 }
@@ -136,11 +127,8 @@ fn patch_sheets(
                     if roots > 1 {
                         stats.multi_root_lines += 1;
                         if stats.multi_root_at.is_none() {
-                            stats.multi_root_at = Some(Location {
-                                patches: vec![pi],
-                                point: point(e, lerp(&a, &q, first)),
-                                vertex: None,
-                            });
+                            stats.multi_root_at =
+                                Some(Location::new(&[e], point(e, lerp(&a, &q, first)), None));
                         }
                     }
                 }
