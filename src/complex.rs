@@ -16,7 +16,8 @@
 //! meaning F(α) = Σ w_λ·n!/(λ1!λ2!λ3!λ4!)·α^λ + Σ_r (Σ_m w_m α^μm)/(Σ_m α^μm)·B^n_κr(α),
 //! weights in the crate's multi-index order (decreasing lexicographic).
 
-use glam::DVec3;
+use crate::bb::{poly, rational, Tet};
+use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 
 /// Identifies the file format in JSON.
@@ -164,5 +165,112 @@ impl Patch {
     #[must_use]
     pub fn tet_points(&self) -> [DVec3; 4] {
         self.tet.map(DVec3::from_array)
+    }
+
+    /// The tetrahedron with its barycentric map; `None` when it is degenerate.
+    #[must_use]
+    pub fn tet(&self) -> Option<Tet> {
+        Tet::new(self.tet_points())
+    }
+
+    /// F at barycentric `a`, rational terms included (0 where their denominator vanishes).
+    ///
+    /// # Panics
+    /// When `weights` does not hold C(n+3,3) numbers.
+    #[must_use]
+    pub fn value_bary(&self, a: [f64; 4]) -> f64 {
+        let n = usize::from(self.degree);
+        let mut f = poly::eval(n, &self.weights, a);
+        for term in &self.rational {
+            f += rational::term_value(term, n, a);
+        }
+        f
+    }
+
+    /// ∂F/∂αi (the four barycentric coordinates treated as independent), rational terms
+    /// included exactly.
+    #[must_use]
+    pub fn gradient_bary(&self, a: [f64; 4]) -> [f64; 4] {
+        let n = usize::from(self.degree);
+        let mut g = poly::gradient_bary(n, &self.weights, a);
+        for term in &self.rational {
+            let (_, gt, _) = rational::term_jet(term, n, a);
+            for i in 0..4 {
+                g[i] += gt[i];
+            }
+        }
+        g
+    }
+
+    /// ∂²F/∂αi∂αj, rational terms included exactly.
+    #[must_use]
+    pub fn hessian_bary(&self, a: [f64; 4]) -> [[f64; 4]; 4] {
+        let n = usize::from(self.degree);
+        let mut h = poly::hessian_bary(n, &self.weights, a);
+        for term in &self.rational {
+            let (_, _, ht) = rational::term_jet(term, n, a);
+            for i in 0..4 {
+                for j in 0..4 {
+                    h[i][j] += ht[i][j];
+                }
+            }
+        }
+        h
+    }
+
+    /// F at world point `p` (NaN when the tetrahedron is degenerate).
+    #[must_use]
+    pub fn value(&self, p: DVec3) -> f64 {
+        match self.tet() {
+            Some(t) => self.value_bary(t.bary(p)),
+            None => f64::NAN,
+        }
+    }
+
+    /// World-space ∇F at `p`, rational terms included exactly (finite on the tetrahedron's
+    /// edges); NaN when the tetrahedron is degenerate.
+    #[must_use]
+    pub fn gradient(&self, p: DVec3) -> DVec3 {
+        match self.tet() {
+            Some(t) => t.world_gradient(self.gradient_bary(t.bary(p))),
+            None => DVec3::NAN,
+        }
+    }
+
+    /// World-space Hessian of F at `p`; NaN when the tetrahedron is degenerate.
+    #[must_use]
+    pub fn hessian(&self, p: DVec3) -> DMat3 {
+        match self.tet() {
+            Some(t) => t.world_hessian(self.hessian_bary(t.bary(p))),
+            None => DMat3::NAN,
+        }
+    }
+
+    /// Degree of [`Patch::segment_poly`]'s output: n plus the degrees of the distinct rational
+    /// denominators. Loaders should reject patches where this exceeds 15.
+    #[must_use]
+    pub fn segment_degree(&self) -> usize {
+        rational::segment_degree(usize::from(self.degree), &self.rational)
+    }
+
+    /// Univariate Bernstein coefficients in s ∈ [0,1] of F((1−s)·x0 + s·x1) times the
+    /// (positive inside the tetrahedron) rational denominators; returns their number,
+    /// [`Patch::segment_degree`] + 1, or 0 when the tetrahedron is degenerate. Inside the
+    /// tetrahedron its roots and signs are those of F. No heap allocation.
+    ///
+    /// # Panics
+    /// When `weights` has the wrong length or the cleared degree exceeds 15.
+    pub fn segment_poly(&self, x0: DVec3, x1: DVec3, out: &mut [f64; 16]) -> usize {
+        let Some(t) = self.tet() else {
+            return 0;
+        };
+        rational::segment_poly(
+            usize::from(self.degree),
+            &self.weights,
+            &self.rational,
+            t.bary(x0),
+            t.bary(x1),
+            out,
+        )
     }
 }

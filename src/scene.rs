@@ -1,1 +1,605 @@
-//! `scene` module (see ARCHITECTURE.md).
+//! Scene files (TOML): what to build, how to look at it, what to write. Paths inside a scene are
+//! relative to the scene file. Unknown keys and bad values are errors naming the key and file.
+//!
+//! ```toml
+//! [model]
+//! file = "models/teapot.obj"      # a mesh, built with [scheme] …
+//! normals = "loop"                # angle | area | loop | file
+//! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
+//!
+//! [scheme]
+//! type = "rational-c1"            # + the scheme's own options (validated by the scheme)
+//!
+//! [camera]                        # Mitsuba `perspective`, to_world = look_at
+//! origin = [0, 2, 6]
+//! target = [0, 0.5, 0]
+//! up = [0, 1, 0]
+//! fov = 30                        # degrees
+//! fov_axis = "x"                  # x | y | diagonal | smaller | larger
+//! width = 800
+//! height = 600
+//! near_clip = 0.01
+//!
+//! [film]
+//! spp = 16
+//! filter = "box"
+//!
+//! [material]
+//! albedo = [0.8, 0.8, 0.8]        # or one number
+//!
+//! [[lights]]
+//! type = "directional"            # direction (travel), irradiance
+//! direction = [-1, -1, -1]
+//! irradiance = 3.0
+//! [[lights]]
+//! type = "point"                  # position, intensity
+//! position = [2, 4, 2]
+//! intensity = 20.0
+//! [[lights]]
+//! type = "constant"               # radiance
+//! radiance = 0.1
+//!
+//! [render]
+//! mode = "shaded"                 # shaded | normal | depth | patch | isophote | zebra | curvature
+//! output = "../renders/teapot.png"   # the EXR is written beside it (same stem, .exr)
+//! threads = 0                     # 0 = all cores
+//! lines = 16                      # isophote lines / zebra stripes
+//! line_width = 1.5                # pixels
+//! isophote = "light"              # light | view
+//! over = "shaded"                 # shaded | none (isophotes alone)
+//! curvature = "mean"              # mean | gaussian
+//! patch_boundaries = true
+//! ```
+
+use crate::complex::{PatchComplex, FORMAT};
+use crate::trace::{Camera, FovAxis, Light, Lighting, Mode, ModeOptions, RenderSettings};
+use anyhow::{anyhow, bail, Context};
+use glam::DVec3;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// Where the surface comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Model {
+    /// A mesh file, its vertex-normal method, and the `[scheme]` table.
+    Mesh {
+        /// The mesh file (resolved).
+        file: PathBuf,
+        /// Vertex normal method name (angle | area | loop | file).
+        normals: String,
+        /// The `[scheme]` table, validated by the scheme.
+        scheme: toml::Table,
+    },
+    /// A patch complex JSON file (resolved).
+    Patches(PathBuf),
+}
+
+/// A loaded, validated scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// The scene file.
+    pub path: PathBuf,
+    /// The surface source.
+    pub model: Model,
+    /// Camera, film, lights and mode.
+    pub settings: RenderSettings,
+    /// Output file (resolved); PNG or EXR by extension, the other format written beside it.
+    pub output: PathBuf,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    model: ModelSection,
+    scheme: Option<toml::Table>,
+    camera: CameraSection,
+    #[serde(default)]
+    film: FilmSection,
+    #[serde(default)]
+    material: MaterialSection,
+    #[serde(default)]
+    lights: Vec<LightSection>,
+    #[serde(default)]
+    render: RenderSection,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModelSection {
+    file: Option<String>,
+    normals: Option<String>,
+    patches: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraSection {
+    origin: [f64; 3],
+    target: [f64; 3],
+    #[serde(default = "default_up")]
+    up: [f64; 3],
+    fov: f64,
+    #[serde(default = "default_fov_axis")]
+    fov_axis: String,
+    width: u32,
+    height: u32,
+    #[serde(default = "default_near")]
+    near_clip: f64,
+}
+
+fn default_up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn default_fov_axis() -> String {
+    "x".into()
+}
+fn default_near() -> f64 {
+    0.01
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FilmSection {
+    #[serde(default = "default_spp")]
+    spp: u32,
+    #[serde(default = "default_filter")]
+    filter: String,
+}
+
+impl Default for FilmSection {
+    fn default() -> Self {
+        FilmSection {
+            spp: default_spp(),
+            filter: default_filter(),
+        }
+    }
+}
+fn default_spp() -> u32 {
+    16
+}
+fn default_filter() -> String {
+    "box".into()
+}
+
+/// A number (grey) or an RGB triple.
+#[derive(Deserialize, Clone, Copy)]
+#[serde(untagged)]
+enum Spectrum {
+    Grey(f64),
+    Rgb([f64; 3]),
+}
+
+impl Spectrum {
+    fn rgb(self) -> DVec3 {
+        match self {
+            Spectrum::Grey(g) => DVec3::splat(g),
+            Spectrum::Rgb(c) => DVec3::from_array(c),
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialSection {
+    #[serde(default = "default_albedo")]
+    albedo: Spectrum,
+}
+
+impl Default for MaterialSection {
+    fn default() -> Self {
+        MaterialSection {
+            albedo: default_albedo(),
+        }
+    }
+}
+fn default_albedo() -> Spectrum {
+    Spectrum::Grey(0.5)
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum LightSection {
+    Directional {
+        direction: [f64; 3],
+        irradiance: Spectrum,
+    },
+    Point {
+        position: [f64; 3],
+        intensity: Spectrum,
+    },
+    Constant {
+        radiance: Spectrum,
+    },
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RenderSection {
+    mode: Option<String>,
+    output: Option<String>,
+    threads: Option<usize>,
+    lines: Option<u32>,
+    line_width: Option<f64>,
+    isophote: Option<String>,
+    over: Option<String>,
+    curvature: Option<String>,
+    patch_boundaries: Option<bool>,
+}
+
+/// "file:line: message (key `k`)" from a TOML error.
+fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> anyhow::Error {
+    let mut msg = e.message().trim().replace('\n', " ");
+    let mut loc = String::new();
+    if let Some(span) = e.span() {
+        let line = text[..span.start.min(text.len())].matches('\n').count() + 1;
+        loc = format!(":{line}");
+        let line_text = text.lines().nth(line - 1).unwrap_or("");
+        if let Some((key, _)) = line_text.split_once('=') {
+            let key = key.trim();
+            if !key.is_empty() && !msg.contains(&format!("`{key}`")) {
+                msg = format!("key `{key}`: {msg}");
+            }
+        }
+    }
+    anyhow!("{}{loc}: {msg}", path.display())
+}
+
+/// Reads and validates the scene file at `path`.
+///
+/// # Errors
+/// Unreadable files, TOML syntax, unknown keys and bad values, each naming the file and key.
+pub fn load(path: &Path) -> anyhow::Result<Scene> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    parse(&text, path)
+}
+
+/// Parses scene `text` as if read from `path` (paths resolve against its directory).
+///
+/// # Errors
+/// As [`load`].
+pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
+    let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let bad = |key: &str, what: String| anyhow!("{}: `{key}`: {what}", path.display());
+    let vec3 = |key: &str, v: [f64; 3]| -> anyhow::Result<DVec3> {
+        let d = DVec3::from_array(v);
+        if d.is_finite() {
+            Ok(d)
+        } else {
+            Err(bad(key, "components must be finite".into()))
+        }
+    };
+
+    // Model.
+    let m = &file.model;
+    let model = match (&m.file, &m.patches) {
+        (Some(_), Some(_)) => bail!(
+            "{}: `model`: give either `file` or `patches`, not both",
+            path.display()
+        ),
+        (None, None) => bail!(
+            "{}: `model`: `file` or `patches` is required",
+            path.display()
+        ),
+        (None, Some(p)) => {
+            if m.normals.is_some() {
+                return Err(bad(
+                    "model.normals",
+                    "only applies with `model.file`".into(),
+                ));
+            }
+            if file.scheme.is_some() {
+                return Err(bad("scheme", "only applies with `model.file`".into()));
+            }
+            Model::Patches(dir.join(p))
+        }
+        (Some(f), None) => {
+            let normals = m.normals.clone().unwrap_or_else(|| "angle".into());
+            if !["angle", "area", "loop", "file"].contains(&normals.as_str()) {
+                return Err(bad(
+                    "model.normals",
+                    format!("`{normals}` is not one of angle, area, loop, file"),
+                ));
+            }
+            let scheme = file.scheme.clone().ok_or_else(|| {
+                bad(
+                    "scheme",
+                    "a [scheme] table is required with `model.file`".into(),
+                )
+            })?;
+            Model::Mesh {
+                file: dir.join(f),
+                normals,
+                scheme,
+            }
+        }
+    };
+
+    // Camera.
+    let c = &file.camera;
+    let axis: FovAxis = c
+        .fov_axis
+        .parse()
+        .map_err(|e: String| bad("camera.fov_axis", e))?;
+    if !(c.fov > 0.0 && c.fov < 180.0) {
+        return Err(bad(
+            "camera.fov",
+            format!("{} is outside (0, 180) degrees", c.fov),
+        ));
+    }
+    if c.width == 0 || c.height == 0 {
+        return Err(bad("camera.width/height", "must be positive".into()));
+    }
+    let camera = Camera::look_at(
+        vec3("camera.origin", c.origin)?,
+        vec3("camera.target", c.target)?,
+        vec3("camera.up", c.up)?,
+        c.fov,
+        axis,
+        c.width,
+        c.height,
+        c.near_clip,
+    )
+    .map_err(|e| bad("camera", e))?;
+
+    // Film.
+    if file.film.spp == 0 {
+        return Err(bad("film.spp", "must be ≥ 1".into()));
+    }
+    if file.film.filter != "box" {
+        return Err(bad(
+            "film.filter",
+            format!("`{}` is not supported (only `box`)", file.film.filter),
+        ));
+    }
+
+    // Material and lights.
+    let albedo = file.material.albedo.rgb();
+    if !(albedo.is_finite() && albedo.min_element() >= 0.0 && albedo.max_element() <= 1.0) {
+        return Err(bad(
+            "material.albedo",
+            "components must lie in [0, 1]".into(),
+        ));
+    }
+    let mut lights = Vec::new();
+    for (i, l) in file.lights.iter().enumerate() {
+        let key = |k: &str| format!("lights[{i}].{k}");
+        let nonneg = |k: &str, s: Spectrum| -> anyhow::Result<DVec3> {
+            let v = s.rgb();
+            if v.is_finite() && v.min_element() >= 0.0 {
+                Ok(v)
+            } else {
+                Err(bad(&key(k), "must be finite and ≥ 0".into()))
+            }
+        };
+        lights.push(match *l {
+            LightSection::Directional {
+                direction,
+                irradiance,
+            } => Light::Directional {
+                direction: vec3(&key("direction"), direction)?
+                    .try_normalize()
+                    .ok_or_else(|| bad(&key("direction"), "must be non-zero".into()))?,
+                irradiance: nonneg("irradiance", irradiance)?,
+            },
+            LightSection::Point {
+                position,
+                intensity,
+            } => Light::Point {
+                position: vec3(&key("position"), position)?,
+                intensity: nonneg("intensity", intensity)?,
+            },
+            LightSection::Constant { radiance } => Light::Constant {
+                radiance: nonneg("radiance", radiance)?,
+            },
+        });
+    }
+
+    // Render.
+    let r = &file.render;
+    let mode: Mode = r
+        .mode
+        .as_deref()
+        .unwrap_or("shaded")
+        .parse()
+        .map_err(|e: String| bad("render.mode", e))?;
+    let mut options = ModeOptions::default();
+    if let Some(n) = r.lines {
+        if n == 0 {
+            return Err(bad("render.lines", "must be ≥ 1".into()));
+        }
+        options.lines = n;
+    }
+    if let Some(w) = r.line_width {
+        if !(w > 0.0 && w.is_finite()) {
+            return Err(bad("render.line_width", "must be > 0".into()));
+        }
+        options.line_width = w;
+    }
+    if let Some(s) = &r.isophote {
+        options.isophote_light = match s.as_str() {
+            "light" => true,
+            "view" => false,
+            _ => {
+                return Err(bad(
+                    "render.isophote",
+                    format!("`{s}` is not light or view"),
+                ))
+            }
+        };
+    }
+    if let Some(s) = &r.over {
+        options.over_shaded = match s.as_str() {
+            "shaded" => true,
+            "none" => false,
+            _ => return Err(bad("render.over", format!("`{s}` is not shaded or none"))),
+        };
+    }
+    if let Some(s) = &r.curvature {
+        options.gaussian = match s.as_str() {
+            "mean" => false,
+            "gaussian" => true,
+            _ => {
+                return Err(bad(
+                    "render.curvature",
+                    format!("`{s}` is not mean or gaussian"),
+                ))
+            }
+        };
+    }
+    if let Some(b) = r.patch_boundaries {
+        options.patch_boundaries = b;
+    }
+    let output = match &r.output {
+        Some(o) => dir.join(o),
+        None => path.with_extension("png"),
+    };
+    check_output(&output).map_err(|e| bad("render.output", e))?;
+
+    Ok(Scene {
+        path: path.to_path_buf(),
+        model,
+        settings: RenderSettings {
+            camera,
+            spp: file.film.spp,
+            mode,
+            options,
+            lighting: Lighting { albedo, lights },
+            threads: r.threads.unwrap_or(0),
+        },
+        output,
+    })
+}
+
+/// Accepts output paths ending in `.png` or `.exr`.
+///
+/// # Errors
+/// Any other extension.
+pub fn check_output(path: &Path) -> Result<(), String> {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("png" | "exr") => Ok(()),
+        _ => Err(format!(
+            "{}: the output must end in .png or .exr",
+            path.display()
+        )),
+    }
+}
+
+/// Builds the scene's patch complex: reads the patch JSON, or loads the mesh and runs the
+/// `[scheme]` (dispatch on `type`).
+///
+/// # Errors
+/// Unreadable or invalid inputs, unknown or unavailable schemes, each naming the file.
+pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
+    match &scene.model {
+        Model::Patches(p) => read_patches(p),
+        Model::Mesh { scheme, .. } => {
+            let ty = scheme.get("type").and_then(|v| v.as_str()).ok_or_else(|| {
+                anyhow!(
+                    "{}: `scheme.type` is required (a string)",
+                    scene.path.display()
+                )
+            })?;
+            match ty {
+                "rational-c1" => bail!(
+                    "{}: scheme `rational-c1` is not available in this build yet (mesh loading and the 2001 scheme have not landed)",
+                    scene.path.display()
+                ),
+                "cubic-c1" | "quintic-c2" => bail!(
+                    "{}: scheme `{ty}` is not implemented yet",
+                    scene.path.display()
+                ),
+                _ => bail!(
+                    "{}: `scheme.type`: `{ty}` is not one of rational-c1, cubic-c1, quintic-c2",
+                    scene.path.display()
+                ),
+            }
+        }
+    }
+}
+
+/// Reads a patch complex JSON file (as written by `apatch export patches`).
+///
+/// # Errors
+/// Unreadable files, JSON errors (with line), a wrong `format`.
+pub fn read_patches(path: &Path) -> anyhow::Result<PatchComplex> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let c: PatchComplex = serde_json::from_str(&text).map_err(|e| {
+        anyhow!(
+            "{}:{}: {}",
+            path.display(),
+            e.line(),
+            e.to_string().replace('\n', " ")
+        )
+    })?;
+    if c.format != FORMAT {
+        bail!(
+            "{}: `format` is `{}`, expected `{FORMAT}`",
+            path.display(),
+            c.format
+        );
+    }
+    Ok(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MINIMAL: &str = r#"
+[model]
+patches = "sphere.json"
+[camera]
+origin = [0, 0, 5]
+target = [0, 0, 0]
+fov = 40
+width = 64
+height = 48
+[[lights]]
+type = "directional"
+direction = [0, 0, -1]
+irradiance = 2.0
+"#;
+
+    #[test]
+    fn minimal_scene_resolves_paths_and_defaults() {
+        let s = parse(MINIMAL, Path::new("scenes/x.toml")).unwrap();
+        assert_eq!(s.model, Model::Patches(PathBuf::from("scenes/sphere.json")));
+        assert_eq!(s.output, PathBuf::from("scenes/x.png"));
+        assert_eq!(s.settings.spp, 16);
+        assert_eq!(s.settings.mode, Mode::Shaded);
+        assert_eq!(s.settings.lighting.lights.len(), 1);
+    }
+
+    #[test]
+    fn unknown_keys_and_bad_values_name_key_and_file() {
+        let text = MINIMAL.replace("fov = 40", "fov = 40\nzoom = 2");
+        let e = format!("{:#}", parse(&text, Path::new("a/b.toml")).unwrap_err());
+        assert!(e.contains("a/b.toml") && e.contains("zoom"), "{e}");
+        let text = MINIMAL.replace("fov = 40", "fov = \"wide\"");
+        let e = format!("{:#}", parse(&text, Path::new("a/b.toml")).unwrap_err());
+        assert!(e.contains("a/b.toml") && e.contains("fov"), "{e}");
+        let text = MINIMAL.replace("fov = 40", "fov = 200");
+        let e = format!("{:#}", parse(&text, Path::new("a/b.toml")).unwrap_err());
+        assert!(e.contains("camera.fov"), "{e}");
+        let text = MINIMAL.replace("irradiance = 2.0", "irradiance = 2.0\nangle = 3");
+        let e = format!("{:#}", parse(&text, Path::new("a/b.toml")).unwrap_err());
+        assert!(e.contains("angle"), "{e}");
+        let text = MINIMAL.replace("type = \"directional\"", "type = \"spot\"");
+        let e = format!("{:#}", parse(&text, Path::new("a/b.toml")).unwrap_err());
+        assert!(e.contains("spot"), "{e}");
+    }
+
+    #[test]
+    fn schemes_dispatch_with_clear_errors() {
+        let text = MINIMAL.replace(
+            "patches = \"sphere.json\"",
+            "file = \"m.obj\"\n[scheme]\ntype = \"quintic-c2\"",
+        );
+        let s = parse(&text, Path::new("s.toml")).unwrap();
+        let e = format!("{:#}", build_complex(&s).unwrap_err());
+        assert!(e.contains("not implemented yet"), "{e}");
+    }
+}

@@ -1,9 +1,15 @@
 //! Bernstein–Bézier math: multi-indices, trivariate BB polynomials on a tetrahedron, and
 //! univariate Bernstein polynomials with a robust first-root finder.
 //!
-//! This file fixes the API the rest of the crate codes against; bodies are filled by the `bb`
-//! work (issue 2). Knows nothing of meshes, hulls or rays.
+//! Knows nothing of meshes, hulls or rays. The trivariate routines also exist on plain
+//! coefficient slices in [`poly`] for callers with their own storage.
 
+// Index loops mirror the formulas (multi-index and matrix subscripts) in this module tree.
+#![allow(clippy::needless_range_loop)]
+
+use glam::{DMat3, DVec3};
+
+pub mod poly;
 pub mod rational;
 pub mod tet;
 pub mod uni;
@@ -53,6 +59,62 @@ pub struct BbPoly {
     pub degree: usize,
     /// C(n+3,3) coefficients in multi-index order.
     pub coeffs: Vec<f64>,
+}
+
+impl BbPoly {
+    /// The polynomial of degree `degree` with `coeffs` in multi-index order.
+    ///
+    /// # Panics
+    /// When `coeffs.len() != C(degree+3, 3)`.
+    #[must_use]
+    pub fn new(degree: usize, coeffs: Vec<f64>) -> BbPoly {
+        assert_eq!(
+            coeffs.len(),
+            num_coeffs(degree),
+            "degree {degree} needs {} BB coefficients",
+            num_coeffs(degree)
+        );
+        BbPoly { degree, coeffs }
+    }
+
+    /// F(α) by de Casteljau.
+    #[must_use]
+    pub fn eval(&self, a: [f64; 4]) -> f64 {
+        poly::eval(self.degree, &self.coeffs, a)
+    }
+
+    /// The blossom b(args[0], …, args[n−1]); `args.len()` must equal the degree.
+    #[must_use]
+    pub fn blossom(&self, args: &[[f64; 4]]) -> f64 {
+        poly::blossom(self.degree, &self.coeffs, args)
+    }
+
+    /// The same function written in degree + 1.
+    #[must_use]
+    pub fn elevate(&self) -> BbPoly {
+        BbPoly {
+            degree: self.degree + 1,
+            coeffs: poly::elevate(self.degree, &self.coeffs),
+        }
+    }
+
+    /// World-space ∇F at barycentric point `a` of `tet`.
+    #[must_use]
+    pub fn gradient(&self, tet: &Tet, a: [f64; 4]) -> DVec3 {
+        tet.world_gradient(poly::gradient_bary(self.degree, &self.coeffs, a))
+    }
+
+    /// World-space Hessian of F at barycentric point `a` of `tet`.
+    #[must_use]
+    pub fn hessian(&self, tet: &Tet, a: [f64; 4]) -> DMat3 {
+        tet.world_hessian(poly::hessian_bary(self.degree, &self.coeffs, a))
+    }
+
+    /// Writes the n+1 univariate Bernstein coefficients of s ↦ F((1−s)·a0 + s·a1), s ∈ [0,1],
+    /// into `out` and returns n+1 (no allocation up to degree [`poly::STACK_DEGREE`]).
+    pub fn restrict(&self, a0: [f64; 4], a1: [f64; 4], out: &mut [f64]) -> usize {
+        poly::restrict(self.degree, &self.coeffs, a0, a1, out)
+    }
 }
 
 #[cfg(test)]

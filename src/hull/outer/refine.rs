@@ -1,0 +1,91 @@
+//! Local refinement of §3.1: when two adjacent face tetrahedra intersect, the common edge is
+//! split at its butterfly point (Dyn, Levin and Gregory 1990, tension w = 1/16) and both
+//! triangles are split in two; the new vertex's normal is the same butterfly stencil applied to
+//! the normals, normalised (n_a + n_b normalised when the stencil is incomplete or degenerate).
+
+use super::{edge_map, NO_FACE};
+use crate::error::Result;
+use glam::DVec3;
+
+/// A triangle mesh being refined, with each triangle's input triangle (`origin`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefineMesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Unit vertex normals.
+    pub normals: Vec<DVec3>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// For each triangle, the index of the input triangle it came from.
+    pub origin: Vec<u32>,
+}
+
+/// Splits the given edges (edge indices in the numbering of [`edge_map`]); edges whose triangle
+/// was already split in this call are skipped. Returns how many edges were split.
+pub fn split_edges(mesh: &mut RefineMesh, edges: &[u32]) -> Result<usize> {
+    let (emap, _) = edge_map(mesh.positions.len(), &mesh.triangles)?;
+    let mut touched = vec![false; mesh.triangles.len()];
+    let mut split = 0;
+    let third = |tri: &[u32; 3], a: u32, b: u32| -> u32 {
+        *tri.iter().find(|&&v| v != a && v != b).unwrap_or(&a)
+    };
+    // The wing vertex across edge (x, y) from triangle `f`.
+    let wing = |f: u32, x: u32, y: u32, tris: &[[u32; 3]]| -> Option<u32> {
+        let (_, faces) = emap
+            .iter()
+            .find(|(v, _)| (v[0] == x && v[1] == y) || (v[0] == y && v[1] == x))?;
+        let g = if faces[0] == f { faces[1] } else { faces[0] };
+        (g != NO_FACE).then(|| third(&tris[g as usize], x, y))
+    };
+    for &e in edges {
+        let ([a, b], [f0, f1]) = emap[e as usize];
+        if f1 == NO_FACE || touched[f0 as usize] || touched[f1 as usize] {
+            continue;
+        }
+        let tris = mesh.triangles.clone();
+        let k = third(&tris[f0 as usize], a, b);
+        let l = third(&tris[f1 as usize], a, b);
+        let wings = [
+            wing(f0, a, k, &tris),
+            wing(f0, b, k, &tris),
+            wing(f1, a, l, &tris),
+            wing(f1, b, l, &tris),
+        ];
+        let p = |i: u32| mesh.positions[i as usize];
+        let n = |i: u32| mesh.normals[i as usize];
+        let (pm, nm) = if wings.iter().all(Option::is_some) {
+            let w: Vec<u32> = wings.iter().map(|x| x.unwrap_or(a)).collect();
+            let pm = 0.5 * (p(a) + p(b)) + 0.125 * (p(k) + p(l))
+                - (p(w[0]) + p(w[1]) + p(w[2]) + p(w[3])) / 16.0;
+            let nm = 0.5 * (n(a) + n(b)) + 0.125 * (n(k) + n(l))
+                - (n(w[0]) + n(w[1]) + n(w[2]) + n(w[3])) / 16.0;
+            (pm, nm)
+        } else {
+            (0.5 * (p(a) + p(b)), n(a) + n(b))
+        };
+        let nm = nm
+            .try_normalize()
+            .or_else(|| (n(a) + n(b)).try_normalize())
+            .unwrap_or(n(a));
+        let m = mesh.positions.len() as u32;
+        mesh.positions.push(pm);
+        mesh.normals.push(nm);
+        for f in [f0, f1] {
+            let tri = mesh.triangles[f as usize];
+            let c = (0..3)
+                .find(|&c| {
+                    let (x, y) = (tri[c], tri[(c + 1) % 3]);
+                    (x == a && y == b) || (x == b && y == a)
+                })
+                .unwrap_or(0);
+            let (x, y, z) = (tri[c], tri[(c + 1) % 3], tri[(c + 2) % 3]);
+            mesh.triangles[f as usize] = [x, m, z];
+            mesh.triangles.push([m, y, z]);
+            mesh.origin.push(mesh.origin[f as usize]);
+            touched[f as usize] = true;
+            touched.push(true);
+        }
+        split += 1;
+    }
+    Ok(split)
+}

@@ -1,0 +1,781 @@
+//! The rational C¹ A-patch scheme of Xu, Huang and Bajaj (2001).
+//!
+//! Input: a triangulation with unit vertex normals. Output: a [`PatchComplex`] (scheme
+//! `rational-c1`) with one cubic patch (plus rational terms) per face and edge tetrahedron of the
+//! outer hull ([`crate::hull::outer`]), three per side of a nonconvex face, and one planar
+//! patch per zero-convex face.
+//!
+//! Scene usage (the `[scheme]` table):
+//! ```toml
+//! [scheme]
+//! type = "rational-c1"
+//! free = "default"            # or "quadric", or { offset = 0.5 }
+//! epsilon = 0.05              # hull ε relative to each face's longest edge
+//! refine_rounds = 4           # bound on the rounds of butterfly refinement
+//! bound_samples = 8           # resolution of the lower-bound sampling grids
+//! bound_margin = 0.001        # f_0003 exceeds its bound by this × the face's longest edge
+//! faces = { "12" = { offset = 2.0 }, "40" = "quadric" }   # per input-triangle overrides
+//! ```
+//!
+//! ## Patches
+//! - Convex face (positive or negative): `Role::Face`, tetrahedron [p_0 p_1 p_2 u] (or v) in the
+//!   triangle's vertex order, the cubic plus the rational term (4.1) on B_1110 with monomials
+//!   α_2α_3, α_1α_3, α_1α_2 (one per side face, 1-based as in the paper). Sheet rule
+//!   `Shooting { base: [0,1,2], top: [3] }`.
+//! - Nonconvex face: per side three `Role::Face` sub-tetrahedra [p_a p_b c u] for the triangle's
+//!   edges (a, b) = (0,1), (1,2), (2,0) (c = centroid), polynomial only. Every shooting line of
+//!   the whole face tetrahedron from q ∈ [p_a p_b c] to u lies in that sub-tetrahedron, so the
+//!   same rule `Shooting { base: [0,1,2], top: [3] }` applies per sub-tetrahedron.
+//! - Edge: `Role::Edge`, element = edge index (numbering in [`crate::hull::outer`]),
+//!   tetrahedron [p_i p_j u_A u_B] where (p_i, p_j) is the edge's stored orientation and A, B
+//!   its first and second triangle; rational terms (4.3) on B_1011 and B_0111 blending by α_3
+//!   (A's side face) and α_4 (B's side face). Sheet rule `Shooting { base: [0,1], top: [2,3] }`.
+//! - Zero-convex face: `Role::Planar`, degree 1 on [p_0 p_1 p_2 c + ε n_f] with weights
+//!   (0, 0, 0, ε): F(x) = (x − c)·n_f, so the surface is the face itself (the base of the
+//!   tetrahedron; tracers accept the zero at the entry/exit point).
+//!
+//! Sign convention: F < 0 inside (opposite the normals), F > 0 outside. The top weight f_0003
+//! is positive on the positive side (u) and negative on the negative side (v). The shooting rule
+//! of (4.5)–(4.7) also requires F(q) ≤ 0 at the base point for positive-side tetrahedra and
+//! F(q) ≥ 0 for negative-side ones, i.e. F(q) and the weight at the top vertex (any top vertex)
+//! do not have the same strict sign.
+//!
+//! ## How the weights are made (deviations from the paper marked)
+//! Steps 1–4 as in the paper; the number 2 and 3 weights come from one affine "edge blossom" per
+//! mesh edge ([`crate::hull::outer::EdgeBlossom`], the closed form of the directional-derivative
+//! interpolation (4.10)–(4.12) and Step 4). Step 5 by the least squares (4.13)/(4.14); for a
+//! nonconvex face the Clough–Tocher values (see [`weights::nonconvex_pieces`]). Step 6 lower
+//! bounds with [`bound::lemma_bound`] sampled on grids (accuracy there), taken ≥ 0, plus
+//! `bound_margin`. Steps 7, 9 by the C¹ conditions (2.3). Step 8 and the `free` choices in
+//! [`Free`]. After the choice, every edge tetrahedron is checked again with the chosen values
+//! and both faces are raised if needed (the paper's bound is taken along f_A − B_A = f_B − B_B
+//! only). Positive (negative) convex faces on which F > 0 (< 0) somewhere are treated as
+//! nonconvex (the paper's rule would put the surface outside the hull); they are counted in
+//! [`RationalBuild::promoted_faces`].
+
+pub mod bound;
+pub mod eval;
+pub mod quadric;
+pub mod weights;
+
+use crate::complex::{Patch, PatchComplex, RationalTerm, Role, SheetRule};
+use crate::error::{Error, Result};
+use crate::hull::outer::{self, refine::RefineMesh, Convexity, HullOptions, OuterHull, NO_FACE};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::path::Path;
+use weights::{convex_piece, ix, nonconvex_pieces, EdgeFrame, FaceData, Piece, N3};
+
+/// The choice of the free parameter f_0003 of a face side (Step 8, §5.3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Free {
+    /// Step 8: the linear function's value p_0001, raised to the lower bound if needed.
+    Default,
+    /// f_0003 = B + offset (offset > 0): the surface family of Fig. 2.
+    Offset(f64),
+    /// The value at u (v) of a quadric fitted to the face's neighbourhood (positions and
+    /// normals), raised to the lower bound if needed: reproduces quadrics (Theorem 4.2).
+    Quadric,
+}
+
+/// Options of the rational C¹ scheme (see the module docs for the scene keys).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RationalOptions {
+    /// The free-parameter choice for every face.
+    pub free: Free,
+    /// Per input-triangle overrides of `free`.
+    pub face_free: Vec<(u32, Free)>,
+    /// Hull ε relative to each face's longest edge.
+    pub epsilon: f64,
+    /// Maximum rounds of local butterfly refinement.
+    pub refine_rounds: usize,
+    /// Sampling resolution of the lower bounds (grid points per edge of the parameter domain).
+    pub bound_samples: usize,
+    /// Margin above the lower bound, relative to the face's longest edge.
+    pub bound_margin: f64,
+}
+
+impl Default for RationalOptions {
+    fn default() -> Self {
+        RationalOptions {
+            free: Free::Default,
+            face_free: Vec::new(),
+            epsilon: 0.05,
+            refine_rounds: 4,
+            bound_samples: 8,
+            bound_margin: 1e-3,
+        }
+    }
+}
+
+fn parse_free(v: &toml::Value, key: &str, file: &Path) -> Result<Free> {
+    let bad = |msg: String| Error::Input {
+        path: file.to_path_buf(),
+        message: format!("[scheme] {key}: {msg}"),
+    };
+    match v {
+        toml::Value::String(s) if s == "default" => Ok(Free::Default),
+        toml::Value::String(s) if s == "quadric" => Ok(Free::Quadric),
+        toml::Value::Table(t) => {
+            if let Some(k) = t.keys().find(|k| k.as_str() != "offset") {
+                return Err(bad(format!("unknown key `{k}` (expected `offset`)")));
+            }
+            let off = t
+                .get("offset")
+                .and_then(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+                .ok_or_else(|| bad("expected { offset = <number> }".into()))?;
+            if off.is_nan() || off <= 0.0 || !off.is_finite() {
+                return Err(bad(format!("offset must be a positive number, got {off}")));
+            }
+            Ok(Free::Offset(off))
+        }
+        other => Err(bad(format!(
+            "expected \"default\", \"quadric\" or {{ offset = <number> }}, got {other}"
+        ))),
+    }
+}
+
+impl RationalOptions {
+    /// Reads the scheme's keys from the scene's `[scheme]` table (all keys except `type`);
+    /// unknown keys / bad values -> error naming the key and `file`.
+    pub fn from_toml(table: &toml::Table, file: &Path) -> Result<RationalOptions> {
+        let mut o = RationalOptions::default();
+        let err = |key: &str, msg: &str| Error::Input {
+            path: file.to_path_buf(),
+            message: format!("[scheme] {key}: {msg}"),
+        };
+        let num = |key: &str, v: &toml::Value| -> Result<f64> {
+            v.as_float()
+                .or_else(|| v.as_integer().map(|i| i as f64))
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| err(key, "expected a number"))
+        };
+        for (key, v) in table {
+            match key.as_str() {
+                "type" => {}
+                "free" => o.free = parse_free(v, key, file)?,
+                "epsilon" => {
+                    o.epsilon = num(key, v)?;
+                    if o.epsilon.is_nan() || o.epsilon <= 0.0 {
+                        return Err(err(key, "must be > 0"));
+                    }
+                }
+                "refine_rounds" => {
+                    o.refine_rounds = v
+                        .as_integer()
+                        .filter(|&i| (0..=64).contains(&i))
+                        .ok_or_else(|| err(key, "expected an integer in 0..=64"))?
+                        as usize;
+                }
+                "bound_samples" => {
+                    o.bound_samples = v
+                        .as_integer()
+                        .filter(|&i| (2..=256).contains(&i))
+                        .ok_or_else(|| err(key, "expected an integer in 2..=256"))?
+                        as usize;
+                }
+                "bound_margin" => {
+                    o.bound_margin = num(key, v)?;
+                    if o.bound_margin.is_nan() || o.bound_margin <= 0.0 {
+                        return Err(err(key, "must be > 0"));
+                    }
+                }
+                "faces" => {
+                    let t = v
+                        .as_table()
+                        .ok_or_else(|| err(key, "expected a table { \"<triangle>\" = <free> }"))?;
+                    for (fk, fv) in t {
+                        let idx: u32 = fk
+                            .parse()
+                            .map_err(|_| err(key, &format!("`{fk}` is not a triangle index")))?;
+                        o.face_free
+                            .push((idx, parse_free(fv, &format!("faces.{fk}"), file)?));
+                    }
+                }
+                other => return Err(err(other, "unknown key")),
+            }
+        }
+        Ok(o)
+    }
+}
+
+/// Counts by [`Convexity`]: positive, zero, negative, nonconvex.
+pub type ClassCounts = [usize; 4];
+
+/// The result of [`build`]: the complex and statistics.
+#[derive(Clone, Debug)]
+pub struct RationalBuild {
+    /// The patches.
+    pub complex: PatchComplex,
+    /// How many edges were split by the local refinement of §3.1.
+    pub refined_edges: usize,
+    /// The (possibly refined) triangles; `complex.vertices`/`normals` match them.
+    pub triangles: Vec<[u32; 3]>,
+    /// For each triangle, the input triangle it came from.
+    pub origin: Vec<u32>,
+    /// Faces by class (positive, zero, negative, nonconvex), after promotion.
+    pub faces_by_class: ClassCounts,
+    /// Edges by class.
+    pub edges_by_class: ClassCounts,
+    /// Convex faces treated as nonconvex because F had the wrong sign on them.
+    pub promoted_faces: usize,
+    /// Per triangle, [positive side, negative side]: the lower bound B (including edge bounds)
+    /// of σ·f_0003 (σ = +1 for u, −1 for v); NaN where the side does not exist.
+    pub lower_bounds: Vec<[f64; 2]>,
+    /// Per triangle, the chosen f_0003 of each side (NaN where absent).
+    pub free_values: Vec<[f64; 2]>,
+    /// Face sides raised after the final edge check.
+    pub raised_faces: usize,
+}
+
+fn class_index(c: Convexity) -> usize {
+    match c {
+        Convexity::Positive => 0,
+        Convexity::Zero => 1,
+        Convexity::Negative => 2,
+        Convexity::Nonconvex => 3,
+    }
+}
+
+/// One side of one face: its pieces and free parameter.
+#[derive(Clone, Debug)]
+struct Side {
+    sigma: f64,
+    pieces: Vec<Piece>,
+    bound: f64,
+    f: f64,
+    margin: f64,
+    edge_extra: f64,
+}
+
+/// Multinomial factors 3!/(λ1!λ2!λ3!) of the base part of each cubic multi-index.
+fn base_factor(l: [u8; 4]) -> f64 {
+    let f = |k: u8| -> f64 { [1.0, 1.0, 2.0, 6.0][usize::from(k)] };
+    f(l[0] + l[1] + l[2]) / (f(l[0]) * f(l[1]) * f(l[2]))
+}
+
+/// Shooting cubic (4.8) of a face piece at base barycentrics `a` (of local 0, 1, 2).
+fn face_shooting(w: &[f64; N3], rat: Option<&[f64; 3]>, a: [f64; 3]) -> [f64; 4] {
+    let mut b = [0.0; 4];
+    for l in crate::bb::multi_indices(3) {
+        let k = ix(l);
+        let mut m = base_factor(l);
+        for i in 0..3 {
+            for _ in 0..l[i] {
+                m *= a[i];
+            }
+        }
+        b[usize::from(l[3])] += w[k] * m;
+    }
+    if let Some(r) = rat {
+        let den = a[1] * a[2] + a[0] * a[2] + a[0] * a[1];
+        if den > 0.0 {
+            let num = r[0] * a[1] * a[2] + r[1] * a[0] * a[2] + r[2] * a[0] * a[1];
+            b[0] += num / den * 6.0 * a[0] * a[1] * a[2];
+        }
+    }
+    b
+}
+
+/// Shooting cubic (4.9) of an edge tetrahedron [p_i p_j u_A u_B] at q = x p_i + (1−x) p_j,
+/// top point y u_A + (1−y) u_B.
+fn edge_shooting(w: &[f64; N3], rat: &[f64; 4], x: f64, y: f64) -> [f64; 4] {
+    let bern = |n: u8, k: u8, s: f64| -> f64 {
+        let c = [
+            [1.0, 0.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0, 0.0],
+            [1.0, 2.0, 1.0, 0.0],
+            [1.0, 3.0, 3.0, 1.0],
+        ][usize::from(n)][usize::from(k)];
+        c * s.powi(i32::from(k)) * (1.0 - s).powi(i32::from(n - k))
+    };
+    let mut b = [0.0; 4];
+    for l in crate::bb::multi_indices(3) {
+        let s = l[2] + l[3];
+        b[usize::from(s)] += w[ix(l)] * bern(3 - s, l[0], x) * bern(s, l[2], y);
+    }
+    let b21 = 2.0 * y * (1.0 - y);
+    b[2] += x * b21 * (rat[0] * y + rat[1] * (1.0 - y))
+        + (1.0 - x) * b21 * (rat[2] * y + rat[3] * (1.0 - y));
+    b
+}
+
+/// Barycentric sample points of a triangle, `n` intervals per edge.
+fn tri_grid(n: usize) -> Vec<[f64; 3]> {
+    let mut v = Vec::with_capacity((n + 1) * (n + 2) / 2);
+    for i in 0..=n {
+        for j in 0..=n - i {
+            let (a, b) = (i as f64 / n as f64, j as f64 / n as f64);
+            v.push([a, b, (1.0 - a - b).max(0.0)]);
+        }
+    }
+    v
+}
+
+/// Lower bound of σ f_0003 for one face side (Step 6, first part), taken ≥ 0.
+fn face_bound(side: &Side, grid: &[[f64; 3]]) -> f64 {
+    const D: [f64; 4] = [0.0, 0.0, 1.0 / 3.0, 1.0];
+    let mut b: f64 = 0.0;
+    for pc in &side.pieces {
+        for &a in grid {
+            let p = face_shooting(&pc.w0, pc.rat.as_ref(), a).map(|x| side.sigma * x);
+            b = b.max(bound::lemma_bound(p, D));
+        }
+    }
+    b
+}
+
+/// An edge tetrahedron under construction.
+struct EdgeTet {
+    edge: u32,
+    faces: [usize; 2],
+    side: usize,
+    piece: [usize; 2],
+    frame: EdgeFrame,
+    /// Shooting-cubic coefficients of ∂/∂b along f_A = σ(B_A + b), f_B = σ(B_B + b), per sample.
+    d: Vec<[f64; 4]>,
+}
+
+/// Builds the rational C¹ complex (see the module docs).
+///
+/// `positions`, `triangles` (vertex indices) and `normals` (unit, one per vertex, pointing to
+/// the outside) describe a manifold triangulation, open or closed.
+pub fn build(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    normals: &[DVec3],
+    opts: &RationalOptions,
+) -> Result<RationalBuild> {
+    if triangles.is_empty() {
+        return Err(Error::Invalid("the mesh has no triangles".into()));
+    }
+    outer::validate_normals(positions, normals)?;
+    let hopts = HullOptions {
+        epsilon: opts.epsilon,
+    };
+    // §3.1: build, refine where adjacent face tetrahedra intersect, repeat.
+    let mut mesh = RefineMesh {
+        positions: positions.to_vec(),
+        normals: normals.to_vec(),
+        triangles: triangles.to_vec(),
+        origin: (0..triangles.len() as u32).collect(),
+    };
+    let mut refined = 0;
+    let mut rounds = 0;
+    let hull = loop {
+        let hull = outer::build(&mesh.positions, &mesh.triangles, &mesh.normals, &hopts)
+            .map_err(|e| {
+                if rounds == 0 {
+                    e
+                } else {
+                    Error::Invalid(format!(
+                        "after {refined} edges were refined because adjacent face tetrahedra intersected (§3.1): {e}"
+                    ))
+                }
+            })?;
+        let bad = hull.bad_edges(&mesh.positions, &mesh.triangles);
+        if bad.is_empty() {
+            break hull;
+        }
+        if rounds >= opts.refine_rounds {
+            let e = hull.edges[bad[0] as usize];
+            return Err(Error::Invalid(format!(
+                "face tetrahedra still intersect after {} rounds of refinement ({} edges, e.g. \
+                 the edge between vertices {} and {}); try a smaller `epsilon` or smoother normals",
+                opts.refine_rounds,
+                bad.len(),
+                e.v[0],
+                e.v[1]
+            )));
+        }
+        let n = outer::refine::split_edges(&mut mesh, &bad)?;
+        refined += n;
+        rounds += 1;
+    };
+    let RefineMesh {
+        positions,
+        normals,
+        triangles,
+        origin,
+    } = mesh;
+    assemble(
+        &positions, &triangles, &normals, &origin, &hull, refined, opts,
+    )
+}
+
+#[allow(clippy::too_many_lines)]
+fn assemble(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    normals: &[DVec3],
+    origin: &[u32],
+    hull: &OuterHull,
+    refined_edges: usize,
+    opts: &RationalOptions,
+) -> Result<RationalBuild> {
+    let nf = triangles.len();
+    let grid = tri_grid(opts.bound_samples);
+    let fit = if opts.free == Free::Quadric || opts.face_free.iter().any(|f| f.1 == Free::Quadric) {
+        Some(quadric::VertexFaces::new(positions.len(), triangles))
+    } else {
+        None
+    };
+    let free_of = |t: usize| -> Free {
+        let o = origin[t];
+        opts.face_free
+            .iter()
+            .rev()
+            .find(|(i, _)| *i == o)
+            .map_or(opts.free, |x| x.1)
+    };
+
+    // Faces: pieces, promotion, face bounds (parallel).
+    struct FaceOut {
+        class: Convexity,
+        promoted: bool,
+        sides: [Option<Side>; 2],
+        fd: FaceData,
+    }
+    let faces: Vec<FaceOut> = (0..nf)
+        .into_par_iter()
+        .map(|t| {
+            let tri = triangles[t];
+            let fh = &hull.faces[t];
+            let p = tri.map(|i| positions[i as usize]);
+            let n = tri.map(|i| normals[i as usize]);
+            let fd = FaceData::new(p, n);
+            let longest = fh.epsilon / opts.epsilon;
+            let margin = opts.bound_margin * longest;
+            let mut class = fh.class;
+            let mut promoted = false;
+            if class == Convexity::Zero {
+                return FaceOut {
+                    class,
+                    promoted,
+                    sides: [None, None],
+                    fd,
+                };
+            }
+            // Promotion: a convex face on which F has the wrong sign is treated as nonconvex.
+            if class != Convexity::Nonconvex {
+                let top = class == Convexity::Positive;
+                let t_apex = if top { fh.t_max } else { fh.t_min };
+                let pc = convex_piece(&fd, fh.centroid + t_apex * fh.normal);
+                let sigma = if top { 1.0 } else { -1.0 };
+                let scale = pc.w0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                if grid
+                    .iter()
+                    .any(|&a| sigma * face_shooting(&pc.w0, pc.rat.as_ref(), a)[0] > 1e-12 * scale)
+                {
+                    class = Convexity::Nonconvex;
+                    promoted = true;
+                }
+            }
+            let mut sides: [Option<Side>; 2] = [None, None];
+            for (s, (has, t_apex, sigma)) in [
+                (class.has_positive(), fh.t_max, 1.0),
+                (class.has_negative(), fh.t_min, -1.0),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                if !has {
+                    continue;
+                }
+                let apex = fh.centroid + t_apex * fh.normal;
+                let pieces = if class == Convexity::Nonconvex {
+                    nonconvex_pieces(&fd, apex).to_vec()
+                } else {
+                    vec![convex_piece(&fd, apex)]
+                };
+                let mut side = Side {
+                    sigma,
+                    pieces,
+                    bound: 0.0,
+                    f: 0.0,
+                    margin,
+                    edge_extra: 0.0,
+                };
+                side.bound = face_bound(&side, &grid);
+                sides[s] = Some(side);
+            }
+            FaceOut {
+                class,
+                promoted,
+                sides,
+                fd,
+            }
+        })
+        .collect();
+
+    // Edge tetrahedra: frames and the b-derivative of their shooting cubics.
+    let egrid: Vec<(f64, f64)> = {
+        let n = opts.bound_samples;
+        (0..=n)
+            .flat_map(|i| (0..=n).map(move |j| (i as f64 / n as f64, j as f64 / n as f64)))
+            .collect()
+    };
+    let piece_at = |t: usize, side: &Side, e: &outer::Edge| -> usize {
+        if side.pieces.len() == 1 {
+            return 0;
+        }
+        let tri = triangles[t];
+        (0..3)
+            .find(|&k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                (a == e.v[0] && b == e.v[1]) || (a == e.v[1] && b == e.v[0])
+            })
+            .unwrap_or(0)
+    };
+    let mut etets: Vec<EdgeTet> = Vec::new();
+    for (ei, e) in hull.edges.iter().enumerate() {
+        if e.faces[1] == NO_FACE || e.class == Convexity::Zero {
+            continue;
+        }
+        let [fa, fb] = e.faces.map(|f| f as usize);
+        for s in 0..2 {
+            let (Some(sa), Some(sb)) = (&faces[fa].sides[s], &faces[fb].sides[s]) else {
+                continue;
+            };
+            let (ka, kb) = (piece_at(fa, sa, e), piece_at(fb, sb, e));
+            let frame = EdgeFrame::new(
+                &sa.pieces[ka],
+                &sb.pieces[kb],
+                positions[e.v[0] as usize],
+                positions[e.v[1] as usize],
+            )
+            .ok_or_else(|| {
+                Error::Invalid(format!(
+                    "edge {ei} (vertices {}, {}): degenerate face tetrahedron",
+                    e.v[0], e.v[1]
+                ))
+            })?;
+            etets.push(EdgeTet {
+                edge: ei as u32,
+                faces: [fa, fb],
+                side: s,
+                piece: [ka, kb],
+                frame,
+                d: Vec::new(),
+            });
+        }
+    }
+    let mut faces = faces;
+    // Edge bounds (Step 6, second part) along f_A = σ(B_A + b), f_B = σ(B_B + b).
+    let edge_bounds: Vec<f64> = etets
+        .par_iter_mut()
+        .map(|et| {
+            let sa = faces[et.faces[0]].sides[et.side]
+                .as_ref()
+                .expect("side exists");
+            let sb = faces[et.faces[1]].sides[et.side]
+                .as_ref()
+                .expect("side exists");
+            let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
+            let (dw, drat) = et.frame.weights(&pa.dw, &pb.dw);
+            let wa = pa.weights(sa.sigma * sa.bound);
+            let wb = pb.weights(sb.sigma * sb.bound);
+            let (w0, r0) = et.frame.weights(&wa, &wb);
+            let mut bmax = f64::NEG_INFINITY;
+            et.d = egrid
+                .iter()
+                .map(|&(x, y)| {
+                    let d = edge_shooting(&dw, &drat, x, y);
+                    let p = edge_shooting(&w0, &r0, x, y).map(|v| sa.sigma * v);
+                    bmax = bmax.max(bound::lemma_bound(p, d));
+                    d
+                })
+                .collect();
+            bmax
+        })
+        .collect();
+    for (et, &be) in etets.iter().zip(&edge_bounds) {
+        if be > 0.0 {
+            for k in 0..2 {
+                if let Some(s) = faces[et.faces[k]].sides[et.side].as_mut() {
+                    // Third part of Step 6: B_ijk += B_ijkl (the largest over its edges).
+                    s.edge_extra = s.edge_extra.max(be);
+                }
+            }
+        }
+    }
+    // Choose the free parameters (Step 8 / §5.3).
+    faces.par_iter_mut().enumerate().for_each(|(t, fo)| {
+        let free = free_of(t);
+        let fd = fo.fd;
+        for s in fo.sides.iter_mut().flatten() {
+            s.bound += s.edge_extra;
+            let apex = s.pieces[0].pts[3];
+            let target = match free {
+                Free::Default => s.sigma * weights::linear_apex_value(&fd, apex),
+                Free::Offset(b) => s.bound + b,
+                Free::Quadric => {
+                    let q = fit
+                        .as_ref()
+                        .and_then(|vf| quadric::fit_face(vf, positions, normals, triangles, t));
+                    q.map_or(f64::NEG_INFINITY, |q| s.sigma * q.value(apex))
+                }
+            };
+            s.f = s.sigma * target.max(s.bound + s.margin);
+        }
+    });
+    // Final edge check with the chosen values; raise both faces where needed.
+    let mut raised = vec![[false; 2]; nf];
+    for _round in 0..4 {
+        let needs: Vec<f64> = etets
+            .par_iter()
+            .map(|et| {
+                let sa = faces[et.faces[0]].sides[et.side]
+                    .as_ref()
+                    .expect("side exists");
+                let sb = faces[et.faces[1]].sides[et.side]
+                    .as_ref()
+                    .expect("side exists");
+                let wa = sa.pieces[et.piece[0]].weights(sa.f);
+                let wb = sb.pieces[et.piece[1]].weights(sb.f);
+                let (w, r) = et.frame.weights(&wa, &wb);
+                let mut need = f64::NEG_INFINITY;
+                for (k, &(x, y)) in egrid.iter().enumerate() {
+                    let p = edge_shooting(&w, &r, x, y).map(|v| sa.sigma * v);
+                    need = need.max(bound::lemma_bound(p, et.d[k]));
+                }
+                need + sa.margin.max(sb.margin)
+            })
+            .collect();
+        let mut any = false;
+        for (et, &need) in etets.iter().zip(&needs) {
+            if need > 0.0 {
+                any = true;
+                for k in 0..2 {
+                    let f = et.faces[k];
+                    if let Some(s) = faces[f].sides[et.side].as_mut() {
+                        s.f += s.sigma * need;
+                        raised[f][et.side] = true;
+                    }
+                }
+            }
+        }
+        if !any {
+            break;
+        }
+    }
+
+    // Emit patches.
+    let mut complex = PatchComplex::new("rational-c1");
+    complex.continuity = Some(1);
+    complex.vertices = positions.iter().map(|p| p.to_array()).collect();
+    complex.normals = normals.iter().map(|n| n.to_array()).collect();
+    let face_sheet = SheetRule::Shooting {
+        base: vec![0, 1, 2],
+        top: vec![3],
+    };
+    let mut faces_by_class = [0; 4];
+    let mut lower_bounds = vec![[f64::NAN; 2]; nf];
+    let mut free_values = vec![[f64::NAN; 2]; nf];
+    for (t, fo) in faces.iter().enumerate() {
+        faces_by_class[class_index(fo.class)] += 1;
+        if fo.class == Convexity::Zero {
+            let fh = &hull.faces[t];
+            let tri = triangles[t];
+            let apex = fh.centroid + fh.epsilon * fh.normal;
+            complex.patches.push(Patch {
+                tet: [
+                    positions[tri[0] as usize].to_array(),
+                    positions[tri[1] as usize].to_array(),
+                    positions[tri[2] as usize].to_array(),
+                    apex.to_array(),
+                ],
+                degree: 1,
+                weights: vec![0.0, 0.0, 0.0, fh.epsilon],
+                rational: Vec::new(),
+                sheet: SheetRule::Any,
+                role: Role::Planar,
+                element: t as u32,
+            });
+            continue;
+        }
+        for (s, side) in fo.sides.iter().enumerate() {
+            let Some(side) = side else { continue };
+            lower_bounds[t][s] = side.bound;
+            free_values[t][s] = side.f;
+            for pc in &side.pieces {
+                let w = pc.weights(side.f);
+                let rational = pc
+                    .rat
+                    .map(|r| {
+                        vec![RationalTerm {
+                            index: [1, 1, 1, 0],
+                            terms: vec![
+                                (r[0], [0, 1, 1, 0]),
+                                (r[1], [1, 0, 1, 0]),
+                                (r[2], [1, 1, 0, 0]),
+                            ],
+                        }]
+                    })
+                    .unwrap_or_default();
+                complex.patches.push(Patch {
+                    tet: pc.pts.map(|p| p.to_array()),
+                    degree: 3,
+                    weights: w.to_vec(),
+                    rational,
+                    sheet: face_sheet.clone(),
+                    role: Role::Face,
+                    element: t as u32,
+                });
+            }
+        }
+    }
+    for et in &etets {
+        let sa = faces[et.faces[0]].sides[et.side]
+            .as_ref()
+            .expect("side exists");
+        let sb = faces[et.faces[1]].sides[et.side]
+            .as_ref()
+            .expect("side exists");
+        let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
+        let (w, r) = et.frame.weights(&pa.weights(sa.f), &pb.weights(sb.f));
+        let e = hull.edges[et.edge as usize];
+        complex.patches.push(Patch {
+            tet: [
+                positions[e.v[0] as usize].to_array(),
+                positions[e.v[1] as usize].to_array(),
+                pa.pts[3].to_array(),
+                pb.pts[3].to_array(),
+            ],
+            degree: 3,
+            weights: w.to_vec(),
+            rational: vec![
+                RationalTerm {
+                    index: [1, 0, 1, 1],
+                    terms: vec![(r[0], [0, 0, 1, 0]), (r[1], [0, 0, 0, 1])],
+                },
+                RationalTerm {
+                    index: [0, 1, 1, 1],
+                    terms: vec![(r[2], [0, 0, 1, 0]), (r[3], [0, 0, 0, 1])],
+                },
+            ],
+            sheet: SheetRule::Shooting {
+                base: vec![0, 1],
+                top: vec![2, 3],
+            },
+            role: Role::Edge,
+            element: et.edge,
+        });
+    }
+    let mut edges_by_class = [0; 4];
+    for e in &hull.edges {
+        edges_by_class[class_index(e.class)] += 1;
+    }
+    Ok(RationalBuild {
+        complex,
+        refined_edges,
+        triangles: triangles.to_vec(),
+        origin: origin.to_vec(),
+        faces_by_class,
+        edges_by_class,
+        promoted_faces: faces.iter().filter(|f| f.promoted).count(),
+        lower_bounds,
+        free_values,
+        raised_faces: raised.iter().flatten().filter(|&&r| r).count(),
+    })
+}

@@ -1,1 +1,0 @@
-//! `trace` module (see ARCHITECTURE.md).

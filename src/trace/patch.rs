@@ -1,0 +1,637 @@
+//! The tracer's compiled form of one [`Patch`]: barycentric map, weights and rational terms
+//! arranged for the hot loop. Restriction of F to a segment (univariate Bernstein coefficients,
+//! rational denominators cleared) and value/gradient/Hessian at a point.
+
+// Index loops over the four barycentric components read better than zipped iterators.
+#![allow(clippy::needless_range_loop)]
+
+use super::poly::{self, Coeffs, MAX_DEGREE};
+use crate::bb::{index_of, multi_indices, num_coeffs};
+use crate::complex::{Patch, SheetRule};
+use glam::{DMat3, DVec3};
+use std::sync::OnceLock;
+
+/// Largest polynomial degree a patch may have.
+pub const MAX_PATCH_DEGREE: usize = 7;
+const MAX_COEFFS: usize = num_coeffs(MAX_PATCH_DEGREE);
+
+/// For each degree m in 1..=MAX_PATCH_DEGREE and each multi-index μ of degree m−1 (in order),
+/// the positions of μ + e_i among the degree-m multi-indices.
+fn raise_tables() -> &'static [Vec<[u16; 4]>] {
+    static TABLES: OnceLock<Vec<Vec<[u16; 4]>>> = OnceLock::new();
+    TABLES.get_or_init(|| {
+        let mut t = vec![Vec::new()];
+        for m in 1..=MAX_PATCH_DEGREE {
+            let rows = multi_indices(m - 1)
+                .into_iter()
+                .map(|mu| {
+                    let mut r = [0u16; 4];
+                    for (i, ri) in r.iter_mut().enumerate() {
+                        let mut l = mu;
+                        l[i] += 1;
+                        *ri = index_of(l) as u16;
+                    }
+                    r
+                })
+                .collect();
+            t.push(rows);
+        }
+        t
+    })
+}
+
+/// One blossom step: the degree-(m−1) coefficients Σ_i β_i c_{μ+e_i} of the degree-m `src`.
+#[inline]
+fn contract(src: &[f64], m: usize, beta: [f64; 4], dst: &mut [f64]) {
+    let table = &raise_tables()[m];
+    for (d, idx) in dst.iter_mut().zip(table.iter()) {
+        *d = beta[0] * src[idx[0] as usize]
+            + beta[1] * src[idx[1] as usize]
+            + beta[2] * src[idx[2] as usize]
+            + beta[3] * src[idx[3] as usize];
+    }
+}
+
+/// Position of e_i + e_j among the degree-2 multi-indices.
+const IDX2: [[usize; 4]; 4] = [[0, 1, 2, 3], [1, 4, 5, 6], [2, 5, 7, 8], [3, 6, 8, 9]];
+
+/// Which roots of F inside the tetrahedron are on the surface (see [`SheetRule`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sheet {
+    /// Every root.
+    Any,
+    /// The 2001 shooting-line rule; masks of the base and top tetrahedron vertices.
+    Shooting {
+        /// Bit i set when vertex i spans the base.
+        base: u8,
+        /// Bit i set when vertex i spans the top.
+        top: u8,
+    },
+}
+
+/// One rational term: κ, its multinomial factor n!/κ!, and the numerator terms (w_m, μ_m).
+type KappaTerm = ([u8; 4], f64, Vec<(f64, [u8; 4])>);
+
+/// Rational terms sharing one denominator Σ_m α^μm.
+#[derive(Clone, Debug)]
+struct RationalGroup {
+    denominator: Vec<[u8; 4]>,
+    /// (κ with its multinomial factor n!/κ!, numerator terms (w_m, μ_m)).
+    terms: Vec<KappaTerm>,
+}
+
+/// A patch compiled for tracing.
+#[derive(Clone, Debug)]
+pub struct CompiledPatch {
+    /// First tetrahedron vertex (origin of the barycentric map).
+    pub v0: DVec3,
+    /// ∇αi in world coordinates.
+    pub grad: [DVec3; 4],
+    /// Polynomial degree n.
+    pub degree: usize,
+    weights: Vec<f64>,
+    groups: Vec<RationalGroup>,
+    /// The sheet rule.
+    pub sheet: Sheet,
+    /// Degree of the segment polynomial once denominators are cleared.
+    pub segment_degree: usize,
+}
+
+fn multinomial(l: [u8; 4]) -> f64 {
+    let f = |k: u8| (1..=u64::from(k)).product::<u64>() as f64;
+    let n: u8 = l.iter().sum();
+    f(n) / (f(l[0]) * f(l[1]) * f(l[2]) * f(l[3]))
+}
+
+/// Bernstein coefficients (degree |μ|) of α(s)^μ with α(s) = (1−s)a + s·b.
+fn monomial_segment(mu: [u8; 4], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
+    out[0] = 1.0;
+    let mut deg = 0;
+    let mut tmp = [0.0; MAX_DEGREE + 1];
+    for i in 0..4 {
+        for _ in 0..mu[i] {
+            poly::product(out, deg, &[a[i], b[i]], 1, &mut tmp);
+            deg += 1;
+            out[..=deg].copy_from_slice(&tmp[..=deg]);
+        }
+    }
+    deg
+}
+
+/// Sum into `acc` (degree `*deg`) the polynomial `p` of degree `d`, elevating as needed.
+fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
+    let mut q = *p;
+    if d < *deg {
+        poly::elevate(&mut q, d, *deg);
+    } else if d > *deg {
+        poly::elevate(acc, *deg, d);
+        *deg = d;
+    }
+    for k in 0..=*deg {
+        acc[k] += q[k];
+    }
+}
+
+impl CompiledPatch {
+    /// Compiles `patch`; `index` names it in errors.
+    ///
+    /// # Errors
+    /// A degenerate tetrahedron, a degree outside 1..=7, a wrong weight count, or rational terms
+    /// whose cleared segment degree exceeds [`MAX_DEGREE`].
+    pub fn new(patch: &Patch, index: usize) -> Result<Self, String> {
+        let n = usize::from(patch.degree);
+        if !(1..=MAX_PATCH_DEGREE).contains(&n) {
+            return Err(format!("patch {index}: degree {n} is outside 1..=7"));
+        }
+        if patch.weights.len() != num_coeffs(n) {
+            return Err(format!(
+                "patch {index}: {} weights for degree {n} (expected {})",
+                patch.weights.len(),
+                num_coeffs(n)
+            ));
+        }
+        if patch.weights.iter().any(|w| !w.is_finite()) {
+            return Err(format!("patch {index}: a weight is not finite"));
+        }
+        let v = patch.tet_points();
+        let m = DMat3::from_cols(v[1] - v[0], v[2] - v[0], v[3] - v[0]);
+        let det = m.determinant();
+        let scale = (v[1] - v[0])
+            .length()
+            .max((v[2] - v[0]).length())
+            .max((v[3] - v[0]).length());
+        if !det.is_finite() || det.abs() <= 1e-14 * scale.powi(3) {
+            return Err(format!("patch {index}: degenerate tetrahedron"));
+        }
+        let inv = m.inverse().transpose();
+        let g1 = inv.x_axis;
+        let g2 = inv.y_axis;
+        let g3 = inv.z_axis;
+        let grad = [-(g1 + g2 + g3), g1, g2, g3];
+
+        let mut groups: Vec<RationalGroup> = Vec::new();
+        for (r, term) in patch.rational.iter().enumerate() {
+            let kdeg: u8 = term.index.iter().sum();
+            if usize::from(kdeg) != n {
+                return Err(format!("patch {index}: rational term {r} has |κ| ≠ {n}"));
+            }
+            if term.terms.is_empty() || term.terms.iter().any(|(w, _)| !w.is_finite()) {
+                return Err(format!(
+                    "patch {index}: rational term {r} is empty or not finite"
+                ));
+            }
+            let mut denom: Vec<[u8; 4]> = term.terms.iter().map(|t| t.1).collect();
+            denom.sort_unstable();
+            let kappa = (term.index, multinomial(term.index), term.terms.clone());
+            match groups.iter_mut().find(|g| g.denominator == denom) {
+                Some(g) => g.terms.push(kappa),
+                None => groups.push(RationalGroup {
+                    denominator: denom,
+                    terms: vec![kappa],
+                }),
+            }
+        }
+        let mu_deg = |l: &[u8; 4]| l.iter().map(|&x| usize::from(x)).sum::<usize>();
+        // Follow the degrees of `segment` step by step.
+        let mut segment_degree = n;
+        let mut qdeg = 0;
+        for g in &groups {
+            let dden = g.denominator.iter().map(mu_deg).max().unwrap_or(0);
+            let dsum = g
+                .terms
+                .iter()
+                .map(|t| t.2.iter().map(|m| mu_deg(&m.1)).max().unwrap_or(0) + n)
+                .max()
+                .unwrap_or(0);
+            segment_degree = (segment_degree + dden).max(dsum + qdeg);
+            qdeg += dden;
+        }
+        if segment_degree > MAX_DEGREE {
+            return Err(format!(
+                "patch {index}: rational terms raise the segment degree to {segment_degree} (> {MAX_DEGREE})"
+            ));
+        }
+        let sheet = match &patch.sheet {
+            SheetRule::Any => Sheet::Any,
+            SheetRule::Shooting { base, top } => {
+                let mask = |s: &[u8]| -> Result<u8, String> {
+                    let mut m = 0u8;
+                    for &i in s {
+                        if i > 3 {
+                            return Err(format!("patch {index}: sheet vertex {i} is not 0..=3"));
+                        }
+                        m |= 1 << i;
+                    }
+                    Ok(m)
+                };
+                let (b, t) = (mask(base)?, mask(top)?);
+                if b == 0 || t == 0 || b & t != 0 {
+                    return Err(format!(
+                        "patch {index}: sheet base and top must be disjoint and non-empty"
+                    ));
+                }
+                Sheet::Shooting { base: b, top: t }
+            }
+        };
+        Ok(CompiledPatch {
+            v0: v[0],
+            grad,
+            degree: n,
+            weights: patch.weights.clone(),
+            groups,
+            sheet,
+            segment_degree,
+        })
+    }
+
+    /// Barycentric coordinates of `x`.
+    #[must_use]
+    #[inline]
+    pub fn bary(&self, x: DVec3) -> [f64; 4] {
+        let d = x - self.v0;
+        let a1 = self.grad[1].dot(d);
+        let a2 = self.grad[2].dot(d);
+        let a3 = self.grad[3].dot(d);
+        [1.0 - a1 - a2 - a3, a1, a2, a3]
+    }
+
+    /// The parameter interval [t0, t1] in which `o + t·d` lies inside the tetrahedron, with
+    /// α(o) and dα/dt (barycentrics along the ray are α(o) + t·rate), or `None`.
+    #[must_use]
+    #[inline]
+    pub fn clip(&self, o: DVec3, d: DVec3) -> Option<(f64, f64, [f64; 4], [f64; 4])> {
+        let a = self.bary(o);
+        let mut t0 = f64::NEG_INFINITY;
+        let mut t1 = f64::INFINITY;
+        let mut rate = [0.0; 4];
+        for i in 0..4 {
+            rate[i] = self.grad[i].dot(d);
+        }
+        // αi(t) = a_i + t·rate_i ≥ 0.
+        for i in 0..4 {
+            let r = rate[i];
+            if r > 0.0 {
+                t0 = t0.max(-a[i] / r);
+            } else if r < 0.0 {
+                t1 = t1.min(-a[i] / r);
+            } else if a[i] < 0.0 {
+                return None;
+            }
+        }
+        if t0 > t1 || !t0.is_finite() || !t1.is_finite() {
+            return None;
+        }
+        Some((t0, t1, a, rate))
+    }
+
+    /// Bernstein coefficients on s ∈ [0, 1] of F((1−s)·a + s·b) (barycentric endpoints), with
+    /// rational denominators cleared (multiplied by their positive values). Returns the degree.
+    pub fn segment(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
+        let n = self.degree;
+        // Polynomial part: c_k = blossom(a^(n−k), b^k).
+        let mut bk = [0.0; MAX_COEFFS];
+        let mut tmp = [0.0; MAX_COEFFS];
+        let mut work = [0.0; MAX_COEFFS];
+        bk[..self.weights.len()].copy_from_slice(&self.weights);
+        for k in 0..=n {
+            // bk has degree n − k here.
+            let m = n - k;
+            work[..num_coeffs(m)].copy_from_slice(&bk[..num_coeffs(m)]);
+            for level in (1..=m).rev() {
+                contract(&work, level, *a, &mut tmp);
+                work[..num_coeffs(level - 1)].copy_from_slice(&tmp[..num_coeffs(level - 1)]);
+            }
+            out[k] = work[0];
+            if m > 0 {
+                contract(&bk, m, *b, &mut tmp);
+                bk[..num_coeffs(m - 1)].copy_from_slice(&tmp[..num_coeffs(m - 1)]);
+            }
+        }
+        if self.groups.is_empty() {
+            return n;
+        }
+        // Rational terms: G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group.
+        let mut deg = n;
+        let mut q = [0.0; MAX_DEGREE + 1]; // Π of the denominators so far
+        q[0] = 1.0;
+        let mut qdeg = 0;
+        for g in &self.groups {
+            let mut den = [0.0; MAX_DEGREE + 1];
+            let mut dden = 0;
+            for mu in &g.denominator {
+                let mut m = [0.0; MAX_DEGREE + 1];
+                let d = monomial_segment(*mu, a, b, &mut m);
+                add_poly(&mut den, &mut dden, &m, d);
+            }
+            let mut sum = [0.0; MAX_DEGREE + 1];
+            let mut dsum = 0;
+            for (kappa, mult, numer) in &g.terms {
+                let mut num = [0.0; MAX_DEGREE + 1];
+                let mut dnum = 0;
+                for (w, mu) in numer {
+                    let mut m = [0.0; MAX_DEGREE + 1];
+                    let d = monomial_segment(*mu, a, b, &mut m);
+                    for x in &mut m[..=d] {
+                        *x *= w;
+                    }
+                    add_poly(&mut num, &mut dnum, &m, d);
+                }
+                let mut bern = [0.0; MAX_DEGREE + 1];
+                let dk = monomial_segment(*kappa, a, b, &mut bern);
+                for x in &mut bern[..=dk] {
+                    *x *= mult;
+                }
+                let mut prod = [0.0; MAX_DEGREE + 1];
+                poly::product(&num, dnum, &bern, dk, &mut prod);
+                add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
+            }
+            let mut left = [0.0; MAX_DEGREE + 1];
+            poly::product(out, deg, &den, dden, &mut left);
+            let mut right = [0.0; MAX_DEGREE + 1];
+            poly::product(&sum, dsum, &q, qdeg, &mut right);
+            let mut dl = deg + dden;
+            add_poly(&mut left, &mut dl, &right, dsum + qdeg);
+            *out = left;
+            deg = dl;
+            let mut nq = [0.0; MAX_DEGREE + 1];
+            poly::product(&q, qdeg, &den, dden, &mut nq);
+            q = nq;
+            qdeg += dden;
+        }
+        deg
+    }
+
+    /// F, its gradient and Hessian with respect to the four barycentric variables at `alpha`.
+    #[must_use]
+    pub fn bary_derivatives(&self, alpha: &[f64; 4]) -> Jet {
+        let n = self.degree;
+        let mut jet = Jet::default();
+        if n == 1 {
+            for i in 0..4 {
+                jet.v += alpha[i] * self.weights[i];
+                jet.g[i] = self.weights[i];
+            }
+        } else {
+            let mut work = [0.0; MAX_COEFFS];
+            let mut tmp = [0.0; MAX_COEFFS];
+            work[..self.weights.len()].copy_from_slice(&self.weights);
+            for level in (3..=n).rev() {
+                contract(&work, level, *alpha, &mut tmp);
+                work[..num_coeffs(level - 1)].copy_from_slice(&tmp[..num_coeffs(level - 1)]);
+            }
+            let nf = n as f64;
+            for i in 0..4 {
+                let mut ci = 0.0;
+                for j in 0..4 {
+                    let d = work[IDX2[i][j]];
+                    ci += alpha[j] * d;
+                    jet.h[i][j] = nf * (nf - 1.0) * d;
+                }
+                jet.v += alpha[i] * ci;
+                jet.g[i] = nf * ci;
+            }
+        }
+        for g in &self.groups {
+            let mut den = Jet::default();
+            for mu in &g.denominator {
+                den = den.add(&Jet::monomial(*mu, alpha));
+            }
+            for (kappa, mult, numer) in &g.terms {
+                let mut num = Jet::default();
+                for (w, mu) in numer {
+                    num = num.add(&Jet::monomial(*mu, alpha).scale(*w));
+                }
+                let bern = Jet::monomial(*kappa, alpha).scale(*mult);
+                jet = jet.add(&num.div(&den).mul(&bern));
+            }
+        }
+        jet
+    }
+
+    /// F, world gradient and world Hessian at the point with barycentrics `alpha`.
+    #[must_use]
+    pub fn derivatives(&self, alpha: &[f64; 4]) -> (f64, DVec3, DMat3) {
+        let j = self.bary_derivatives(alpha);
+        let mut g = DVec3::ZERO;
+        let mut h = DMat3::ZERO;
+        for i in 0..4 {
+            g += j.g[i] * self.grad[i];
+            for k in 0..4 {
+                let gi = self.grad[i] * j.h[i][k];
+                let gk = self.grad[k];
+                h += DMat3::from_cols(gi * gk.x, gi * gk.y, gi * gk.z);
+            }
+        }
+        (j.v, g, h)
+    }
+
+    /// Approximate bytes this patch occupies.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.weights.len() * 8
+            + self
+                .groups
+                .iter()
+                .map(|g| {
+                    std::mem::size_of::<RationalGroup>()
+                        + g.denominator.len() * 4
+                        + g.terms.iter().map(|t| 48 + t.2.len() * 16).sum::<usize>()
+                })
+                .sum::<usize>()
+    }
+}
+
+/// Value, gradient and Hessian of a function of four variables (second-order forward jet).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Jet {
+    /// Value.
+    pub v: f64,
+    /// Gradient.
+    pub g: [f64; 4],
+    /// Hessian.
+    pub h: [[f64; 4]; 4],
+}
+
+impl Jet {
+    fn constant(v: f64) -> Self {
+        Jet {
+            v,
+            ..Jet::default()
+        }
+    }
+    fn variable(i: usize, x: f64) -> Self {
+        let mut j = Jet::constant(x);
+        j.g[i] = 1.0;
+        j
+    }
+    fn monomial(mu: [u8; 4], alpha: &[f64; 4]) -> Self {
+        let mut j = Jet::constant(1.0);
+        for i in 0..4 {
+            for _ in 0..mu[i] {
+                j = j.mul(&Jet::variable(i, alpha[i]));
+            }
+        }
+        j
+    }
+    fn add(&self, o: &Jet) -> Jet {
+        let mut r = *self;
+        r.v += o.v;
+        for i in 0..4 {
+            r.g[i] += o.g[i];
+            for k in 0..4 {
+                r.h[i][k] += o.h[i][k];
+            }
+        }
+        r
+    }
+    fn scale(&self, s: f64) -> Jet {
+        let mut r = *self;
+        r.v *= s;
+        for i in 0..4 {
+            r.g[i] *= s;
+            for k in 0..4 {
+                r.h[i][k] *= s;
+            }
+        }
+        r
+    }
+    fn mul(&self, o: &Jet) -> Jet {
+        let mut r = Jet::constant(self.v * o.v);
+        for i in 0..4 {
+            r.g[i] = self.g[i] * o.v + self.v * o.g[i];
+            for k in 0..4 {
+                r.h[i][k] = self.h[i][k] * o.v
+                    + self.v * o.h[i][k]
+                    + self.g[i] * o.g[k]
+                    + self.g[k] * o.g[i];
+            }
+        }
+        r
+    }
+    fn div(&self, o: &Jet) -> Jet {
+        // 1/o as a jet, then a product.
+        let inv = 1.0 / o.v;
+        let mut r = Jet::constant(inv);
+        for i in 0..4 {
+            r.g[i] = -o.g[i] * inv * inv;
+            for k in 0..4 {
+                r.h[i][k] = 2.0 * o.g[i] * o.g[k] * inv * inv * inv - o.h[i][k] * inv * inv;
+            }
+        }
+        self.mul(&r)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::complex::{RationalTerm, Role};
+    use crate::fixtures::{quadric_weights, Quadric};
+
+    fn tet() -> [DVec3; 4] {
+        [
+            DVec3::new(-0.3, -0.2, -0.4),
+            DVec3::new(1.2, 0.1, -0.1),
+            DVec3::new(0.2, 1.1, 0.3),
+            DVec3::new(0.1, 0.2, 1.3),
+        ]
+    }
+
+    fn patch(q: &Quadric, n: usize) -> Patch {
+        let t = tet();
+        Patch {
+            tet: t.map(|v| v.to_array()),
+            degree: n as u8,
+            weights: quadric_weights(q, &t, n),
+            rational: Vec::new(),
+            sheet: SheetRule::Any,
+            role: Role::Other,
+            element: 0,
+        }
+    }
+
+    #[test]
+    fn segment_and_derivatives_match_the_quadric() {
+        let q = Quadric::ellipsoid(DVec3::new(0.2, 0.3, 0.1), DVec3::new(0.7, 0.5, 0.9));
+        for n in 2..=5 {
+            let c = CompiledPatch::new(&patch(&q, n), 0).unwrap();
+            let x0 = DVec3::new(0.1, 0.2, 0.1);
+            let x1 = DVec3::new(0.3, 0.25, 0.4);
+            let (a, b) = (c.bary(x0), c.bary(x1));
+            let mut co = [0.0; MAX_DEGREE + 1];
+            let d = c.segment(&a, &b, &mut co);
+            assert_eq!(d, n);
+            for k in 0..=4 {
+                let s = k as f64 / 4.0;
+                let want = q.value(x0.lerp(x1, s));
+                // Blossom rounding on O(1) weights.
+                assert!((poly::eval(&co, d, s) - want).abs() < 1e-13, "n={n} s={s}");
+            }
+            let x = DVec3::new(0.2, 0.3, 0.35);
+            let (v, g, h) = c.derivatives(&c.bary(x));
+            // Rounding only: exact representation of a quadric.
+            assert!((v - q.value(x)).abs() < 1e-13);
+            assert!(
+                (g - q.gradient(x)).length() < 1e-12,
+                "{g} vs {}",
+                q.gradient(x)
+            );
+            assert!(
+                (h - 2.0 * q.a)
+                    .abs()
+                    .to_cols_array()
+                    .iter()
+                    .all(|e| *e < 1e-11),
+                "{h}"
+            );
+        }
+    }
+
+    #[test]
+    fn rational_term_is_cleared_consistently() {
+        // F = P + (2α1² + 3α2²)/(α1² + α2²)·B_κ: compare the cleared segment polynomial
+        // with F·D sampled directly, and the jet gradient with finite differences.
+        let q = Quadric::sphere(DVec3::new(0.3, 0.3, 0.3), 0.4);
+        let mut p = patch(&q, 3);
+        p.rational.push(RationalTerm {
+            index: [1, 1, 1, 0],
+            terms: vec![(2.0, [2, 0, 0, 0]), (3.0, [0, 2, 0, 0])],
+        });
+        let c = CompiledPatch::new(&p, 0).unwrap();
+        let f = |x: DVec3| c.derivatives(&c.bary(x)).0;
+        let den = |x: DVec3| {
+            let a = c.bary(x);
+            a[0] * a[0] + a[1] * a[1]
+        };
+        let x0 = DVec3::new(0.1, 0.2, 0.1);
+        let x1 = DVec3::new(0.3, 0.25, 0.4);
+        let mut co = [0.0; MAX_DEGREE + 1];
+        let d = c.segment(&c.bary(x0), &c.bary(x1), &mut co);
+        assert_eq!(d, 5);
+        for k in 0..=4 {
+            let s = k as f64 / 4.0;
+            let x = x0.lerp(x1, s);
+            // Rounding of O(1) products.
+            assert!((poly::eval(&co, d, s) - f(x) * den(x)).abs() < 1e-13);
+        }
+        let x = DVec3::new(0.25, 0.3, 0.2);
+        let (_, g, h) = c.derivatives(&c.bary(x));
+        let e = 1e-5;
+        for axis in 0..3 {
+            let mut dx = DVec3::ZERO;
+            dx[axis] = e;
+            let fd = (f(x + dx) - f(x - dx)) / (2.0 * e);
+            // Central differences: O(e²) truncation with O(1) third derivatives.
+            assert!((fd - g[axis]).abs() < 1e-8, "{fd} vs {}", g[axis]);
+            let gp = c.derivatives(&c.bary(x + dx)).1;
+            let gm = c.derivatives(&c.bary(x - dx)).1;
+            let hd = (gp - gm) / (2.0 * e);
+            assert!(
+                (hd - h.col(axis)).length() < 1e-7,
+                "{hd} vs {}",
+                h.col(axis)
+            );
+        }
+    }
+}
