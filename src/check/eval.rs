@@ -209,25 +209,6 @@ fn de_casteljau(c: &mut [f64], from: usize, to: usize, alpha: [f64; 4]) {
     }
 }
 
-/// The blossom of Σ w_λ B^n_λ at the `n` arguments `args` (barycentric 4-vectors).
-#[must_use]
-pub fn poly_blossom(weights: &[f64], n: usize, args: &[[f64; 4]]) -> f64 {
-    debug_assert_eq!(weights.len(), num_coeffs(n));
-    debug_assert_eq!(args.len(), n);
-    let tables = raise_tables();
-    let mut c = [0.0; 120];
-    c[..weights.len()].copy_from_slice(weights);
-    for (m, alpha) in (1..=n).rev().zip(args) {
-        for (k, up) in tables[m].iter().enumerate() {
-            c[k] = alpha[0] * c[usize::from(up[0])]
-                + alpha[1] * c[usize::from(up[1])]
-                + alpha[2] * c[usize::from(up[2])]
-                + alpha[3] * c[usize::from(up[3])];
-        }
-    }
-    c[0]
-}
-
 /// Σ w_λ B^n_λ(α).
 #[must_use]
 pub fn poly_value(weights: &[f64], n: usize, alpha: [f64; 4]) -> f64 {
@@ -437,33 +418,6 @@ mod tests {
                 let b = e.bary(x);
                 assert!((0..4).all(|i| (b[i] - alpha[i]).abs() < 1e-12));
             }
-        }
-    }
-
-    /// The blossom's diagonal is the value, and restriction to a segment gives Bernstein
-    /// coefficients that reproduce the values along it.
-    #[test]
-    fn blossom_restriction() {
-        let w: Vec<f64> = (0..num_coeffs(4))
-            .map(|k| (k as f64 * 0.61).cos())
-            .collect();
-        let a = [0.1, 0.2, 0.3, 0.4];
-        let b = [0.7, 0.0, 0.2, 0.1];
-        // Rounding of O(1) sums only.
-        assert!((poly_blossom(&w, 4, &[a; 4]) - poly_value(&w, 4, a)).abs() < 1e-14);
-        let c: Vec<f64> = (0..=4)
-            .map(|k| {
-                let args: Vec<[f64; 4]> = (0..4).map(|i| if i < k { b } else { a }).collect();
-                poly_blossom(&w, 4, &args)
-            })
-            .collect();
-        for t in [0.0, 0.3, 0.8, 1.0] {
-            let x: [f64; 4] = std::array::from_fn(|i| (1.0 - t) * a[i] + t * b[i]);
-            let binom = [1.0, 4.0, 6.0, 4.0, 1.0];
-            let u: f64 = (0..=4)
-                .map(|k| c[k] * binom[k] * t.powi(k as i32) * (1.0 - t).powi(4 - k as i32))
-                .sum();
-            assert!((u - poly_value(&w, 4, x)).abs() < 1e-14, "t={t}");
         }
     }
 
