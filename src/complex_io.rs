@@ -24,6 +24,10 @@ use std::path::Path;
 /// Highest polynomial degree a patch may have.
 pub const MAX_DEGREE: u8 = 7;
 
+/// Highest degree of a patch restricted to a segment with its rational denominators cleared
+/// ([`crate::bb::rational::segment_degree`]), as the tracer and checker need.
+pub const MAX_SEGMENT_DEGREE: usize = 15;
+
 /// A tetrahedron is degenerate when |det[v2−v1, v3−v1, v4−v1]| ≤ this × (longest edge)³
 /// (a regular tetrahedron has ≈ 0.71; 1e-12 only rejects flat or repeated-vertex ones).
 pub const DEGENERATE_TET_RATIO: f64 = 1e-12;
@@ -214,6 +218,27 @@ pub fn validate_patch(p: &Patch) -> std::result::Result<(), String> {
                 ));
             }
         }
+    }
+    let mut distinct = 0;
+    for (r, term) in p.rational.iter().enumerate() {
+        if !p.rational[..r]
+            .iter()
+            .any(|t| crate::bb::rational::same_denominator(t, term))
+        {
+            distinct += 1;
+        }
+    }
+    if distinct > crate::bb::rational::MAX_DENOMINATORS {
+        return Err(format!(
+            "{distinct} distinct rational denominators (at most {})",
+            crate::bb::rational::MAX_DENOMINATORS
+        ));
+    }
+    let cleared = crate::bb::rational::segment_degree(n, &p.rational);
+    if cleared > MAX_SEGMENT_DEGREE {
+        return Err(format!(
+            "rational terms raise the segment degree to {cleared} (at most {MAX_SEGMENT_DEGREE})"
+        ));
     }
     if let crate::complex::SheetRule::Shooting { base, top } = &p.sheet {
         let ok = !base.is_empty()

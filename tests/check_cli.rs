@@ -144,14 +144,53 @@ fn bad_inputs_exit_2_with_one_line() {
     );
     assert!(e.contains("patch 0: degree 9"), "{e}");
     let e = bad_input("scene.toml", "[camera]\n");
+    assert!(e.contains("missing field"), "{e}");
+    let e = bad_input("model.obj", "v 0 0 0\n");
     assert!(
-        e.contains("scene input needs a scheme; not available yet"),
+        e.contains("model input needs a scheme; not available yet"),
         "{e}"
     );
-    let e = bad_input("model.obj", "v 0 0 0\n");
-    assert!(e.contains("not available yet"), "{e}");
     let e = bad_input("what.xyz", "");
     assert!(e.contains("unknown input type"), "{e}");
+}
+
+const SCENE: &str = r#"
+[model]
+patches = "PATCHES"
+[camera]
+origin = [0, 0, 5]
+target = [0, 0, 0]
+fov = 40
+width = 8
+height = 8
+[[lights]]
+type = "directional"
+direction = [0, 0, -1]
+irradiance = 2.0
+"#;
+
+#[test]
+fn scene_input_is_checked() {
+    let patches = sphere_file("scene_patches.json", 2);
+    let scene = tmp("scene_ok.toml");
+    let name = patches.file_name().unwrap().to_str().unwrap();
+    std::fs::write(&scene, SCENE.replace("PATCHES", name)).unwrap();
+    let o = apatch(&["check", scene.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    assert!(stdout(&o).contains("PASSED"));
+
+    // A scene naming an invalid complex is bad input (exit 2), with the patch named.
+    let bad = tmp("scene_bad_patches.json");
+    std::fs::write(&bad, one_patch("2", "[1,2,3,4]")).unwrap();
+    let bad_name = bad.file_name().unwrap().to_str().unwrap();
+    let scene = tmp("scene_bad.toml");
+    std::fs::write(&scene, SCENE.replace("PATCHES", bad_name)).unwrap();
+    let o = apatch(&["check", scene.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.contains(bad.to_str().unwrap()), "{e}");
+    assert!(e.contains("patch 0: 4 weights for degree 2"), "{e}");
 }
 
 #[test]

@@ -95,6 +95,24 @@ pub struct Location {
     /// The mesh vertex index, for vertex measures.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vertex: Option<usize>,
+    /// Each patch's hull role and mesh element, e.g. "face 12".
+    pub elements: Vec<String>,
+}
+
+impl Location {
+    /// The location of `point` in `patches` (and at mesh vertex `vertex`).
+    #[must_use]
+    pub fn new(patches: &[&eval::PatchEval<'_>], point: [f64; 3], vertex: Option<usize>) -> Self {
+        Location {
+            patches: patches.iter().map(|e| e.id).collect(),
+            point,
+            vertex,
+            elements: patches
+                .iter()
+                .map(|e| format!("{} {}", e.patch.role.name(), e.patch.element))
+                .collect(),
+        }
+    }
 }
 
 /// One measure: its worst value over all samples and where it occurred.
@@ -210,6 +228,11 @@ pub struct CheckReport {
     pub patches: usize,
     /// Number of vertices.
     pub vertices: usize,
+    /// Patches that fail [`crate::complex_io::validate_patch`] (not measured; a failure).
+    pub invalid_patches: usize,
+    /// The first invalid patch's problem.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_invalid: Option<String>,
     /// Face sharing.
     pub faces: FaceStats,
     /// Relative value jump across shared faces.
@@ -238,6 +261,9 @@ impl CheckReport {
     pub fn failures(&self) -> Vec<&'static str> {
         let o = &self.options;
         let mut f = Vec::new();
+        if self.invalid_patches > 0 {
+            f.push("invalid patches");
+        }
         if !self.value_jump.within(o.jump_tolerance) {
             f.push("value jump");
         }
@@ -272,16 +298,27 @@ impl CheckReport {
     }
 }
 
-/// Measures `complex` (which should have passed [`crate::complex_io::validate`]; patches that do
-/// not are skipped by the evaluator's assumptions only in the sense that their numbers may be
-/// NaN, which fails the check).
+/// Measures `complex`. Patches failing [`crate::complex_io::validate_patch`] are counted in
+/// [`CheckReport::invalid_patches`] (a failure) and left out of every measure; non-finite
+/// results elsewhere (overflow) also fail.
 #[must_use]
 pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
     let continuity = opts
         .continuity
         .unwrap_or_else(|| complex.promised_continuity());
-    let evals: Vec<eval::PatchEval<'_>> =
-        complex.patches.iter().map(eval::PatchEval::new).collect();
+    // Invalid patches are reported, not evaluated.
+    let mut invalid_patches = 0;
+    let mut first_invalid = None;
+    let mut evals = Vec::with_capacity(complex.patches.len());
+    for (i, p) in complex.patches.iter().enumerate() {
+        match crate::complex_io::validate_patch(p) {
+            Ok(()) => evals.push(eval::PatchEval::new(p, i)),
+            Err(m) => {
+                invalid_patches += 1;
+                first_invalid.get_or_insert_with(|| format!("patch {i}: {m}"));
+            }
+        }
+    }
     let faces = faces::measure(&evals, opts);
     let interpolation = interp::measure(complex, &evals);
     let sheets = sheets::measure(&evals, opts);
@@ -290,6 +327,8 @@ pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
         continuity,
         patches: complex.patches.len(),
         vertices: complex.vertices.len(),
+        invalid_patches,
+        first_invalid,
         faces: faces.stats,
         value_jump: faces.value,
         gradient_jump: faces.gradient,
@@ -408,6 +447,26 @@ mod tests {
         };
         let r2 = check(&c, &opts);
         assert_eq!(r2.failures(), vec!["hessian jump"], "{r2}");
+    }
+
+    #[test]
+    fn invalid_patches_are_reported_not_evaluated() {
+        let mut c = sphere_complex(2);
+        c.patches[3].weights.truncate(4);
+        c.patches[4].degree = 9;
+        c.patches[5].weights = vec![1.0; 220];
+        let r = check(&c, &CheckOptions::default());
+        assert_eq!(r.invalid_patches, 3, "{r}");
+        assert!(
+            r.first_invalid
+                .as_deref()
+                .unwrap()
+                .starts_with("patch 3: 4 weights"),
+            "{r}"
+        );
+        assert_eq!(r.failures(), vec!["invalid patches"], "{r}");
+        // An empty complex measures nothing and passes.
+        assert!(check(&PatchComplex::new("empty"), &CheckOptions::default()).passed());
     }
 
     #[test]

@@ -18,7 +18,8 @@ fn fmt_location(at: &Option<Location>) -> String {
     let patches = at
         .patches
         .iter()
-        .map(usize::to_string)
+        .zip(&at.elements)
+        .map(|(p, e)| format!("{p} ({e})"))
         .collect::<Vec<_>>()
         .join(", ");
     let vertex = at
@@ -63,6 +64,14 @@ impl fmt::Display for CheckReport {
             "scheme {} (C{} promised), {} patches, {} vertices",
             self.scheme, self.continuity, self.patches, self.vertices
         )?;
+        if self.invalid_patches > 0 {
+            writeln!(
+                f,
+                "invalid patches  {} not measured  FAIL  (first: {})",
+                self.invalid_patches,
+                self.first_invalid.as_deref().unwrap_or("")
+            )?;
+        }
         let fs = &self.faces;
         writeln!(
             f,

@@ -103,11 +103,8 @@ pub(super) fn overlapping_pairs(
                     count += 1;
                     if at.is_none() {
                         let c = (a.pts[0] + a.pts[1] + a.pts[2]) / 3.0;
-                        at = Some(Location {
-                            patches: vec![a.patch as usize, b.patch as usize],
-                            point: c.to_array(),
-                            vertex: None,
-                        });
+                        let pair = [&evals[a.patch as usize], &evals[b.patch as usize]];
+                        at = Some(Location::new(&pair, c.to_array(), None));
                     }
                 }
             }
