@@ -95,6 +95,13 @@ pub struct CompiledPatch {
     pub sheet: Sheet,
     /// Degree of the segment polynomial once denominators are cleared.
     pub segment_degree: usize,
+    /// The weight at the first top vertex of a shooting rule (0 for `Any`): F at a shooting
+    /// line's base point must not have its strict sign.
+    pub top_weight: f64,
+    /// How many factors of t the cleared polynomial on a shooting line carries at its base
+    /// point (denominators that vanish on the base simplex, e.g. α3 + α4 for edge patches):
+    /// those roots at t = 0 are not zeros of F and are divided out.
+    pub base_order: usize,
 }
 
 fn multinomial(l: [u8; 4]) -> f64 {
@@ -233,7 +240,36 @@ impl CompiledPatch {
                 Sheet::Shooting { base: b, top: t }
             }
         };
+        let top_weight = match sheet {
+            Sheet::Any => 0.0,
+            Sheet::Shooting { top, .. } => {
+                let k = top.trailing_zeros() as usize;
+                let mut l = [0u8; 4];
+                l[k] = n as u8;
+                patch.weights[index_of(l)]
+            }
+        };
+        let base_order = match sheet {
+            Sheet::Any => 0,
+            Sheet::Shooting { top, .. } => groups
+                .iter()
+                .map(|g| {
+                    g.denominator
+                        .iter()
+                        .map(|mu| {
+                            (0..4)
+                                .filter(|&i| top & (1 << i) != 0)
+                                .map(|i| usize::from(mu[i]))
+                                .sum::<usize>()
+                        })
+                        .min()
+                        .unwrap_or(0)
+                })
+                .sum(),
+        };
         Ok(CompiledPatch {
+            base_order,
+            top_weight,
             v0: v[0],
             grad,
             degree: n,
