@@ -157,6 +157,9 @@ impl Geometry {
         tmax: f64,
     ) -> Option<(f64, [f64; 4])> {
         let p = &self.patches[i];
+        if p.no_zero {
+            return None;
+        }
         let (t0, t1, a0, rate) = p.clip(o, d)?;
         let pad = CLIP_PAD * (t1 - t0) + 1e-15 * t0.abs().max(t1.abs());
         let (t0, t1) = (t0 - pad, t1 + pad);
