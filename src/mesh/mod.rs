@@ -27,10 +27,15 @@
 //! Findings in the [`Report`] (the mesh is still returned):
 //! - notes: welded duplicates, boundary edges, averaged file normals, ignored statements;
 //! - warnings, repaired: repeated vertices in a face (removed), faces with < 3 distinct
-//!   vertices (dropped), duplicate faces (dropped), unreferenced vertices (dropped), inconsistent orientation (flipped),
-//!   inward closed surface (flipped);
+//!   vertices (dropped), duplicate faces (dropped), unreferenced vertices (dropped),
+//!   inconsistent orientation (flipped), inward closed surface (flipped);
 //! - warnings, kept: zero-area faces, non-planar polygons, non-manifold edges and vertices,
 //!   non-orientable components, incomplete file normals.
+//!
+//! `apatch info` exits 0 with notes only, 1 with warnings (or normals that cannot be computed),
+//! 2 on hard errors. Element indices in findings are the loaded mesh's (after welding and
+//! dropping), except for dropped faces and vertices, which carry the file's 0-based number;
+//! every element carries its 1-based file line.
 //!
 //! Which schemes accept what ([`Report::require`]): every scheme needs a manifold, orientable
 //! mesh. The 2001 rational scheme accepts boundary edges; the 1994 inner-hull schemes need a
