@@ -5,6 +5,21 @@
 //! [`check`] never fails: it returns a [`CheckReport`] whose [`CheckReport::passed`] compares every
 //! measure with the tolerances of [`CheckOptions`].
 //!
+//! ```
+//! use apatch::check::{check, CheckOptions};
+//! use apatch::fixtures::{quadric_complex, Quadric};
+//! use glam::DVec3;
+//!
+//! let sphere = Quadric::sphere(DVec3::ZERO, 0.8);
+//! let mut complex = quadric_complex(&sphere, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 3);
+//! assert!(check(&complex, &CheckOptions::default()).passed());
+//!
+//! complex.patches[0].weights[0] += 1e-3; // break continuity at a shared corner weight
+//! let report = check(&complex, &CheckOptions::default());
+//! assert!(!report.passed());
+//! println!("{report}"); // one line per measure, worst patches named
+//! ```
+//!
 //! ## Relative measures
 //! Jumps and errors are scaled so they do not depend on the size of the model or of F:
 //! for a shared face with longest edge L and gradient scale G (the largest |∇F| of either patch

@@ -12,6 +12,10 @@ fn verdict(ok: bool) -> &'static str {
 }
 
 fn fmt_location(at: &Option<Location>) -> String {
+    fmt_location_as("worst", at)
+}
+
+fn fmt_location_as(label: &str, at: &Option<Location>) -> String {
     let Some(at) = at else {
         return String::new();
     };
@@ -32,7 +36,7 @@ fn fmt_location(at: &Option<Location>) -> String {
     } else {
         "patches"
     };
-    format!("  (worst: {vertex}{noun} {patches} at ({x:.6}, {y:.6}, {z:.6}))")
+    format!("  ({label}: {vertex}{noun} {patches} at ({x:.6}, {y:.6}, {z:.6}))")
 }
 
 fn measure_line(
@@ -80,14 +84,14 @@ impl fmt::Display for CheckReport {
             fs.boundary,
             fs.overshared,
             verdict(fs.overshared == 0),
-            fmt_location(&fs.overshared_at)
+            fmt_location_as("e.g.", &fs.overshared_at)
         )?;
         writeln!(
             f,
             "t-junctions      {} overlapping boundary face pairs  {}{}",
             fs.t_junctions,
             verdict(fs.t_junctions == 0),
-            fmt_location(&fs.t_junction_at)
+            fmt_location_as("e.g.", &fs.t_junction_at)
         )?;
         measure_line(f, "value jump", &self.value_jump, o.jump_tolerance, true)?;
         measure_line(
@@ -149,7 +153,7 @@ impl fmt::Display for CheckReport {
             s.multi_root_lines,
             s.vertex_lines,
             multi_verdict,
-            fmt_location(&s.multi_root_at)
+            fmt_location_as("e.g.", &s.multi_root_at)
         )?;
         let failures = self.failures();
         if failures.is_empty() {
