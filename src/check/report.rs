@@ -141,19 +141,24 @@ impl fmt::Display for CheckReport {
             fmt_location(&s.min_root_slope_at)
         )?;
         let multi_verdict = if o.single_sheet {
-            verdict(s.multi_root_lines == 0)
-        } else if s.multi_root_lines > 0 {
+            verdict(s.multi_sheet_patches == 0)
+        } else if s.multi_sheet_patches > 0 {
             "warning"
         } else {
             "ok"
         };
         writeln!(
             f,
-            "sheets           {} of {} vertex lines cross F = 0 more than once  {}{}",
+            "sheets           {} patches crossed twice from every vertex ({} of {} vertex lines \
+             cross F = 0 more than once)  {}{}",
+            s.multi_sheet_patches,
             s.multi_root_lines,
             s.vertex_lines,
             multi_verdict,
-            fmt_location_as("e.g.", &s.multi_root_at)
+            fmt_location_as(
+                "e.g.",
+                &s.multi_sheet_at.clone().or(s.multi_root_at.clone())
+            )
         )?;
         let failures = self.failures();
         if failures.is_empty() {
