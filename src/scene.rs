@@ -52,6 +52,8 @@
 //! ```
 
 use crate::complex::{PatchComplex, FORMAT};
+use crate::mesh::{self, NormalMethod};
+use crate::scheme::rational_c1;
 use crate::trace::{Camera, FovAxis, Light, Lighting, Mode, ModeOptions, RenderSettings};
 use anyhow::{anyhow, bail, Context};
 use glam::DVec3;
@@ -494,7 +496,11 @@ pub fn check_output(path: &Path) -> Result<(), String> {
 pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
     match &scene.model {
         Model::Patches(p) => read_patches(p),
-        Model::Mesh { scheme, .. } => {
+        Model::Mesh {
+            file,
+            normals,
+            scheme,
+        } => {
             let ty = scheme.get("type").and_then(|v| v.as_str()).ok_or_else(|| {
                 anyhow!(
                     "{}: `scheme.type` is required (a string)",
@@ -502,10 +508,21 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                 )
             })?;
             match ty {
-                "rational-c1" => bail!(
-                    "{}: scheme `rational-c1` is not available in this build yet (mesh loading and the 2001 scheme have not landed)",
-                    scene.path.display()
-                ),
+                "rational-c1" => {
+                    let opts = rational_c1::RationalOptions::from_toml(scheme, &scene.path)?;
+                    let method: NormalMethod = normals.parse().map_err(|e: String| {
+                        anyhow!("{}: `model.normals`: {e}", scene.path.display())
+                    })?;
+                    let (m, report) = mesh::load(file)?;
+                    report.require(false)?;
+                    let tri = mesh::triangulate(&m);
+                    let vn = mesh::vertex_normals(&m, method)?;
+                    let triangles: Vec<[u32; 3]> =
+                        tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+                    let built = rational_c1::build(&tri.positions, &triangles, &vn, &opts)
+                        .with_context(|| format!("{}", file.display()))?;
+                    Ok(built.complex)
+                }
                 "cubic-c1" | "quintic-c2" => bail!(
                     "{}: scheme `{ty}` is not implemented yet",
                     scene.path.display()

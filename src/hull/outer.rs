@@ -519,9 +519,9 @@ mod tests {
         let out_i = DVec3::new(-1.0, 0.0, 1.0).normalize();
         let out_j = DVec3::new(1.0, 0.0, 1.0).normalize();
         assert_eq!(edge_convexity(pi, pj, out_i, out_j), Convexity::Positive);
-        assert_eq!(edge_convexity(pi, pj, -out_j, -out_i), Convexity::Negative);
+        assert_eq!(edge_convexity(pi, pj, out_j, out_i), Convexity::Negative);
         assert_eq!(edge_convexity(pi, pj, up, up), Convexity::Zero);
-        assert_eq!(edge_convexity(pi, pj, out_i, -out_i), Convexity::Nonconvex);
+        assert_eq!(edge_convexity(pi, pj, out_i, out_i), Convexity::Nonconvex);
         use Convexity::*;
         assert_eq!(face_convexity([Positive, Zero, Positive]), Positive);
         assert_eq!(face_convexity([Zero, Zero, Zero]), Zero);

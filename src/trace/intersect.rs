@@ -157,6 +157,9 @@ impl Geometry {
         tmax: f64,
     ) -> Option<(f64, [f64; 4])> {
         let p = &self.patches[i];
+        if p.no_zero {
+            return None;
+        }
         let (t0, t1, a0, rate) = p.clip(o, d)?;
         let pad = CLIP_PAD * (t1 - t0) + 1e-15 * t0.abs().max(t1.abs());
         let (t0, t1) = (t0 - pad, t1 + pad);
@@ -184,7 +187,7 @@ impl Geometry {
             for k in 0..4 {
                 alpha[k] = (1.0 - s) * a[k] + s * b[k];
             }
-            if self.sheet_accepts(p, &alpha) {
+            if Self::sheet_accepts(p, &alpha) {
                 return Some((t0 + s * len, alpha));
             }
             // Continue just after the rejected root.
@@ -196,8 +199,9 @@ impl Geometry {
         None
     }
 
-    /// The sheet rule of `p` at the root with barycentrics `alpha`.
-    fn sheet_accepts(&self, p: &CompiledPatch, alpha: &[f64; 4]) -> bool {
+    /// The sheet rule of `p` at the root with barycentrics `alpha`: true when the root is on
+    /// the surface.
+    pub fn sheet_accepts(p: &CompiledPatch, alpha: &[f64; 4]) -> bool {
         let Sheet::Shooting { base, top } = p.sheet else {
             return true;
         };
@@ -224,7 +228,18 @@ impl Geometry {
             u[k] /= ts;
         }
         let mut c = [0.0; MAX_DEGREE + 1];
-        let n = p.segment(&q, &u, &mut c);
+        let mut n = p.segment(&q, &u, &mut c);
+        for _ in 0..p.base_order.min(n) {
+            // G(t) = t·H(t): h_k = g_{k+1}·m/(k+1).
+            for k in 0..n {
+                c[k] = c[k + 1] * n as f64 / (k + 1) as f64;
+            }
+            n -= 1;
+        }
+        // (4.5)–(4.7): F at the base point must not have the top weight's strict sign.
+        if c[0] * p.top_weight > 0.0 {
+            return false;
+        }
         poly::first_root_in(&c, n, 0.0, t - SHEET_TOL).is_none()
     }
 }

@@ -95,6 +95,16 @@ pub struct CompiledPatch {
     pub sheet: Sheet,
     /// Degree of the segment polynomial once denominators are cleared.
     pub segment_degree: usize,
+    /// The weight at the first top vertex of a shooting rule (0 for `Any`): F at a shooting
+    /// line's base point must not have its strict sign.
+    pub top_weight: f64,
+    /// How many factors of t the cleared polynomial on a shooting line carries at its base
+    /// point (denominators that vanish on the base simplex, e.g. α3 + α4 for edge patches):
+    /// those roots at t = 0 are not zeros of F and are divided out.
+    pub base_order: usize,
+    /// True when every weight (rational blends included) has the same strict sign: by the
+    /// convex hull property F has no zero in the tetrahedron and rays skip the patch.
+    pub no_zero: bool,
 }
 
 fn multinomial(l: [u8; 4]) -> f64 {
@@ -233,7 +243,47 @@ impl CompiledPatch {
                 Sheet::Shooting { base: b, top: t }
             }
         };
+        let top_weight = match sheet {
+            Sheet::Any => 0.0,
+            Sheet::Shooting { top, .. } => {
+                let k = top.trailing_zeros() as usize;
+                let mut l = [0u8; 4];
+                l[k] = n as u8;
+                patch.weights[index_of(l)]
+            }
+        };
+        let base_order = match sheet {
+            Sheet::Any => 0,
+            Sheet::Shooting { top, .. } => groups
+                .iter()
+                .map(|g| {
+                    g.denominator
+                        .iter()
+                        .map(|mu| {
+                            (0..4)
+                                .filter(|&i| top & (1 << i) != 0)
+                                .map(|i| usize::from(mu[i]))
+                                .sum::<usize>()
+                        })
+                        .min()
+                        .unwrap_or(0)
+                })
+                .sum(),
+        };
+        let all = patch.weights.iter().copied().chain(
+            patch
+                .rational
+                .iter()
+                .flat_map(|r| r.terms.iter().map(|t| t.0)),
+        );
+        let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), w| {
+            (l.min(w), h.max(w))
+        });
+        let no_zero = lo > 0.0 || hi < 0.0;
         Ok(CompiledPatch {
+            no_zero,
+            base_order,
+            top_weight,
             v0: v[0],
             grad,
             degree: n,
@@ -288,24 +338,11 @@ impl CompiledPatch {
     /// rational denominators cleared (multiplied by their positive values). Returns the degree.
     pub fn segment(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
         let n = self.degree;
-        // Polynomial part: c_k = blossom(a^(n−k), b^k).
-        let mut bk = [0.0; MAX_COEFFS];
-        let mut tmp = [0.0; MAX_COEFFS];
-        let mut work = [0.0; MAX_COEFFS];
-        bk[..self.weights.len()].copy_from_slice(&self.weights);
-        for k in 0..=n {
-            // bk has degree n − k here.
-            let m = n - k;
-            work[..num_coeffs(m)].copy_from_slice(&bk[..num_coeffs(m)]);
-            for level in (1..=m).rev() {
-                contract(&work, level, *a, &mut tmp);
-                work[..num_coeffs(level - 1)].copy_from_slice(&tmp[..num_coeffs(level - 1)]);
-            }
-            out[k] = work[0];
-            if m > 0 {
-                contract(&bk, m, *b, &mut tmp);
-                bk[..num_coeffs(m - 1)].copy_from_slice(&tmp[..num_coeffs(m - 1)]);
-            }
+        // Polynomial part: c_k = blossom(a^(n−k), b^k), with scratch sized to the degree.
+        match n {
+            0..=3 => self.polynomial_segment::<20>(a, b, out),
+            4..=5 => self.polynomial_segment::<56>(a, b, out),
+            _ => self.polynomial_segment::<MAX_COEFFS>(a, b, out),
         }
         if self.groups.is_empty() {
             return n;
@@ -359,6 +396,30 @@ impl CompiledPatch {
             qdeg += dden;
         }
         deg
+    }
+
+    /// The polynomial part of [`CompiledPatch::segment`]; `M` ≥ C(n+3, 3).
+    #[inline]
+    fn polynomial_segment<const M: usize>(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) {
+        let n = self.degree;
+        let mut bk = [0.0; M];
+        let mut tmp = [0.0; M];
+        let mut work = [0.0; M];
+        bk[..self.weights.len()].copy_from_slice(&self.weights);
+        for k in 0..=n {
+            // bk has degree n − k here.
+            let m = n - k;
+            work[..num_coeffs(m)].copy_from_slice(&bk[..num_coeffs(m)]);
+            for level in (1..=m).rev() {
+                contract(&work, level, *a, &mut tmp);
+                work[..num_coeffs(level - 1)].copy_from_slice(&tmp[..num_coeffs(level - 1)]);
+            }
+            out[k] = work[0];
+            if m > 0 {
+                contract(&bk, m, *b, &mut tmp);
+                bk[..num_coeffs(m - 1)].copy_from_slice(&tmp[..num_coeffs(m - 1)]);
+            }
+        }
     }
 
     /// F, its gradient and Hessian with respect to the four barycentric variables at `alpha`.

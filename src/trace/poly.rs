@@ -153,11 +153,31 @@ pub fn first_root_in(c: &[f64], n: usize, lo: f64, hi: f64) -> Option<f64> {
     if work[0].abs() <= zero {
         return Some(lo);
     }
+    // Fast paths (most calls): no sign change, or exactly one with opposite end signs.
+    match sign_changes(&work, n) {
+        0 => {
+            return if work[n].abs() <= zero {
+                Some(hi)
+            } else {
+                None
+            };
+        }
+        1 if work[n] != 0.0 && (work[0] > 0.0) != (work[n] > 0.0) => {
+            return Some(polish(c, n, lo, hi));
+        }
+        _ => {}
+    }
+    subdivide(c, n, &work, lo, hi, zero)
+}
+
+/// The general case of [`first_root_in`]: Bernstein subdivision of `work` (c restricted to
+/// [lo, hi]).
+fn subdivide(c: &[f64], n: usize, work: &Coeffs, lo: f64, hi: f64, zero: f64) -> Option<f64> {
     // Explicit stack of (coefficients, interval); left halves pop first.
     const DEPTH: usize = 64;
     let mut stack = [([0.0; MAX_DEGREE + 1], 0.0, 0.0); DEPTH];
     let mut top = 0usize;
-    stack[0] = (work, lo, hi);
+    stack[0] = (*work, lo, hi);
     top += 1;
     while top > 0 {
         top -= 1;
