@@ -297,3 +297,15 @@ fn promised_continuity_follows_scheme_and_field() {
     let o = apatch(&["check", path.to_str().unwrap(), "--continuity", "1"]);
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
 }
+
+#[test]
+fn scene_with_scheme_is_built_and_checked() {
+    // End to end: mesh → rational C1 scheme → check (the cube scene of the repository).
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cube.toml");
+    let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["scheme"], "rational-c1");
+    assert!(v["faces"]["shared"].as_u64().unwrap() > 0);
+    assert!(v["interpolation"]["value"]["samples"].as_u64().unwrap() > 0);
+}
