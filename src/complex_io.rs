@@ -8,8 +8,25 @@
 //! index and the line/column.
 //!
 //! Reading validates ([`validate`]): format and version, degree 1..=7, C(n+3,3) weights, finite
-//! numbers, non-degenerate tetrahedra, rational index sums, and that `normals` is empty or as
-//! long as `vertices`.
+//! numbers, non-degenerate tetrahedra, rational index sums (and a cleared segment degree ≤ 15),
+//! shooting rules that split the vertices, and that `normals` is empty or as long as
+//! `vertices`.
+//!
+//! ```
+//! use apatch::complex_io::{from_json_str, to_json_string};
+//! use apatch::fixtures::{quadric_complex, Quadric};
+//! use glam::DVec3;
+//! use std::path::Path;
+//!
+//! let q = Quadric::sphere(DVec3::ZERO, 0.5);
+//! let complex = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 1, 2);
+//! let text = to_json_string(&complex)?;
+//! assert_eq!(from_json_str(&text, Path::new("memory.json"))?, complex);
+//!
+//! let err = from_json_str(&text.replace("\"degree\":2", "\"degree\":9"), Path::new("bad.json"));
+//! assert!(err.unwrap_err().to_string().starts_with("bad.json: patch 0: degree 9"));
+//! # Ok::<(), apatch::error::Error>(())
+//! ```
 
 use crate::bb::num_coeffs;
 use crate::complex::{Patch, PatchComplex, FORMAT, VERSION};

@@ -5,6 +5,21 @@
 //! [`check`] never fails: it returns a [`CheckReport`] whose [`CheckReport::passed`] compares every
 //! measure with the tolerances of [`CheckOptions`].
 //!
+//! ```
+//! use apatch::check::{check, CheckOptions};
+//! use apatch::fixtures::{quadric_complex, Quadric};
+//! use glam::DVec3;
+//!
+//! let sphere = Quadric::sphere(DVec3::ZERO, 0.8);
+//! let mut complex = quadric_complex(&sphere, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 3);
+//! assert!(check(&complex, &CheckOptions::default()).passed());
+//!
+//! complex.patches[0].weights[0] += 1e-3; // break continuity at a shared corner weight
+//! let report = check(&complex, &CheckOptions::default());
+//! assert!(!report.passed());
+//! println!("{report}"); // one line per measure, worst patches named
+//! ```
+//!
 //! ## Relative measures
 //! Jumps and errors are scaled so they do not depend on the size of the model or of F:
 //! for a shared face with longest edge L and gradient scale G (the largest |∇F| of either patch
@@ -64,7 +79,8 @@ pub struct CheckOptions {
     /// Samples along each sheet line.
     pub line_samples: usize,
     /// The scheme promises single-sheeted patches for [`crate::complex::SheetRule::Any`]:
-    /// lines with more than one root fail the check instead of only being reported.
+    /// patches crossed twice by lines from each of their vertices
+    /// ([`SheetStats::multi_sheet_patches`]) fail the check instead of only being reported.
     pub single_sheet: bool,
 }
 
@@ -209,12 +225,18 @@ pub struct SheetStats {
     /// Lines from tetrahedron vertices sampled in single-sheet ("any") patches of degree ≥ 2
     /// that can vanish.
     pub vertex_lines: usize,
-    /// Of those, lines crossing F = 0 more than once (a failure only if single sheets are
-    /// promised).
+    /// Of those, lines crossing F = 0 more than once (information: an A-patch is single
+    /// sheeted with respect to one vertex; lines from the others may cross twice).
     pub multi_root_lines: usize,
     /// An example of a multi-root line (its first root).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub multi_root_at: Option<Location>,
+    /// Patches with a multi-root line from every one of their four vertices: single-sheeted
+    /// with respect to none (a failure only if single sheets are promised).
+    pub multi_sheet_patches: usize,
+    /// An example of such a patch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub multi_sheet_at: Option<Location>,
 }
 
 /// Everything [`check`] measured, with the options used.
@@ -291,7 +313,7 @@ impl CheckReport {
         if self.sheets.non_simple > 0 {
             f.push("non-simple shooting roots");
         }
-        if o.single_sheet && self.sheets.multi_root_lines > 0 {
+        if o.single_sheet && self.sheets.multi_sheet_patches > 0 {
             f.push("multiple sheets");
         }
         f
@@ -587,6 +609,7 @@ mod tests {
             .push(unit_tet_patch(2, quadratic_weights(m), SheetRule::Any));
         let r = check(&c, &CheckOptions::default());
         assert!(r.sheets.multi_root_lines > 0, "{r}");
+        assert_eq!(r.sheets.multi_sheet_patches, 1, "{r}");
         assert!(r.passed(), "{r}");
         let strict = CheckOptions {
             single_sheet: true,

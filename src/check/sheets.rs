@@ -47,6 +47,8 @@ fn merge(a: SheetStats, b: SheetStats) -> SheetStats {
         vertex_lines: a.vertex_lines + b.vertex_lines,
         multi_root_lines: a.multi_root_lines + b.multi_root_lines,
         multi_root_at: a.multi_root_at.or(b.multi_root_at),
+        multi_sheet_patches: a.multi_sheet_patches + b.multi_sheet_patches,
+        multi_sheet_at: a.multi_sheet_at.or(b.multi_sheet_at),
     }
 }
 
@@ -119,7 +121,9 @@ fn patch_sheets(e: &PatchEval<'_>, opts: &CheckOptions, mut stats: SheetStats) -
             }
         }
         SheetRule::Any if e.patch.degree >= 2 => {
+            let mut apexes_with_multi_roots = 0;
             for apex in 0..4u8 {
+                let mut multi = false;
                 let face: Vec<u8> = (0..4u8).filter(|&k| k != apex).collect();
                 let mut a = [0.0; 4];
                 a[usize::from(apex)] = 1.0;
@@ -127,12 +131,20 @@ fn patch_sheets(e: &PatchEval<'_>, opts: &CheckOptions, mut stats: SheetStats) -
                     stats.vertex_lines += 1;
                     let (roots, first) = count_sign_changes(e, &a, &q, n);
                     if roots > 1 {
+                        multi = true;
                         stats.multi_root_lines += 1;
                         if stats.multi_root_at.is_none() {
                             stats.multi_root_at =
                                 Some(Location::new(&[e], point(e, lerp(&a, &q, first)), None));
                         }
                     }
+                }
+                apexes_with_multi_roots += usize::from(multi);
+            }
+            if apexes_with_multi_roots == 4 {
+                stats.multi_sheet_patches += 1;
+                if stats.multi_sheet_at.is_none() {
+                    stats.multi_sheet_at = stats.multi_root_at.clone();
                 }
             }
         }
