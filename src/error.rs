@@ -17,12 +17,14 @@ pub enum Error {
     #[error("{0}")]
     Invalid(String),
     /// An I/O failure.
-    #[error("{path}: {source}")]
+    // The cause is part of the message and deliberately not a `source`, so that
+    // `anyhow`'s `{:#}` does not print it twice.
+    #[error("{path}: {cause}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
 }
 

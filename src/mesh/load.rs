@@ -51,9 +51,9 @@ impl Format {
 /// missing vertices, faces with fewer than 3 vertices, no usable face) are `Err` naming the file
 /// and line.
 pub fn load(path: &Path) -> Result<(Mesh, Report)> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+    let bytes = std::fs::read(path).map_err(|cause| Error::Io {
         path: path.into(),
-        source,
+        cause,
     })?;
     let format = Format::detect(path, &bytes)?;
     let raw = parse(&bytes, format, path)?;
