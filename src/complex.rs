@@ -89,7 +89,9 @@ pub enum SheetRule {
     /// 2001 scheme, (4.5)–(4.7): a point p is on the surface only if, on the shooting line
     /// through p from the base simplex (tetrahedron vertices `base`) to the top simplex
     /// (vertices `top`), p is the zero with the smallest parameter t ∈ [0, 1)
-    /// (t = Σ_{i∈top} αi at p; q and u are the normalised base and top parts of α).
+    /// (t = Σ_{i∈top} αi at p; q and u are the normalised base and top parts of α), and F at
+    /// the base point q does not have the strict sign of the weight at a top vertex (the top
+    /// weights of one patch share their sign: > 0 on the positive side, < 0 on the negative).
     Shooting {
         /// Tetrahedron-local vertex indices spanning the base (a face: 3, an edge: 2).
         base: Vec<u8>,

@@ -14,6 +14,10 @@ const INTERP_TOL: f64 = 1e-12;
 const JUMP_TOL: f64 = 1e-9;
 
 fn run(name: &str) {
+    run_with(name, &RationalOptions::default());
+}
+
+fn run_with(name: &str, opts: &RationalOptions) {
     let path = Path::new("/work/shared/meshes").join(format!("{name}.obj"));
     if !path.exists() {
         eprintln!("{name}: not present, skipped");
@@ -23,12 +27,7 @@ fn run(name: &str) {
     let mesh = triangulate(&mesh);
     let normals = vertex_normals(&mesh, NormalMethod::Loop).expect("normals");
     let tris: Vec<[u32; 3]> = mesh.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
-    let b = match build(
-        &mesh.positions,
-        &tris,
-        &normals,
-        &RationalOptions::default(),
-    ) {
+    let b = match build(&mesh.positions, &tris, &normals, opts) {
         Ok(b) => b,
         Err(e) => panic!("{name}: {e}"),
     };
@@ -73,12 +72,20 @@ fn spot() {
     run("spot");
 }
 #[test]
-#[ignore = "known failure: adjacent face tetrahedra still intersect after 4 refinement rounds (see the rational branch report)"]
+#[ignore = "known failure: with ε = 0.01 it builds (11 edges refined) but interpolation of the \
+            normals is 4e-8 and gradient jumps 1e-5 (unexplained; suspect thin tetrahedra \
+            after refinement); with the default ε refinement does not converge"]
 fn bunny() {
-    run("bunny_npm_lowres");
+    // With the default ε = 0.05 two face tetrahedra pairs keep intersecting through the
+    // refinement rounds; a smaller ε (flatter tetrahedra) builds after refining a few edges.
+    let opts = RationalOptions {
+        epsilon: 0.01,
+        ..RationalOptions::default()
+    };
+    run_with("bunny_npm_lowres", &opts);
 }
 #[test]
-#[ignore = "known failure: adjacent face tetrahedra still intersect after 4 refinement rounds (see the rational branch report)"]
+#[ignore = "known failure: at sharp creases adjacent face tetrahedra keep intersecting through the refinement rounds (see the rational branch report)"]
 fn fandisk() {
     run("fandisk");
 }
@@ -91,7 +98,7 @@ fn nut() {
     run("nut_pyvista");
 }
 #[test]
-#[ignore = "known failure: adjacent face tetrahedra still intersect after 4 refinement rounds (see the rational branch report)"]
+#[ignore = "known failure: at sharp creases adjacent face tetrahedra keep intersecting through the refinement rounds (see the rational branch report)"]
 fn teapot() {
     run("teapot_npm");
 }

@@ -69,7 +69,7 @@ use crate::hull::outer::{self, refine::RefineMesh, Convexity, HullOptions, Outer
 use glam::DVec3;
 use rayon::prelude::*;
 use std::path::Path;
-use weights::{convex_piece, ix, nonconvex_pieces, EdgeFrame, FaceData, Piece, N3};
+use weights::{convex_piece, nonconvex_pieces, EdgeFrame, FaceData, Piece, N3};
 
 /// The choice of the free parameter f_0003 of a face side (Step 8, §5.3).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -265,14 +265,13 @@ fn base_factor(l: [u8; 4]) -> f64 {
 /// Shooting cubic (4.8) of a face piece at base barycentrics `a` (of local 0, 1, 2).
 fn face_shooting(w: &[f64; N3], rat: Option<&[f64; 3]>, a: [f64; 3]) -> [f64; 4] {
     let mut b = [0.0; 4];
-    for l in crate::bb::multi_indices(3) {
-        let k = ix(l);
-        let mut m = base_factor(l);
-        for i in 0..3 {
-            for _ in 0..l[i] {
-                m *= a[i];
-            }
-        }
+    let pw = |s: f64| [1.0, s, s * s, s * s * s];
+    let p = [pw(a[0]), pw(a[1]), pw(a[2])];
+    for (k, &l) in weights::cubic_indices().iter().enumerate() {
+        let m = base_factor(l)
+            * p[0][usize::from(l[0])]
+            * p[1][usize::from(l[1])]
+            * p[2][usize::from(l[2])];
         b[usize::from(l[3])] += w[k] * m;
     }
     if let Some(r) = rat {
@@ -288,24 +287,112 @@ fn face_shooting(w: &[f64; N3], rat: Option<&[f64; 3]>, a: [f64; 3]) -> [f64; 4]
 /// Shooting cubic (4.9) of an edge tetrahedron [p_i p_j u_A u_B] at q = x p_i + (1−x) p_j,
 /// top point y u_A + (1−y) u_B.
 fn edge_shooting(w: &[f64; N3], rat: &[f64; 4], x: f64, y: f64) -> [f64; 4] {
-    let bern = |n: u8, k: u8, s: f64| -> f64 {
-        let c = [
-            [1.0, 0.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0, 0.0],
-            [1.0, 2.0, 1.0, 0.0],
-            [1.0, 3.0, 3.0, 1.0],
-        ][usize::from(n)][usize::from(k)];
-        c * s.powi(i32::from(k)) * (1.0 - s).powi(i32::from(n - k))
-    };
+    const C: [[f64; 4]; 4] = [
+        [1.0, 0.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0, 0.0],
+        [1.0, 2.0, 1.0, 0.0],
+        [1.0, 3.0, 3.0, 1.0],
+    ];
+    let pw = |s: f64| [1.0, s, s * s, s * s * s];
+    let (px, qx, py, qy) = (pw(x), pw(1.0 - x), pw(y), pw(1.0 - y));
     let mut b = [0.0; 4];
-    for l in crate::bb::multi_indices(3) {
-        let s = l[2] + l[3];
-        b[usize::from(s)] += w[ix(l)] * bern(3 - s, l[0], x) * bern(s, l[2], y);
+    for (k, &l) in weights::cubic_indices().iter().enumerate() {
+        let s = usize::from(l[2] + l[3]);
+        let (i, j) = (usize::from(l[0]), usize::from(l[2]));
+        let bx = C[3 - s][i] * px[i] * qx[3 - s - i];
+        let by = C[s][j] * py[j] * qy[s - j];
+        b[s] += w[k] * bx * by;
     }
     let b21 = 2.0 * y * (1.0 - y);
     b[2] += x * b21 * (rat[0] * y + rat[1] * (1.0 - y))
         + (1.0 - x) * b21 * (rat[2] * y + rat[3] * (1.0 - y));
     b
+}
+
+/// Shooting-cubic bases tabulated on a sample grid: per sample, the factor of every cubic
+/// weight (added to coefficient `slot[k]`) and of every rational weight.
+struct Tab {
+    slot: [usize; N3],
+    rat_slot: usize,
+    basis: Vec<([f64; N3], [f64; 4])>,
+}
+
+impl Tab {
+    fn face(grid: &[[f64; 3]]) -> Tab {
+        let basis = grid
+            .iter()
+            .map(|&a| {
+                let mut w = [0.0; N3];
+                let mut out = [0.0; N3];
+                for k in 0..N3 {
+                    w[k] = 1.0;
+                    out[k] = face_shooting(&w, None, a).iter().sum();
+                    w[k] = 0.0;
+                }
+                let den = a[1] * a[2] + a[0] * a[2] + a[0] * a[1];
+                let bb = 6.0 * a[0] * a[1] * a[2];
+                let r = if den > 0.0 {
+                    [
+                        a[1] * a[2] / den * bb,
+                        a[0] * a[2] / den * bb,
+                        a[0] * a[1] / den * bb,
+                        0.0,
+                    ]
+                } else {
+                    [0.0; 4]
+                };
+                (out, r)
+            })
+            .collect();
+        let slot = std::array::from_fn(|k| usize::from(weights::cubic_indices()[k][3]));
+        Tab {
+            slot,
+            rat_slot: 0,
+            basis,
+        }
+    }
+
+    fn edge(grid: &[(f64, f64)]) -> Tab {
+        let basis = grid
+            .iter()
+            .map(|&(x, y)| {
+                let mut w = [0.0; N3];
+                let mut out = [0.0; N3];
+                for k in 0..N3 {
+                    w[k] = 1.0;
+                    out[k] = edge_shooting(&w, &[0.0; 4], x, y).iter().sum();
+                    w[k] = 0.0;
+                }
+                let mut r = [0.0; 4];
+                for (k, rk) in r.iter_mut().enumerate() {
+                    let mut e = [0.0; 4];
+                    e[k] = 1.0;
+                    *rk = edge_shooting(&[0.0; N3], &e, x, y)[2];
+                }
+                (out, r)
+            })
+            .collect();
+        let slot = std::array::from_fn(|k| {
+            let l = weights::cubic_indices()[k];
+            usize::from(l[2] + l[3])
+        });
+        Tab {
+            slot,
+            rat_slot: 2,
+            basis,
+        }
+    }
+
+    #[inline]
+    fn eval(&self, i: usize, w: &[f64; N3], rat: &[f64; 4], sigma: f64) -> [f64; 4] {
+        let (bw, br) = &self.basis[i];
+        let mut b = [0.0; 4];
+        for k in 0..N3 {
+            b[self.slot[k]] += w[k] * bw[k];
+        }
+        b[self.rat_slot] += rat[0] * br[0] + rat[1] * br[1] + rat[2] * br[2] + rat[3] * br[3];
+        b.map(|x| sigma * x)
+    }
 }
 
 /// Barycentric sample points of a triangle, `n` intervals per edge.
@@ -321,16 +408,13 @@ fn tri_grid(n: usize) -> Vec<[f64; 3]> {
 }
 
 /// Lower bound of σ f_0003 for one face side (Step 6, first part), taken ≥ 0.
-fn face_bound(side: &Side, grid: &[[f64; 3]]) -> f64 {
+fn face_bound(side: &Side, tab: &Tab) -> f64 {
     const D: [f64; 4] = [0.0, 0.0, 1.0 / 3.0, 1.0];
-    let mut b: f64 = 0.0;
-    for pc in &side.pieces {
-        for &a in grid {
-            let p = face_shooting(&pc.w0, pc.rat.as_ref(), a).map(|x| side.sigma * x);
-            b = b.max(bound::lemma_bound(p, D));
-        }
-    }
-    b
+    let lines = side.pieces.iter().flat_map(|pc| {
+        let r = pc.rat.map_or([0.0; 4], |r| [r[0], r[1], r[2], 0.0]);
+        (0..tab.basis.len()).map(move |i| (tab.eval(i, &pc.w0, &r, side.sigma), D))
+    });
+    bound::max_lemma_bound(lines, 0.0)
 }
 
 /// An edge tetrahedron under construction.
@@ -493,6 +577,7 @@ fn assemble(
 ) -> Result<RationalBuild> {
     let nf = triangles.len();
     let grid = tri_grid(opts.bound_samples);
+    let ftab = Tab::face(&grid);
     let fit = if opts.free == Free::Quadric || opts.face_free.iter().any(|f| f.1 == Free::Quadric) {
         Some(quadric::VertexFaces::new(positions.len(), triangles))
     } else {
@@ -574,7 +659,7 @@ fn assemble(
                     margin,
                     edge_extra: 0.0,
                 };
-                side.bound = face_bound(&side, &grid);
+                side.bound = face_bound(&side, &ftab);
                 sides[s] = Some(side);
             }
             FaceOut {
@@ -593,6 +678,7 @@ fn assemble(
             .flat_map(|i| (0..=n).map(move |j| (i as f64 / n as f64, j as f64 / n as f64)))
             .collect()
     };
+    let etab = Tab::edge(&egrid);
     let piece_at = |t: usize, side: &Side, e: &outer::Edge| -> usize {
         if side.pieces.len() == 1 {
             return 0;
@@ -654,17 +740,11 @@ fn assemble(
             let wa = pa.weights(sa.sigma * sa.bound);
             let wb = pb.weights(sb.sigma * sb.bound);
             let (w0, r0) = et.frame.weights(&wa, &wb);
-            let mut bmax = f64::NEG_INFINITY;
-            et.d = egrid
-                .iter()
-                .map(|&(x, y)| {
-                    let d = edge_shooting(&dw, &drat, x, y);
-                    let p = edge_shooting(&w0, &r0, x, y).map(|v| sa.sigma * v);
-                    bmax = bmax.max(bound::lemma_bound(p, d));
-                    d
-                })
+            et.d = (0..egrid.len())
+                .map(|i| etab.eval(i, &dw, &drat, 1.0))
                 .collect();
-            bmax
+            let lines = (0..egrid.len()).map(|i| (etab.eval(i, &w0, &r0, sa.sigma), et.d[i]));
+            bound::max_lemma_bound(lines, f64::NEG_INFINITY)
         })
         .collect();
     for (et, &be) in etets.iter().zip(&edge_bounds) {
@@ -712,12 +792,9 @@ fn assemble(
                 let wa = sa.pieces[et.piece[0]].weights(sa.f);
                 let wb = sb.pieces[et.piece[1]].weights(sb.f);
                 let (w, r) = et.frame.weights(&wa, &wb);
-                let mut need = f64::NEG_INFINITY;
-                for (k, &(x, y)) in egrid.iter().enumerate() {
-                    let p = edge_shooting(&w, &r, x, y).map(|v| sa.sigma * v);
-                    need = need.max(bound::lemma_bound(p, et.d[k]));
-                }
-                need + sa.margin.max(sb.margin)
+                let margin = sa.margin.max(sb.margin);
+                let lines = (0..egrid.len()).map(|i| (etab.eval(i, &w, &r, sa.sigma), et.d[i]));
+                bound::max_lemma_bound(lines, -margin) + margin
             })
             .collect();
         let mut any = false;

@@ -16,6 +16,13 @@ use std::sync::OnceLock;
 /// Number of cubic weights.
 pub const N3: usize = 20;
 
+/// The 20 cubic multi-indices in the crate's order (computed once).
+#[must_use]
+pub fn cubic_indices() -> &'static [[u8; 4]] {
+    static IDX: OnceLock<Vec<[u8; 4]>> = OnceLock::new();
+    IDX.get_or_init(|| crate::bb::multi_indices(3))
+}
+
 /// Index of the cubic weight with multi-index λ.
 #[inline]
 #[must_use]
@@ -420,8 +427,7 @@ impl EdgeFrame {
                 .sum()
         };
         let mut e = [0.0; N3];
-        for l in crate::bb::multi_indices(3) {
-            let k = ix(l);
+        for (k, &l) in cubic_indices().iter().enumerate() {
             if l[3] == 0 {
                 e[k] = wa[ix(map(&self.a_loc, [l[0], l[1], l[2]]))];
             } else if l[2] == 0 {
