@@ -358,3 +358,19 @@ fn duplicate_faces_are_dropped() {
     assert!(r.get(FindingKind::InconsistentOrientation).is_none());
     assert!(r.require(true).is_ok());
 }
+
+/// `vn` lines may follow the faces that use them (positive indices are resolved at the end),
+/// and the corner normals then still reach their vertices.
+#[test]
+fn normals_defined_after_faces() {
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n\
+                f 1//1 3//3 2//2\nf 1//1 2//2 4//4\nf 1//1 4//4 3//3\nf 2//2 3//3 4//4\n\
+                vn -1 -1 -1\nvn 1 0 0\nvn 0 1 0\nvn 1 1 1\n";
+    let (m, _) = mesh::load_bytes(text.as_bytes(), Format::Obj, Path::new("after.obj"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let n = m.file_normals.expect("file normals");
+    // Vertex 3 (line 5) has corner normal 4 = (1,1,1)/√3 at every corner; exact up to the
+    // rounding of one normalisation.
+    let expect = glam::DVec3::ONE.normalize();
+    assert!((n[3] - expect).length() < 1e-15, "{:?}", n[3]);
+}

@@ -52,6 +52,9 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
     // Unresolved positive indices are checked once all vertices are known (forward references).
     let mut max_index: u64 = 0;
     let mut max_index_line = 0u32;
+    // The same for normal indices (`vn` lines may follow the faces that use them).
+    let mut max_normal: u64 = 0;
+    let mut max_normal_line = 0u32;
     for (line_no, line) in lines(bytes) {
         // Comments run from `#` to the end of the line.
         let line = match line.iter().position(|&b| b == b'#') {
@@ -123,15 +126,11 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
                     face.push(vi);
                     let ni = match vn {
                         Some(t) => {
-                            let (ni, _) = resolve(t, raw.normals.len())
+                            let (ni, forward) = resolve(t, raw.normals.len())
                                 .map_err(|m| at(format!("face normal {}: {m}", face.len())))?;
-                            if ni as usize >= raw.normals.len() {
-                                return Err(at(format!(
-                                    "face normal {} refers to normal {} but only {} are defined",
-                                    face.len(),
-                                    u64::from(ni) + 1,
-                                    raw.normals.len()
-                                )));
+                            if forward && u64::from(ni) + 1 > max_normal {
+                                max_normal = u64::from(ni) + 1;
+                                max_normal_line = line_no;
                             }
                             any_corner_normal = true;
                             ni
@@ -173,6 +172,12 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
         return Err(format!(
             "line {max_index_line}: face refers to vertex {max_index} but the file defines {} vertices",
             raw.positions.len()
+        ));
+    }
+    if max_normal > raw.normals.len() as u64 {
+        return Err(format!(
+            "line {max_normal_line}: face refers to normal {max_normal} but the file defines {} normals",
+            raw.normals.len()
         ));
     }
     // No face refers to a normal but there is one per vertex: the common per-vertex convention.
