@@ -253,7 +253,7 @@ impl Patch {
         rational::segment_degree(usize::from(self.degree), &self.rational)
     }
 
-    /// Univariate Bernstein coefficients in s ∈ [0,1] of F((1−s)·x0 + s·x1) times the
+    /// Univariate Bernstein coefficients in s ∈ \[0, 1\] of F((1−s)·x0 + s·x1) times the
     /// (positive inside the tetrahedron) rational denominators; returns their number,
     /// [`Patch::segment_degree`] + 1, or 0 when the tetrahedron is degenerate. Inside the
     /// tetrahedron its roots and signs are those of F. No heap allocation.
@@ -264,12 +264,21 @@ impl Patch {
         let Some(t) = self.tet() else {
             return 0;
         };
+        self.segment_poly_bary(t.bary(x0), t.bary(x1), out)
+    }
+
+    /// [`Patch::segment_poly`] for a segment given by the barycentric coordinates of its ends
+    /// (for callers that keep the tetrahedron's barycentric map).
+    ///
+    /// # Panics
+    /// As [`Patch::segment_poly`].
+    pub fn segment_poly_bary(&self, a0: [f64; 4], a1: [f64; 4], out: &mut [f64; 16]) -> usize {
         rational::segment_poly(
             usize::from(self.degree),
             &self.weights,
             &self.rational,
-            t.bary(x0),
-            t.bary(x1),
+            a0,
+            a1,
             out,
         )
     }

@@ -8,8 +8,25 @@
 //! index and the line/column.
 //!
 //! Reading validates ([`validate`]): format and version, degree 1..=7, C(n+3,3) weights, finite
-//! numbers, non-degenerate tetrahedra, rational index sums, and that `normals` is empty or as
-//! long as `vertices`.
+//! numbers, non-degenerate tetrahedra, rational index sums (and a cleared segment degree ≤ 15),
+//! shooting rules that split the vertices, and that `normals` is empty or as long as
+//! `vertices`.
+//!
+//! ```
+//! use apatch::complex_io::{from_json_str, to_json_string};
+//! use apatch::fixtures::{quadric_complex, Quadric};
+//! use glam::DVec3;
+//! use std::path::Path;
+//!
+//! let q = Quadric::sphere(DVec3::ZERO, 0.5);
+//! let complex = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 1, 2);
+//! let text = to_json_string(&complex)?;
+//! assert_eq!(from_json_str(&text, Path::new("memory.json"))?, complex);
+//!
+//! let err = from_json_str(&text.replace("\"degree\":2", "\"degree\":9"), Path::new("bad.json"));
+//! assert!(err.unwrap_err().to_string().starts_with("bad.json: patch 0: degree 9"));
+//! # Ok::<(), apatch::error::Error>(())
+//! ```
 
 use crate::bb::num_coeffs;
 use crate::complex::{Patch, PatchComplex, FORMAT, VERSION};
@@ -23,6 +40,10 @@ use std::path::Path;
 
 /// Highest polynomial degree a patch may have.
 pub const MAX_DEGREE: u8 = 7;
+
+/// Highest degree of a patch restricted to a segment with its rational denominators cleared
+/// ([`crate::bb::rational::segment_degree`]), as the tracer and checker need.
+pub const MAX_SEGMENT_DEGREE: usize = 15;
 
 /// A tetrahedron is degenerate when |det[v2−v1, v3−v1, v4−v1]| ≤ this × (longest edge)³
 /// (a regular tetrahedron has ≈ 0.71; 1e-12 only rejects flat or repeated-vertex ones).
@@ -214,6 +235,27 @@ pub fn validate_patch(p: &Patch) -> std::result::Result<(), String> {
                 ));
             }
         }
+    }
+    let mut distinct = 0;
+    for (r, term) in p.rational.iter().enumerate() {
+        if !p.rational[..r]
+            .iter()
+            .any(|t| crate::bb::rational::same_denominator(t, term))
+        {
+            distinct += 1;
+        }
+    }
+    if distinct > crate::bb::rational::MAX_DENOMINATORS {
+        return Err(format!(
+            "{distinct} distinct rational denominators (at most {})",
+            crate::bb::rational::MAX_DENOMINATORS
+        ));
+    }
+    let cleared = crate::bb::rational::segment_degree(n, &p.rational);
+    if cleared > MAX_SEGMENT_DEGREE {
+        return Err(format!(
+            "rational terms raise the segment degree to {cleared} (at most {MAX_SEGMENT_DEGREE})"
+        ));
     }
     if let crate::complex::SheetRule::Shooting { base, top } = &p.sheet {
         let ok = !base.is_empty()

@@ -134,12 +134,24 @@ pub fn quadric_complex(
     for i in 0..cells {
         for j in 0..cells {
             for k in 0..cells {
-                let a = lo + step * DVec3::new(i as f64, j as f64, k as f64);
-                let b = if i + 1 == cells { hi.x } else { a.x + step.x };
+                // Grid coordinates from one formula, so neighbouring cubes share corners
+                // bit for bit (a.x + step.x would differ from the next cube's a.x by rounding).
+                let coord = |lo: f64, hi: f64, step: f64, i: usize| {
+                    if i == cells {
+                        hi
+                    } else {
+                        lo + step * i as f64
+                    }
+                };
+                let a = DVec3::new(
+                    coord(lo.x, hi.x, step.x, i),
+                    coord(lo.y, hi.y, step.y, j),
+                    coord(lo.z, hi.z, step.z, k),
+                );
                 let bb = DVec3::new(
-                    b,
-                    if j + 1 == cells { hi.y } else { a.y + step.y },
-                    if k + 1 == cells { hi.z } else { a.z + step.z },
+                    coord(lo.x, hi.x, step.x, i + 1),
+                    coord(lo.y, hi.y, step.y, j + 1),
+                    coord(lo.z, hi.z, step.z, k + 1),
                 );
                 for tet in kuhn_tets(a, bb) {
                     c.patches.push(Patch {

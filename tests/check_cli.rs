@@ -144,14 +144,53 @@ fn bad_inputs_exit_2_with_one_line() {
     );
     assert!(e.contains("patch 0: degree 9"), "{e}");
     let e = bad_input("scene.toml", "[camera]\n");
+    assert!(e.contains("missing field"), "{e}");
+    let e = bad_input("model.obj", "v 0 0 0\n");
     assert!(
-        e.contains("scene input needs a scheme; not available yet"),
+        e.contains("model input needs a scheme; not available yet"),
         "{e}"
     );
-    let e = bad_input("model.obj", "v 0 0 0\n");
-    assert!(e.contains("not available yet"), "{e}");
     let e = bad_input("what.xyz", "");
     assert!(e.contains("unknown input type"), "{e}");
+}
+
+const SCENE: &str = r#"
+[model]
+patches = "PATCHES"
+[camera]
+origin = [0, 0, 5]
+target = [0, 0, 0]
+fov = 40
+width = 8
+height = 8
+[[lights]]
+type = "directional"
+direction = [0, 0, -1]
+irradiance = 2.0
+"#;
+
+#[test]
+fn scene_input_is_checked() {
+    let patches = sphere_file("scene_patches.json", 2);
+    let scene = tmp("scene_ok.toml");
+    let name = patches.file_name().unwrap().to_str().unwrap();
+    std::fs::write(&scene, SCENE.replace("PATCHES", name)).unwrap();
+    let o = apatch(&["check", scene.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    assert!(stdout(&o).contains("PASSED"));
+
+    // A scene naming an invalid complex is bad input (exit 2), with the patch named.
+    let bad = tmp("scene_bad_patches.json");
+    std::fs::write(&bad, one_patch("2", "[1,2,3,4]")).unwrap();
+    let bad_name = bad.file_name().unwrap().to_str().unwrap();
+    let scene = tmp("scene_bad.toml");
+    std::fs::write(&scene, SCENE.replace("PATCHES", bad_name)).unwrap();
+    let o = apatch(&["check", scene.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.contains(bad.to_str().unwrap()), "{e}");
+    assert!(e.contains("patch 0: 4 weights for degree 2"), "{e}");
 }
 
 #[test]
@@ -207,4 +246,66 @@ fn export_patches_rewrites_json() {
         "{}",
         stderr(&o)
     );
+}
+
+/// A fixture that is C1 but not C2 across the plane x = x0 (the quadric c·(x − x0)² added on
+/// its right), under the given scheme name and continuity field.
+fn c1_not_c2_file(name: &str, scheme: &str, continuity: Option<u8>) -> PathBuf {
+    let q = Quadric::sphere(DVec3::ZERO, 0.7);
+    let mut c = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 3, 4);
+    c.scheme = scheme.to_string();
+    c.continuity = continuity;
+    // The grid plane exactly as the fixture computes it.
+    let x0 = -1.0 + 2.0 / 3.0 * 2.0;
+    let bump = Quadric {
+        a: glam::DMat3::from_diagonal(DVec3::new(0.05, 0.0, 0.0)),
+        b: DVec3::new(-0.1 * x0, 0.0, 0.0),
+        c: 0.05 * x0 * x0,
+    };
+    for p in &mut c.patches {
+        let tet = p.tet_points();
+        if tet.iter().all(|v| v.x >= x0) {
+            let extra = apatch::fixtures::quadric_weights(&bump, &tet, 4);
+            for (w, e) in p.weights.iter_mut().zip(extra) {
+                *w += e;
+            }
+        }
+    }
+    let path = tmp(name);
+    write_json_file(&c, &path).unwrap();
+    path
+}
+
+#[test]
+fn promised_continuity_follows_scheme_and_field() {
+    for (name, scheme, field, code) in [
+        ("c1_scheme.json", "cubic-c1", None, 0),
+        ("c2_scheme.json", "quintic-c2", None, 1),
+        ("c2_field.json", "cubic-c1", Some(2), 1),
+        ("c1_field.json", "quintic-c2", Some(1), 0),
+    ] {
+        let path = c1_not_c2_file(name, scheme, field);
+        let o = apatch(&["check", path.to_str().unwrap()]);
+        let out = stdout(&o);
+        assert_eq!(o.status.code(), Some(code), "{name}: {out}");
+        if code == 1 {
+            assert!(out.contains("FAILED: hessian jump"), "{name}: {out}");
+        }
+    }
+    // The flag overrides both.
+    let path = c1_not_c2_file("c2_flag.json", "quintic-c2", Some(2));
+    let o = apatch(&["check", path.to_str().unwrap(), "--continuity", "1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+}
+
+#[test]
+fn scene_with_scheme_is_built_and_checked() {
+    // End to end: mesh → rational C1 scheme → check (the cube scene of the repository).
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cube.toml");
+    let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["scheme"], "rational-c1");
+    assert!(v["faces"]["shared"].as_u64().unwrap() > 0);
+    assert!(v["interpolation"]["value"]["samples"].as_u64().unwrap() > 0);
 }

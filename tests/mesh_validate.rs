@@ -289,6 +289,13 @@ fn file_normals_obj_corners_and_noff() {
     let off = "NOFF\n3 1 0\n0 0 0 0 0 2\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n";
     let (m, _) = mesh::load_bytes(off.as_bytes(), Format::Off, Path::new("n.off")).unwrap();
     assert_eq!(m.file_normals.unwrap()[0], glam::DVec3::Z);
+    // One unreferenced `vn` per `v`: per-vertex normals.
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 3\nvn 0 0 1\nvn 1 0 0\nf 1 2 3\n";
+    let (m, _) = mesh::load_bytes(obj.as_bytes(), Format::Obj, Path::new("n.obj")).unwrap();
+    assert_eq!(
+        m.file_normals.unwrap(),
+        vec![glam::DVec3::Z, glam::DVec3::Z, glam::DVec3::X]
+    );
 }
 
 #[test]
@@ -319,4 +326,35 @@ fn fans_are_counter_clockwise_from_outside() {
             }
         }
     }
+}
+
+#[test]
+fn from_polygons_runs_the_same_pipeline() {
+    let (m, _) = corpus("inward_orientation.obj");
+    // Reverse every face again: the pipeline must flip them back.
+    let faces: Vec<Vec<u32>> = m
+        .faces
+        .iter()
+        .map(|f| f.iter().rev().copied().collect())
+        .collect();
+    let (fixed, r) = mesh::from_polygons(m.positions.clone(), faces).unwrap();
+    assert_eq!(fixed.faces, m.faces);
+    assert_eq!(elements(&r, FindingKind::InwardOrientation).len(), 4);
+    let e = mesh::from_polygons(m.positions.clone(), vec![vec![0, 1, 7]]).unwrap_err();
+    assert!(e.to_string().contains("face 0 refers to vertex 7"), "{e}");
+    let e = mesh::from_polygons(vec![glam::DVec3::NAN; 3], vec![vec![0, 1, 2]]).unwrap_err();
+    assert!(e.to_string().contains("vertex 0: non-finite"), "{e}");
+}
+
+#[test]
+fn duplicate_faces_are_dropped() {
+    // A closed tetrahedron plus the same face twice more (once reversed, once rotated).
+    let (m, r) = corpus("duplicate_face.obj");
+    assert_eq!(
+        elements(&r, FindingKind::DuplicateFace),
+        vec![face(2, 7), face(5, 10)]
+    );
+    assert_eq!(m.faces.len(), 4);
+    assert!(r.get(FindingKind::InconsistentOrientation).is_none());
+    assert!(r.require(true).is_ok());
 }

@@ -83,7 +83,7 @@ impl BbPoly {
         poly::eval(self.degree, &self.coeffs, a)
     }
 
-    /// The blossom b(args[0], …, args[n−1]); `args.len()` must equal the degree.
+    /// The blossom b(`args[0]`, …, `args[n−1]`); `args.len()` must equal the degree.
     #[must_use]
     pub fn blossom(&self, args: &[[f64; 4]]) -> f64 {
         poly::blossom(self.degree, &self.coeffs, args)
@@ -110,7 +110,7 @@ impl BbPoly {
         tet.world_hessian(poly::hessian_bary(self.degree, &self.coeffs, a))
     }
 
-    /// Writes the n+1 univariate Bernstein coefficients of s ↦ F((1−s)·a0 + s·a1), s ∈ [0,1],
+    /// Writes the n+1 univariate Bernstein coefficients of s ↦ F((1−s)·a0 + s·a1), s ∈ \[0, 1\],
     /// into `out` and returns n+1 (no allocation up to degree [`poly::STACK_DEGREE`]).
     pub fn restrict(&self, a0: [f64; 4], a1: [f64; 4], out: &mut [f64]) -> usize {
         poly::restrict(self.degree, &self.coeffs, a0, a1, out)

@@ -17,40 +17,96 @@ const STACK_COEFFS: usize = num_coeffs(STACK_DEGREE);
 /// With the decreasing-lexicographic order, the children of λ (|λ| = d−1, position j) sit at
 /// j (λ+e1), j+s (λ+e2), j+s+r+1 (λ+e3) and j+s+r+2 (λ+e4), where m = d−1−λ1, s = (m+1)(m+2)/2
 /// and r = m−λ2. All are ≥ j, so a forward sweep can overwrite in place.
-#[inline]
+#[inline(always)]
 pub fn step_in_place(c: &mut [f64], d: usize, a: [f64; 4]) {
     debug_assert!(d >= 1 && c.len() >= num_coeffs(d));
     let mut j = 0;
     for m in 0..d {
         let s = (m + 1) * (m + 2) / 2;
         for r in 0..=m {
-            for _ in 0..=r {
-                c[j] = a[0] * c[j]
-                    + a[1] * c[j + s]
-                    + a[2] * c[j + s + r + 1]
-                    + a[3] * c[j + s + r + 2];
-                j += 1;
+            // A run of r+1 outputs reads four contiguous runs; all but the first lie beyond
+            // the outputs (s ≥ r+1), so splitting there lets them be read while writing.
+            let run = r + 1;
+            let (head, tail) = c.split_at_mut(j + run);
+            let out = &mut head[j..];
+            let base = s - run;
+            let p1 = &tail[base..base + run];
+            let p23 = &tail[base + r + 1..base + r + 2 + run];
+            for i in 0..run {
+                out[i] = a[0] * out[i] + a[1] * p1[i] + a[2] * p23[i] + a[3] * p23[i + 1];
             }
+            j += run;
         }
     }
 }
 
 /// One de Casteljau step from `src` (degree `d`) into `dst` (degree d−1); see [`step_in_place`].
-#[inline]
+#[inline(always)]
 pub fn step_into(src: &[f64], dst: &mut [f64], d: usize, a: [f64; 4]) {
     debug_assert!(d >= 1 && src.len() >= num_coeffs(d) && dst.len() >= num_coeffs(d - 1));
     let mut j = 0;
     for m in 0..d {
         let s = (m + 1) * (m + 2) / 2;
         for r in 0..=m {
-            for _ in 0..=r {
-                dst[j] = a[0] * src[j]
-                    + a[1] * src[j + s]
-                    + a[2] * src[j + s + r + 1]
-                    + a[3] * src[j + s + r + 2];
-                j += 1;
+            let run = r + 1;
+            let out = &mut dst[j..j + run];
+            let p0 = &src[j..j + run];
+            let p1 = &src[j + s..j + s + run];
+            let p23 = &src[j + s + r + 1..j + s + r + 2 + run];
+            for i in 0..run {
+                out[i] = a[0] * p0[i] + a[1] * p1[i] + a[2] * p23[i] + a[3] * p23[i + 1];
             }
+            j += run;
         }
+    }
+}
+
+/// [`step_in_place`] for the constant degree D: the loops unroll into straight-line code.
+#[inline]
+fn step_in_place_c<const D: usize>(c: &mut [f64], a: [f64; 4]) {
+    let c = &mut c[..num_coeffs(D)];
+    step_in_place(c, D, a);
+}
+
+/// [`step_into`] for the constant degree D: the loops unroll into straight-line code.
+#[inline]
+fn step_into_c<const D: usize>(src: &[f64], dst: &mut [f64], a: [f64; 4]) {
+    let src = &src[..num_coeffs(D)];
+    let dst = &mut dst[..num_coeffs(D - 1)];
+    step_into(src, dst, D, a);
+}
+
+/// [`step_in_place`] through a degree-specialised body for d ≤ 9.
+#[inline(never)]
+pub fn step_in_place_fast(c: &mut [f64], d: usize, a: [f64; 4]) {
+    match d {
+        1 => step_in_place_c::<1>(c, a),
+        2 => step_in_place_c::<2>(c, a),
+        3 => step_in_place_c::<3>(c, a),
+        4 => step_in_place_c::<4>(c, a),
+        5 => step_in_place_c::<5>(c, a),
+        6 => step_in_place_c::<6>(c, a),
+        7 => step_in_place_c::<7>(c, a),
+        8 => step_in_place_c::<8>(c, a),
+        9 => step_in_place_c::<9>(c, a),
+        _ => step_in_place(c, d, a),
+    }
+}
+
+/// [`step_into`] through a degree-specialised body for d ≤ 9.
+#[inline(never)]
+pub fn step_into_fast(src: &[f64], dst: &mut [f64], d: usize, a: [f64; 4]) {
+    match d {
+        1 => step_into_c::<1>(src, dst, a),
+        2 => step_into_c::<2>(src, dst, a),
+        3 => step_into_c::<3>(src, dst, a),
+        4 => step_into_c::<4>(src, dst, a),
+        5 => step_into_c::<5>(src, dst, a),
+        6 => step_into_c::<6>(src, dst, a),
+        7 => step_into_c::<7>(src, dst, a),
+        8 => step_into_c::<8>(src, dst, a),
+        9 => step_into_c::<9>(src, dst, a),
+        _ => step_into(src, dst, d, a),
     }
 }
 
@@ -74,13 +130,13 @@ fn with_copy<R>(n: usize, c: &[f64], f: impl FnOnce(&mut [f64]) -> R) -> R {
 pub fn eval(n: usize, c: &[f64], a: [f64; 4]) -> f64 {
     with_copy(n, c, |w| {
         for d in (1..=n).rev() {
-            step_in_place(w, d, a);
+            step_in_place_fast(w, d, a);
         }
         w[0]
     })
 }
 
-/// The blossom b(args[0], …, args[n−1]) (symmetric, multi-affine, b(α,…,α) = F(α)).
+/// The blossom b(`args[0]`, …, `args[n−1]`) (symmetric, multi-affine, b(α,…,α) = F(α)).
 ///
 /// # Panics
 /// When `args.len() != n` or `c` has the wrong length.
@@ -93,7 +149,7 @@ pub fn blossom(n: usize, c: &[f64], args: &[[f64; 4]]) -> f64 {
     );
     with_copy(n, c, |w| {
         for (k, a) in args.iter().enumerate() {
-            step_in_place(w, n - k, *a);
+            step_in_place_fast(w, n - k, *a);
         }
         w[0]
     })
@@ -108,7 +164,7 @@ pub fn gradient_bary(n: usize, c: &[f64], a: [f64; 4]) -> [f64; 4] {
     }
     with_copy(n, c, |w| {
         for d in (2..=n).rev() {
-            step_in_place(w, d, a);
+            step_in_place_fast(w, d, a);
         }
         let k = n as f64;
         [k * w[0], k * w[1], k * w[2], k * w[3]]
@@ -127,7 +183,7 @@ pub fn hessian_bary(n: usize, c: &[f64], a: [f64; 4]) -> [[f64; 4]; 4] {
     }
     with_copy(n, c, |w| {
         for d in (3..=n).rev() {
-            step_in_place(w, d, a);
+            step_in_place_fast(w, d, a);
         }
         let k = (n * (n - 1)) as f64;
         PAIR.map(|row| row.map(|p| k * w[p]))
@@ -160,7 +216,7 @@ pub fn elevate(n: usize, c: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Restriction of F to the segment α(s) = (1−s)·a0 + s·a1, s ∈ [0,1]: writes the n+1
+/// Restriction of F to the segment α(s) = (1−s)·a0 + s·a1, s ∈ \[0, 1\]: writes the n+1
 /// univariate Bernstein coefficients b_k = blossom(a0 ×(n−k), a1 ×k) to `out[..n+1]` and
 /// returns n+1. No heap allocation up to degree [`STACK_DEGREE`].
 ///
@@ -186,15 +242,15 @@ pub fn restrict(n: usize, c: &[f64], a0: [f64; 4], a1: [f64; 4], out: &mut [f64]
             out[0] = c[0];
             1
         }
-        1 => restrict_with::<{ chain_len(1) }>(n, c, a0, a1, out),
-        2 => restrict_with::<{ chain_len(2) }>(n, c, a0, a1, out),
-        3 => restrict_with::<{ chain_len(3) }>(n, c, a0, a1, out),
-        4 => restrict_with::<{ chain_len(4) }>(n, c, a0, a1, out),
-        5 => restrict_with::<{ chain_len(5) }>(n, c, a0, a1, out),
-        6 => restrict_with::<{ chain_len(6) }>(n, c, a0, a1, out),
-        7 => restrict_with::<{ chain_len(7) }>(n, c, a0, a1, out),
-        8 => restrict_with::<{ chain_len(8) }>(n, c, a0, a1, out),
-        9 => restrict_with::<{ chain_len(9) }>(n, c, a0, a1, out),
+        1 => restrict_with::<1, { chain_len(1) }>(c, a0, a1, out),
+        2 => restrict_with::<2, { chain_len(2) }>(c, a0, a1, out),
+        3 => restrict_with::<3, { chain_len(3) }>(c, a0, a1, out),
+        4 => restrict_with::<4, { chain_len(4) }>(c, a0, a1, out),
+        5 => restrict_with::<5, { chain_len(5) }>(c, a0, a1, out),
+        6 => restrict_with::<6, { chain_len(6) }>(c, a0, a1, out),
+        7 => restrict_with::<7, { chain_len(7) }>(c, a0, a1, out),
+        8 => restrict_with::<8, { chain_len(8) }>(c, a0, a1, out),
+        9 => restrict_with::<9, { chain_len(9) }>(c, a0, a1, out),
         _ => restrict_heap(n, c, a0, a1, out),
     }
 }
@@ -221,9 +277,10 @@ const fn chain_len_exact(n: usize) -> usize {
     n * (n + 1) * (n + 2) * (n + 3) / 24
 }
 
+/// [`restrict`] for the constant degree N (chains of length L = C(N+3,4)): every loop has a
+/// constant trip count, so the index arithmetic folds away.
 #[inline]
-fn restrict_with<const L: usize>(
-    n: usize,
+fn restrict_with<const N: usize, const L: usize>(
     c: &[f64],
     a0: [f64; 4],
     a1: [f64; 4],
@@ -231,7 +288,7 @@ fn restrict_with<const L: usize>(
 ) -> usize {
     let mut c0 = [0.0; L];
     let mut c1 = [0.0; L];
-    restrict_chains(n, c, a0, a1, &mut c0, &mut c1, out)
+    restrict_chains(N, c, a0, a1, &mut c0, &mut c1, out)
 }
 
 fn restrict_heap(n: usize, c: &[f64], a0: [f64; 4], a1: [f64; 4], out: &mut [f64]) -> usize {
@@ -240,7 +297,7 @@ fn restrict_heap(n: usize, c: &[f64], a0: [f64; 4], a1: [f64; 4], out: &mut [f64
     restrict_chains(n, c, a0, a1, &mut c0, &mut c1, out)
 }
 
-#[inline]
+#[inline(always)]
 fn restrict_chains(
     n: usize,
     c: &[f64],
@@ -251,13 +308,13 @@ fn restrict_chains(
     out: &mut [f64],
 ) -> usize {
     // Chains: node of degree d = n−j holds a0^j (resp. a1^j) applied to c.
-    step_into(c, &mut c0[chain_offset(n, n - 1)..], n, a0);
-    step_into(c, &mut c1[chain_offset(n, n - 1)..], n, a1);
+    step_into_fast(c, &mut c0[chain_offset(n, n - 1)..], n, a0);
+    step_into_fast(c, &mut c1[chain_offset(n, n - 1)..], n, a1);
     for d in (1..n).rev() {
         let (src, dst) = c0.split_at_mut(chain_offset(n, d - 1));
-        step_into(&src[chain_offset(n, d)..], dst, d, a0);
+        step_into_fast(&src[chain_offset(n, d)..], dst, d, a0);
         let (src, dst) = c1.split_at_mut(chain_offset(n, d - 1));
-        step_into(&src[chain_offset(n, d)..], dst, d, a1);
+        step_into_fast(&src[chain_offset(n, d)..], dst, d, a1);
     }
     out[0] = c0[chain_offset(n, 0)];
     out[n] = c1[chain_offset(n, 0)];
@@ -266,7 +323,7 @@ fn restrict_chains(
     for k in 1..=half {
         let node = &mut c0[chain_offset(n, k)..];
         for d in (1..=k).rev() {
-            step_in_place(node, d, a1);
+            step_in_place_fast(node, d, a1);
         }
         out[k] = node[0];
     }
@@ -274,7 +331,7 @@ fn restrict_chains(
     for k in half + 1..n {
         let node = &mut c1[chain_offset(n, n - k)..];
         for d in (1..=n - k).rev() {
-            step_in_place(node, d, a0);
+            step_in_place_fast(node, d, a0);
         }
         out[k] = node[0];
     }

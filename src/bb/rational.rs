@@ -176,15 +176,37 @@ pub fn segment_degree(degree: usize, rational: &[RationalTerm]) -> usize {
 /// Coefficients (length e+1) of α^μ along α(s) = (1−s)a0 + s·a1, elevated to degree `e`.
 #[inline]
 fn monomial_on_segment(mu: [u8; 4], a0: [f64; 4], a1: [f64; 4], e: usize, out: &mut [f64]) {
+    // The denominators of the 2001 scheme are sums of α_i and α_iα_j: write those directly.
+    let degree: usize = mu.iter().map(|&k| usize::from(k)).sum();
+    if degree == e && (1..=2).contains(&degree) {
+        let mut factors = [0usize; 2];
+        let mut k = 0;
+        for i in 0..4 {
+            for _ in 0..mu[i] {
+                factors[k] = i;
+                k += 1;
+            }
+        }
+        let (i, j) = (factors[0], factors[1]);
+        if degree == 1 {
+            out[0] = a0[i];
+            out[1] = a1[i];
+        } else {
+            out[0] = a0[i] * a0[j];
+            out[1] = 0.5 * (a0[i] * a1[j] + a1[i] * a0[j]);
+            out[2] = a1[i] * a1[j];
+        }
+        return;
+    }
     let mut len = 1;
     out[0] = 1.0;
     for i in 0..4 {
         for _ in 0..mu[i] {
             // Multiply by the linear factor with Bernstein coefficients [a0_i, a1_i].
-            let k = len as f64; // new degree
+            let inv = 1.0 / len as f64; // 1/(new degree)
             out[len] = a1[i] * out[len - 1];
             for j in (1..len).rev() {
-                let w = j as f64 / k;
+                let w = j as f64 * inv;
                 out[j] = w * a1[i] * out[j - 1] + (1.0 - w) * a0[i] * out[j];
             }
             out[0] *= a0[i];
@@ -216,7 +238,7 @@ fn sum_on_segment(
     out
 }
 
-/// Bernstein coefficients in s ∈ [0,1] of F(α(s))·Π_g D_g(α(s)), α(s) = (1−s)a0 + s·a1, where
+/// Bernstein coefficients in s ∈ \[0, 1\] of F(α(s))·Π_g D_g(α(s)), α(s) = (1−s)a0 + s·a1, where
 /// F is the polynomial (degree `degree`, `weights`) plus the `rational` terms and the product
 /// runs over their distinct denominators. Writes them to `out` and returns their number
 /// (degree + 1 without rational terms). No heap allocation.

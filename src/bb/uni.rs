@@ -27,6 +27,21 @@ const BINOM: [[f64; 32]; 32] = {
     t
 };
 
+/// 1/C(n,k) for n < 32 (saves a division per coefficient in products).
+const INV_BINOM: [[f64; 32]; 32] = {
+    let mut t = [[0.0; 32]; 32];
+    let mut n = 0;
+    while n < 32 {
+        let mut k = 0;
+        while k <= n {
+            t[n][k] = 1.0 / BINOM[n][k];
+            k += 1;
+        }
+        n += 1;
+    }
+    t
+};
+
 /// C(n, k) as f64 (exact for n < 32; computed by the product formula beyond).
 #[inline]
 #[must_use]
@@ -156,8 +171,14 @@ pub fn multiply_into(a: &[f64], b: &[f64], out: &mut [f64]) -> usize {
             out[i + j] += wi * binomial(n, j) * bj;
         }
     }
-    for (k, o) in out[..len].iter_mut().enumerate() {
-        *o /= binomial(m + n, k);
+    if m + n < 32 {
+        for (k, o) in out[..len].iter_mut().enumerate() {
+            *o *= INV_BINOM[m + n][k];
+        }
+    } else {
+        for (k, o) in out[..len].iter_mut().enumerate() {
+            *o /= binomial(m + n, k);
+        }
     }
     len
 }
@@ -178,10 +199,10 @@ pub fn elevate_in_place(c: &mut [f64], len: usize) -> usize {
         c[0] = 0.0;
         return 1;
     }
-    let n1 = len as f64; // new degree n+1 = len
+    let inv = 1.0 / len as f64; // 1/(n+1), the new degree being len
     c[len] = c[len - 1];
     for k in (1..len).rev() {
-        let w = k as f64 / n1;
+        let w = k as f64 * inv;
         c[k] = w * c[k - 1] + (1.0 - w) * c[k];
     }
     len + 1

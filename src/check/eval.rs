@@ -46,14 +46,17 @@ pub struct WorldJet {
 pub struct PatchEval<'a> {
     /// The patch.
     pub patch: &'a Patch,
+    /// Its index in the complex (for reports).
+    pub id: usize,
     /// ∇αi in world coordinates.
     pub bary_grad: [DVec3; 4],
 }
 
 impl<'a> PatchEval<'a> {
-    /// Prepares `patch` (which must have passed [`crate::complex_io::validate_patch`]).
+    /// Prepares `patch`, number `id` of its complex (it must have passed
+    /// [`crate::complex_io::validate_patch`]).
     #[must_use]
-    pub fn new(patch: &'a Patch) -> Self {
+    pub fn new(patch: &'a Patch, id: usize) -> Self {
         let v = patch.tet_points();
         let m = DMat3::from_cols(v[1] - v[0], v[2] - v[0], v[3] - v[0]);
         let inv_t = m.inverse().transpose();
@@ -62,6 +65,7 @@ impl<'a> PatchEval<'a> {
         let g3 = inv_t.col(2);
         PatchEval {
             patch,
+            id,
             bary_grad: [-(g1 + g2 + g3), g1, g2, g3],
         }
     }
@@ -394,7 +398,7 @@ mod tests {
         let tet = kuhn_tets(DVec3::new(-0.5, -0.3, 0.1), DVec3::new(0.7, 0.4, 0.6))[3];
         for n in 2..=7 {
             let p = patch(tet, n, quadric_weights(&q, &tet, n));
-            let e = PatchEval::new(&p);
+            let e = PatchEval::new(&p, 0);
             for alpha in [[0.25; 4], [0.1, 0.2, 0.3, 0.4], [1.0, 0.0, 0.0, 0.0]] {
                 let x: DVec3 = (0..4).map(|i| alpha[i] * tet[i]).sum();
                 let j = e.world_jet(alpha);
@@ -439,7 +443,7 @@ mod tests {
             index: [1, 1, 0, 1],
             terms: vec![(0.5, [1, 0, 0, 0]), (-0.9, [0, 0, 0, 1])],
         });
-        let e = PatchEval::new(&p);
+        let e = PatchEval::new(&p, 0);
         let x0 = DVec3::new(0.35, 0.3, 0.25);
         let j = e.world_jet(e.bary(x0));
         let f = |x: DVec3| e.value(e.bary(x));

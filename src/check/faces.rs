@@ -97,11 +97,15 @@ pub(super) fn measure(evals: &[PatchEval<'_>], opts: &CheckOptions) -> FaceMeasu
                 stats.overshared += 1;
                 if stats.overshared_at.is_none() {
                     let f = &entries[s];
-                    stats.overshared_at = Some(Location {
-                        patches: entries[s..e].iter().map(|f| f.patch as usize).collect(),
-                        point: face_centroid(evals, f).to_array(),
-                        vertex: None,
-                    });
+                    let group: Vec<&PatchEval<'_>> = entries[s..e]
+                        .iter()
+                        .map(|f| &evals[f.patch as usize])
+                        .collect();
+                    stats.overshared_at = Some(Location::new(
+                        &group,
+                        face_centroid(evals, f).to_array(),
+                        None,
+                    ));
                 }
             }
         }
@@ -198,11 +202,7 @@ fn face_jumps(evals: &[PatchEval<'_>], a: &FaceEntry, b: &FaceEntry, opts: &Chec
     let measure = |(d, idx): (f64, usize)| Measure {
         worst: d,
         samples: samples.len(),
-        at: Some(Location {
-            patches: vec![a.patch as usize, b.patch as usize],
-            point: samples[idx].0.to_array(),
-            vertex: None,
-        }),
+        at: Some(Location::new(&[ea, eb], samples[idx].0.to_array(), None)),
     };
     Jumps {
         value: measure(worst[0]),

@@ -40,11 +40,7 @@ pub(super) fn measure(complex: &PatchComplex, evals: &[PatchEval<'_>]) -> Interp
                 let e = &evals[pi];
                 let j = e.world_jet(alpha);
                 let l = longest_edge(&e.patch.tet_points());
-                let at = Location {
-                    patches: vec![pi],
-                    point: *v,
-                    vertex: Some(vi),
-                };
+                let at = Location::new(&[e], *v, Some(vi));
                 let g = j.grad.length();
                 let rel = if j.value == 0.0 {
                     0.0

@@ -5,6 +5,21 @@
 //! [`check`] never fails: it returns a [`CheckReport`] whose [`CheckReport::passed`] compares every
 //! measure with the tolerances of [`CheckOptions`].
 //!
+//! ```
+//! use apatch::check::{check, CheckOptions};
+//! use apatch::fixtures::{quadric_complex, Quadric};
+//! use glam::DVec3;
+//!
+//! let sphere = Quadric::sphere(DVec3::ZERO, 0.8);
+//! let mut complex = quadric_complex(&sphere, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 3);
+//! assert!(check(&complex, &CheckOptions::default()).passed());
+//!
+//! complex.patches[0].weights[0] += 1e-3; // break continuity at a shared corner weight
+//! let report = check(&complex, &CheckOptions::default());
+//! assert!(!report.passed());
+//! println!("{report}"); // one line per measure, worst patches named
+//! ```
+//!
 //! ## Relative measures
 //! Jumps and errors are scaled so they do not depend on the size of the model or of F:
 //! for a shared face with longest edge L and gradient scale G (the largest |∇F| of either patch
@@ -64,7 +79,8 @@ pub struct CheckOptions {
     /// Samples along each sheet line.
     pub line_samples: usize,
     /// The scheme promises single-sheeted patches for [`crate::complex::SheetRule::Any`]:
-    /// lines with more than one root fail the check instead of only being reported.
+    /// patches crossed twice by lines from each of their vertices
+    /// ([`SheetStats::multi_sheet_patches`]) fail the check instead of only being reported.
     pub single_sheet: bool,
 }
 
@@ -95,6 +111,24 @@ pub struct Location {
     /// The mesh vertex index, for vertex measures.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vertex: Option<usize>,
+    /// Each patch's hull role and mesh element, e.g. "face 12".
+    pub elements: Vec<String>,
+}
+
+impl Location {
+    /// The location of `point` in `patches` (and at mesh vertex `vertex`).
+    #[must_use]
+    pub fn new(patches: &[&eval::PatchEval<'_>], point: [f64; 3], vertex: Option<usize>) -> Self {
+        Location {
+            patches: patches.iter().map(|e| e.id).collect(),
+            point,
+            vertex,
+            elements: patches
+                .iter()
+                .map(|e| format!("{} {}", e.patch.role.name(), e.patch.element))
+                .collect(),
+        }
+    }
 }
 
 /// One measure: its worst value over all samples and where it occurred.
@@ -191,12 +225,18 @@ pub struct SheetStats {
     /// Lines from tetrahedron vertices sampled in single-sheet ("any") patches of degree ≥ 2
     /// that can vanish.
     pub vertex_lines: usize,
-    /// Of those, lines crossing F = 0 more than once (a failure only if single sheets are
-    /// promised).
+    /// Of those, lines crossing F = 0 more than once (information: an A-patch is single
+    /// sheeted with respect to one vertex; lines from the others may cross twice).
     pub multi_root_lines: usize,
     /// An example of a multi-root line (its first root).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub multi_root_at: Option<Location>,
+    /// Patches with a multi-root line from every one of their four vertices: single-sheeted
+    /// with respect to none (a failure only if single sheets are promised).
+    pub multi_sheet_patches: usize,
+    /// An example of such a patch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub multi_sheet_at: Option<Location>,
 }
 
 /// Everything [`check`] measured, with the options used.
@@ -210,6 +250,11 @@ pub struct CheckReport {
     pub patches: usize,
     /// Number of vertices.
     pub vertices: usize,
+    /// Patches that fail [`crate::complex_io::validate_patch`] (not measured; a failure).
+    pub invalid_patches: usize,
+    /// The first invalid patch's problem.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_invalid: Option<String>,
     /// Face sharing.
     pub faces: FaceStats,
     /// Relative value jump across shared faces.
@@ -238,6 +283,9 @@ impl CheckReport {
     pub fn failures(&self) -> Vec<&'static str> {
         let o = &self.options;
         let mut f = Vec::new();
+        if self.invalid_patches > 0 {
+            f.push("invalid patches");
+        }
         if !self.value_jump.within(o.jump_tolerance) {
             f.push("value jump");
         }
@@ -265,23 +313,34 @@ impl CheckReport {
         if self.sheets.non_simple > 0 {
             f.push("non-simple shooting roots");
         }
-        if o.single_sheet && self.sheets.multi_root_lines > 0 {
+        if o.single_sheet && self.sheets.multi_sheet_patches > 0 {
             f.push("multiple sheets");
         }
         f
     }
 }
 
-/// Measures `complex` (which should have passed [`crate::complex_io::validate`]; patches that do
-/// not are skipped by the evaluator's assumptions only in the sense that their numbers may be
-/// NaN, which fails the check).
+/// Measures `complex`. Patches failing [`crate::complex_io::validate_patch`] are counted in
+/// [`CheckReport::invalid_patches`] (a failure) and left out of every measure; non-finite
+/// results elsewhere (overflow) also fail.
 #[must_use]
 pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
     let continuity = opts
         .continuity
         .unwrap_or_else(|| complex.promised_continuity());
-    let evals: Vec<eval::PatchEval<'_>> =
-        complex.patches.iter().map(eval::PatchEval::new).collect();
+    // Invalid patches are reported, not evaluated.
+    let mut invalid_patches = 0;
+    let mut first_invalid = None;
+    let mut evals = Vec::with_capacity(complex.patches.len());
+    for (i, p) in complex.patches.iter().enumerate() {
+        match crate::complex_io::validate_patch(p) {
+            Ok(()) => evals.push(eval::PatchEval::new(p, i)),
+            Err(m) => {
+                invalid_patches += 1;
+                first_invalid.get_or_insert_with(|| format!("patch {i}: {m}"));
+            }
+        }
+    }
     let faces = faces::measure(&evals, opts);
     let interpolation = interp::measure(complex, &evals);
     let sheets = sheets::measure(&evals, opts);
@@ -290,6 +349,8 @@ pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
         continuity,
         patches: complex.patches.len(),
         vertices: complex.vertices.len(),
+        invalid_patches,
+        first_invalid,
         faces: faces.stats,
         value_jump: faces.value,
         gradient_jump: faces.gradient,
@@ -332,6 +393,19 @@ mod tests {
             assert!(r.hessian_jump.worst < 1e-10, "{r}");
             assert!(r.passed(), "{r}");
         }
+    }
+
+    #[test]
+    fn fixture_grid_is_conforming_for_inexact_steps() {
+        // Step 2/7 is inexact: neighbouring cubes must still share corners bit for bit, so every
+        // interior face is matched and no T-junction is seen.
+        let q = Quadric::sphere(DVec3::ZERO, 0.9);
+        let cells = 7;
+        let c = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), cells, 2);
+        let r = check(&c, &CheckOptions::default());
+        assert_eq!(r.faces.boundary, 6 * 2 * cells * cells, "{r}");
+        assert_eq!(r.faces.t_junctions, 0, "{r}");
+        assert!(r.passed(), "{r}");
     }
 
     #[test]
@@ -395,6 +469,26 @@ mod tests {
         };
         let r2 = check(&c, &opts);
         assert_eq!(r2.failures(), vec!["hessian jump"], "{r2}");
+    }
+
+    #[test]
+    fn invalid_patches_are_reported_not_evaluated() {
+        let mut c = sphere_complex(2);
+        c.patches[3].weights.truncate(4);
+        c.patches[4].degree = 9;
+        c.patches[5].weights = vec![1.0; 220];
+        let r = check(&c, &CheckOptions::default());
+        assert_eq!(r.invalid_patches, 3, "{r}");
+        assert!(
+            r.first_invalid
+                .as_deref()
+                .unwrap()
+                .starts_with("patch 3: 4 weights"),
+            "{r}"
+        );
+        assert_eq!(r.failures(), vec!["invalid patches"], "{r}");
+        // An empty complex measures nothing and passes.
+        assert!(check(&PatchComplex::new("empty"), &CheckOptions::default()).passed());
     }
 
     #[test]
@@ -515,6 +609,7 @@ mod tests {
             .push(unit_tet_patch(2, quadratic_weights(m), SheetRule::Any));
         let r = check(&c, &CheckOptions::default());
         assert!(r.sheets.multi_root_lines > 0, "{r}");
+        assert_eq!(r.sheets.multi_sheet_patches, 1, "{r}");
         assert!(r.passed(), "{r}");
         let strict = CheckOptions {
             single_sheet: true,

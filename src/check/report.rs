@@ -12,13 +12,18 @@ fn verdict(ok: bool) -> &'static str {
 }
 
 fn fmt_location(at: &Option<Location>) -> String {
+    fmt_location_as("worst", at)
+}
+
+fn fmt_location_as(label: &str, at: &Option<Location>) -> String {
     let Some(at) = at else {
         return String::new();
     };
     let patches = at
         .patches
         .iter()
-        .map(usize::to_string)
+        .zip(&at.elements)
+        .map(|(p, e)| format!("{p} ({e})"))
         .collect::<Vec<_>>()
         .join(", ");
     let vertex = at
@@ -31,7 +36,7 @@ fn fmt_location(at: &Option<Location>) -> String {
     } else {
         "patches"
     };
-    format!("  (worst: {vertex}{noun} {patches} at ({x:.6}, {y:.6}, {z:.6}))")
+    format!("  ({label}: {vertex}{noun} {patches} at ({x:.6}, {y:.6}, {z:.6}))")
 }
 
 fn measure_line(
@@ -63,6 +68,14 @@ impl fmt::Display for CheckReport {
             "scheme {} (C{} promised), {} patches, {} vertices",
             self.scheme, self.continuity, self.patches, self.vertices
         )?;
+        if self.invalid_patches > 0 {
+            writeln!(
+                f,
+                "invalid patches  {} not measured  FAIL  (first: {})",
+                self.invalid_patches,
+                self.first_invalid.as_deref().unwrap_or("")
+            )?;
+        }
         let fs = &self.faces;
         writeln!(
             f,
@@ -71,14 +84,14 @@ impl fmt::Display for CheckReport {
             fs.boundary,
             fs.overshared,
             verdict(fs.overshared == 0),
-            fmt_location(&fs.overshared_at)
+            fmt_location_as("e.g.", &fs.overshared_at)
         )?;
         writeln!(
             f,
             "t-junctions      {} overlapping boundary face pairs  {}{}",
             fs.t_junctions,
             verdict(fs.t_junctions == 0),
-            fmt_location(&fs.t_junction_at)
+            fmt_location_as("e.g.", &fs.t_junction_at)
         )?;
         measure_line(f, "value jump", &self.value_jump, o.jump_tolerance, true)?;
         measure_line(
@@ -128,19 +141,24 @@ impl fmt::Display for CheckReport {
             fmt_location(&s.min_root_slope_at)
         )?;
         let multi_verdict = if o.single_sheet {
-            verdict(s.multi_root_lines == 0)
-        } else if s.multi_root_lines > 0 {
+            verdict(s.multi_sheet_patches == 0)
+        } else if s.multi_sheet_patches > 0 {
             "warning"
         } else {
             "ok"
         };
         writeln!(
             f,
-            "sheets           {} of {} vertex lines cross F = 0 more than once  {}{}",
+            "sheets           {} patches crossed twice from every vertex ({} of {} vertex lines \
+             cross F = 0 more than once)  {}{}",
+            s.multi_sheet_patches,
             s.multi_root_lines,
             s.vertex_lines,
             multi_verdict,
-            fmt_location(&s.multi_root_at)
+            fmt_location_as(
+                "e.g.",
+                &s.multi_sheet_at.clone().or(s.multi_root_at.clone())
+            )
         )?;
         let failures = self.failures();
         if failures.is_empty() {

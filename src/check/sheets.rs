@@ -11,6 +11,8 @@
 
 use super::eval::PatchEval;
 use super::{CheckOptions, Location, SheetStats};
+use crate::bb::rational::segment_poly;
+use crate::bb::uni;
 use crate::complex::SheetRule;
 use rayon::prelude::*;
 
@@ -21,8 +23,7 @@ const BISECTIONS: usize = 60;
 pub(super) fn measure(evals: &[PatchEval<'_>], opts: &CheckOptions) -> SheetStats {
     evals
         .par_iter()
-        .enumerate()
-        .map(|(pi, e)| patch_sheets(pi, e, opts, SheetStats::default()))
+        .map(|e| patch_sheets(e, opts, SheetStats::default()))
         .reduce(SheetStats::default, merge)
 }
 
@@ -46,6 +47,8 @@ fn merge(a: SheetStats, b: SheetStats) -> SheetStats {
         vertex_lines: a.vertex_lines + b.vertex_lines,
         multi_root_lines: a.multi_root_lines + b.multi_root_lines,
         multi_root_at: a.multi_root_at.or(b.multi_root_at),
+        multi_sheet_patches: a.multi_sheet_patches + b.multi_sheet_patches,
+        multi_sheet_at: a.multi_sheet_at.or(b.multi_sheet_at),
     }
 }
 
@@ -87,12 +90,7 @@ fn point(e: &PatchEval<'_>, alpha: [f64; 4]) -> [f64; 3] {
         .to_array()
 }
 
-fn patch_sheets(
-    pi: usize,
-    e: &PatchEval<'_>,
-    opts: &CheckOptions,
-    mut stats: SheetStats,
-) -> SheetStats {
+fn patch_sheets(e: &PatchEval<'_>, opts: &CheckOptions, mut stats: SheetStats) -> SheetStats {
     if e.has_no_zero() {
         return stats;
     }
@@ -115,18 +113,17 @@ fn patch_sheets(
                             .is_none_or(|m| rel < m || (rel.is_nan() && !m.is_nan()));
                         if smaller {
                             stats.min_root_slope = Some(rel);
-                            stats.min_root_slope_at = Some(Location {
-                                patches: vec![pi],
-                                point: point(e, lerp(&q, &u, t)),
-                                vertex: None,
-                            });
+                            stats.min_root_slope_at =
+                                Some(Location::new(&[e], point(e, lerp(&q, &u, t)), None));
                         }
                     }
                 }
             }
         }
         SheetRule::Any if e.patch.degree >= 2 => {
+            let mut apexes_with_multi_roots = 0;
             for apex in 0..4u8 {
+                let mut multi = false;
                 let face: Vec<u8> = (0..4u8).filter(|&k| k != apex).collect();
                 let mut a = [0.0; 4];
                 a[usize::from(apex)] = 1.0;
@@ -134,15 +131,20 @@ fn patch_sheets(
                     stats.vertex_lines += 1;
                     let (roots, first) = count_sign_changes(e, &a, &q, n);
                     if roots > 1 {
+                        multi = true;
                         stats.multi_root_lines += 1;
                         if stats.multi_root_at.is_none() {
-                            stats.multi_root_at = Some(Location {
-                                patches: vec![pi],
-                                point: point(e, lerp(&a, &q, first)),
-                                vertex: None,
-                            });
+                            stats.multi_root_at =
+                                Some(Location::new(&[e], point(e, lerp(&a, &q, first)), None));
                         }
                     }
+                }
+                apexes_with_multi_roots += usize::from(multi);
+            }
+            if apexes_with_multi_roots == 4 {
+                stats.multi_sheet_patches += 1;
+                if stats.multi_sheet_at.is_none() {
+                    stats.multi_sheet_at = stats.multi_root_at.clone();
                 }
             }
         }
@@ -151,9 +153,44 @@ fn patch_sheets(
     stats
 }
 
-/// Sign changes of F along the segment from `a` to `b` (N + 1 samples), and the parameter of
-/// the first.
+/// Bernstein coefficients of F·(rational denominators) along the segment from `a` to `b`
+/// (`bb::rational::segment_poly`; the denominators are positive inside, so roots and signs
+/// are F's), and the number of sign changes among them (zeros skipped). By Descartes' rule for
+/// the Bernstein basis, the number of roots in (0, 1) counted with multiplicity is at most that
+/// and of the same parity.
+fn segment(e: &PatchEval<'_>, a: &[f64; 4], b: &[f64; 4]) -> ([f64; 16], usize, usize) {
+    let p = e.patch;
+    let mut c = [0.0; 16];
+    let len = segment_poly(
+        usize::from(p.degree),
+        &p.weights,
+        &p.rational,
+        *a,
+        *b,
+        &mut c,
+    );
+    let mut changes = 0;
+    let mut prev: Option<bool> = None;
+    for &x in &c[..len] {
+        if x != 0.0 {
+            let pos = x > 0.0;
+            changes += usize::from(prev.is_some_and(|q| q != pos));
+            prev = Some(pos);
+        }
+    }
+    (c, len, changes)
+}
+
+/// Sign changes of F along the segment from `a` to `b`, and the parameter of the first.
+///
+/// With at most one sign change among the segment's Bernstein coefficients there are that many
+/// roots in (0, 1); otherwise F is sampled at N + 1 points.
 fn count_sign_changes(e: &PatchEval<'_>, a: &[f64; 4], b: &[f64; 4], n: usize) -> (usize, f64) {
+    let (_, _, changes) = segment(e, a, b);
+    if changes <= 1 {
+        // At most one root: its position is never reported.
+        return (changes, 0.0);
+    }
     let mut prev: Option<bool> = None;
     let mut count = 0;
     let mut first = 0.0;
@@ -189,9 +226,38 @@ fn minimal_root(
         let j = e.bary_jet(lerp(q, u, t));
         (0..4).map(|i| j.grad[i] * (u[i] - q[i])).sum::<f64>()
     };
+    let root_at = |t: f64| Some((t, dphi(t).abs()));
+    // Fast path: no sign change in the Bernstein coefficients → no root in (0, 1); exactly one
+    // (with non-zero end coefficients) → exactly one root, simple by Descartes' rule.
+    let (mut c, mut len, changes) = segment(e, q, u);
+    // Divide out (1 − t) and t factors (the cleared denominators vanish at top or base vertices
+    // and edges): (1 − t)·B^(m−1)_k = ((m − k)/m)·B^m_k and t·B^(m−1)_k = ((k + 1)/m)·B^m_(k+1),
+    // so the quotient keeps the signs of the remaining coefficients.
+    while len > 1 && c[len - 1] == 0.0 {
+        let m = (len - 1) as f64;
+        for (k, x) in c[..len - 1].iter_mut().enumerate() {
+            *x *= m / (m - k as f64);
+        }
+        len -= 1;
+    }
+    if phi(0.0) != 0.0 {
+        while len > 1 && c[0] == 0.0 {
+            let m = (len - 1) as f64;
+            for k in 0..len - 1 {
+                c[k] = c[k + 1] * m / (k as f64 + 1.0);
+            }
+            len -= 1;
+        }
+    }
+    if len > 1 && c[0] != 0.0 && changes <= 1 {
+        if changes == 0 {
+            return None;
+        }
+        let t = illinois(&c[..len]);
+        return root_at(t);
+    }
     let ts: Vec<f64> = (0..=n).map(|k| k as f64 / n as f64).collect();
     let f: Vec<f64> = ts.iter().map(|&t| phi(t)).collect();
-    let root_at = |t: f64| Some((t, dphi(t).abs()));
     for k in 0..n {
         if f[k] == 0.0 {
             return root_at(ts[k]);
@@ -219,6 +285,43 @@ fn minimal_root(
         }
     }
     None
+}
+
+/// The root of a Bernstein polynomial with one sign change on [0, 1] (c[0], c[last] of opposite
+/// signs): Illinois regula falsi, stopped when the bracket stops shrinking or is below 1e-15.
+fn illinois(c: &[f64]) -> f64 {
+    let (mut a, mut b) = (0.0f64, 1.0f64);
+    let (mut fa, mut fb) = (c[0], c[c.len() - 1]);
+    let mut side = 0i8;
+    for _ in 0..100 {
+        if b - a <= 1e-15 {
+            break;
+        }
+        let mut t = (a * fb - b * fa) / (fb - fa);
+        if !(t > a && t < b) {
+            t = 0.5 * (a + b);
+        }
+        let ft = uni::eval(c, t);
+        if ft == 0.0 {
+            return t;
+        }
+        if (ft > 0.0) == (fa > 0.0) {
+            a = t;
+            fa = ft;
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = t;
+            fb = ft;
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    0.5 * (a + b)
 }
 
 /// A sign change of `g` in [lo, hi] (g(lo), g(hi) of opposite signs), by bisection.

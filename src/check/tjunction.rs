@@ -47,13 +47,12 @@ pub(super) fn overlapping_pairs(
             let towards_opposite = (v[usize::from(opposite)] - pts[0]).dot(canon);
             let d = canon.dot(pts[0]) / scale;
             let q = |x: f64| (x / PLANE_QUANTUM).round() as i64;
-            let drop_axis = canon.abs().max_position();
             Some(Planar {
                 key: [q(canon.x), q(canon.y), q(canon.z), q(d)],
                 outward_positive: towards_opposite < 0.0,
                 pts,
                 patch,
-                drop_axis,
+                drop_axis: canon.abs().max_position(),
             })
         })
         .collect();
@@ -68,29 +67,44 @@ pub(super) fn overlapping_pairs(
         }
         let group = &planar[start..i];
         start = i;
-        let (pos, neg): (Vec<&Planar>, Vec<&Planar>) =
-            group.iter().partition(|f| f.outward_positive);
-        if pos.is_empty() || neg.is_empty() {
+        if group.iter().all(|f| f.outward_positive) || !group.iter().any(|f| f.outward_positive) {
             continue;
         }
-        for a in &pos {
-            for b in &neg {
-                let axis = a.drop_axis;
-                let flat = |p: &DVec3| {
-                    let k: Vec<f64> = (0..3).filter(|&j| j != axis).map(|j| p[j]).collect();
-                    DVec2::new(k[0], k[1])
-                };
-                let ta = a.pts.each_ref().map(flat);
-                let tb = b.pts.each_ref().map(flat);
-                if triangles_overlap(&ta, &tb) {
+        // Both sides present: project to 2D and sweep the negative side by bounding box in x.
+        let axis = group[0].drop_axis;
+        let flat = |f: &Planar| {
+            let (u, v) = match axis {
+                0 => (1, 2),
+                1 => (0, 2),
+                _ => (0, 1),
+            };
+            f.pts.map(|p| DVec2::new(p[u], p[v]))
+        };
+        let bbox = |t: &[DVec2; 3]| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+        let mut neg: Vec<(&Planar, [DVec2; 3], DVec2, DVec2)> = group
+            .iter()
+            .filter(|f| !f.outward_positive)
+            .map(|f| {
+                let t = flat(f);
+                let (lo, hi) = bbox(&t);
+                (f, t, lo, hi)
+            })
+            .collect();
+        neg.sort_by(|a, b| a.2.x.total_cmp(&b.2.x));
+        for a in group.iter().filter(|f| f.outward_positive) {
+            let ta = flat(a);
+            let (alo, ahi) = bbox(&ta);
+            let end = neg.partition_point(|n| n.2.x < ahi.x);
+            for (b, tb, blo, bhi) in &neg[..end] {
+                if bhi.x <= alo.x || bhi.y <= alo.y || blo.y >= ahi.y {
+                    continue;
+                }
+                if triangles_overlap(&ta, tb) {
                     count += 1;
                     if at.is_none() {
                         let c = (a.pts[0] + a.pts[1] + a.pts[2]) / 3.0;
-                        at = Some(Location {
-                            patches: vec![a.patch as usize, b.patch as usize],
-                            point: c.to_array(),
-                            vertex: None,
-                        });
+                        let pair = [&evals[a.patch as usize], &evals[b.patch as usize]];
+                        at = Some(Location::new(&pair, c.to_array(), None));
                     }
                 }
             }

@@ -45,8 +45,8 @@ fn tolerance(s: &str) -> Result<f64, String> {
     }
 }
 
-/// Loads the patch complex `path` names: a patch JSON file, or (once schemes exist) a scene or
-/// model file built with its scheme.
+/// Loads the patch complex `path` names: a patch JSON file, or a scene (`scene::load` +
+/// `scene::build_complex`, then validated); model files wait for a default scheme.
 ///
 /// # Errors
 /// A missing or unreadable file, invalid data, or an input kind not supported yet.
@@ -58,12 +58,23 @@ pub fn load_complex(path: &Path) -> anyhow::Result<PatchComplex> {
         .unwrap_or_default();
     match ext.as_str() {
         "json" => Ok(apatch::complex_io::read_json_file(path)?),
-        "toml" | "obj" | "off" => {
+        "toml" => {
+            let scene = apatch::scene::load(path)?;
+            if let apatch::scene::Model::Patches(json) = &scene.model {
+                return Ok(apatch::complex_io::read_json_file(json)?);
+            }
+            let complex = apatch::scene::build_complex(&scene)?;
+            apatch::complex_io::validate(&complex)
+                .map_err(|m| anyhow::anyhow!("{}: {m}", path.display()))?;
+            Ok(complex)
+        }
+        "obj" | "off" => {
             if !path.exists() {
                 anyhow::bail!("{}: no such file", path.display());
             }
             anyhow::bail!(
-                "{}: scene input needs a scheme; not available yet (give a patches .json)",
+                "{}: model input needs a scheme; not available yet (give a scene .toml with \
+                 [scheme] or a patches .json)",
                 path.display()
             )
         }

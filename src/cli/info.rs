@@ -95,6 +95,8 @@ fn print_text(path: &std::path::Path, s: &Summary) {
     }
     println!("  2001 edges{tri}: {}", c(&s.edges_2001));
     println!("  2001 triangles{tri}: {}", c(&s.triangles_2001));
+    println!("  1994 edges: {}", c(&s.edges_1994));
+    println!("  1994 triangles{tri}: {}", c(&s.triangles_1994));
     println!(
         "  1994 faces        {} convex, {} non-convex polygons",
         s.convex_faces_1994, s.nonconvex_faces_1994

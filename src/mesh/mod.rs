@@ -5,6 +5,18 @@
 //! ear-clips polygons for the 2001 scheme; [`vertex_normals`] estimates the normals the schemes
 //! interpolate; [`convexity`] classifies edges and faces.
 //!
+//! ```
+//! use apatch::mesh::{self, NormalMethod};
+//! let (polygons, report) = mesh::load("scenes/models/l_prism.obj".as_ref())?;
+//! assert!(report.findings.is_empty());
+//! report.require(true)?; // closed, manifold, orientable: fine for every scheme
+//! let triangles = mesh::triangulate(&polygons); // for the 2001 scheme
+//! assert_eq!(triangles.faces.len(), 6 * 2 + 2 * 4);
+//! let normals = mesh::vertex_normals(&triangles, NormalMethod::Loop)?;
+//! assert!(mesh::above_face_failures(&triangles, &normals).is_empty());
+//! # Ok::<(), apatch::error::Error>(())
+//! ```
+//!
 //! # Errors and warnings
 //! Hard errors (`load` returns `Err` naming file and line): unreadable file, unknown format,
 //! syntax errors, non-UTF-8 data lines, NaN/inf coordinates or coordinates beyond
@@ -15,10 +27,15 @@
 //! Findings in the [`Report`] (the mesh is still returned):
 //! - notes: welded duplicates, boundary edges, averaged file normals, ignored statements;
 //! - warnings, repaired: repeated vertices in a face (removed), faces with < 3 distinct
-//!   vertices (dropped), unreferenced vertices (dropped), inconsistent orientation (flipped),
-//!   inward closed surface (flipped);
+//!   vertices (dropped), duplicate faces (dropped), unreferenced vertices (dropped),
+//!   inconsistent orientation (flipped), inward closed surface (flipped);
 //! - warnings, kept: zero-area faces, non-planar polygons, non-manifold edges and vertices,
 //!   non-orientable components, incomplete file normals.
+//!
+//! `apatch info` exits 0 with notes only, 1 with warnings (or normals that cannot be computed),
+//! 2 on hard errors. Element indices in findings are the loaded mesh's (after welding and
+//! dropping), except for dropped faces and vertices, which carry the file's 0-based number;
+//! every element carries its 1-based file line.
 //!
 //! Which schemes accept what ([`Report::require`]): every scheme needs a manifold, orientable
 //! mesh. The 2001 rational scheme accepts boundary edges; the 1994 inner-hull schemes need a
@@ -38,7 +55,7 @@ pub mod topology;
 mod triangulate;
 mod validate;
 
-pub use load::{load, load_bytes, Format};
+pub use load::{from_polygons, load, load_bytes, Format};
 pub use normals::{above_face_failures, loop_limit_normal, vertex_normals, NormalMethod};
 pub use orient::signed_volume;
 pub use report::{Element, Finding, FindingKind, Report, Severity, LISTED_ELEMENTS};

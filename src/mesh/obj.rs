@@ -10,6 +10,8 @@
 //! `v//vn`, `v/vt/vn` corners, positive (1-based) and negative (relative) indices. Ignored, and
 //! counted in a note: `l`, `p`, free-form geometry statements. Skipped silently: comments, `vt`,
 //! `vp`, groups, smoothing, materials. Anything else is an error naming the line.
+//! Normals: per face corner (`v//vn`); when no face refers to a normal and there are as many
+//! `vn` as `v`, the i-th `vn` is the i-th vertex's normal.
 
 use super::raw::{lines, parse_float, shorten, RawMesh, MAX_FACE_VERTICES, NO_NORMAL};
 use glam::DVec3;
@@ -51,9 +53,12 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
     let mut max_index: u64 = 0;
     let mut max_index_line = 0u32;
     for (line_no, line) in lines(bytes) {
-        let first = line.iter().position(|b| !b.is_ascii_whitespace());
-        let Some(first) = first else { continue };
-        if line[first] == b'#' {
+        // Comments run from `#` to the end of the line.
+        let line = match line.iter().position(|&b| b == b'#') {
+            Some(i) => &line[..i],
+            None => line,
+        };
+        if line.iter().all(u8::is_ascii_whitespace) {
             continue;
         }
         let text = std::str::from_utf8(line)
@@ -169,6 +174,10 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
             "line {max_index_line}: face refers to vertex {max_index} but the file defines {} vertices",
             raw.positions.len()
         ));
+    }
+    // No face refers to a normal but there is one per vertex: the common per-vertex convention.
+    if !any_corner_normal && !raw.normals.is_empty() && raw.normals.len() == raw.positions.len() {
+        raw.vertex_normals = Some(std::mem::take(&mut raw.normals));
     }
     Ok(raw)
 }

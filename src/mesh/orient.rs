@@ -13,7 +13,8 @@ use super::Mesh;
 use glam::DVec3;
 
 /// Makes the orientation consistent, then outward; records what it changed in `report`.
-pub fn orient(mesh: &mut Mesh, report: &mut Report) {
+/// Returns the mesh's topology when no face changed (so it need not be rebuilt).
+pub fn orient(mesh: &mut Mesh, report: &mut Report) -> Option<Topology> {
     let topo = Topology::new(mesh.positions.len(), &mesh.faces);
     let n_faces = mesh.faces.len();
     const UNSEEN: u32 = u32::MAX;
@@ -39,12 +40,11 @@ pub fn orient(mesh: &mut Mesh, report: &mut Report) {
             members.push(f);
             let (s, e) = (topo.face_start[f as usize], topo.face_start[f as usize + 1]);
             for c in s..e {
-                let cs = topo.edge_corners(topo.corner_edge[c as usize]);
-                if cs.len() != 2 {
+                let o = topo.corner_mate[c as usize];
+                if o == u32::MAX {
                     closed = false;
                     continue;
                 }
-                let o = if cs[0] == c { cs[1] } else { cs[0] };
                 let g = topo.corner_face[o as usize];
                 // Same direction in both faces means one of them must be flipped.
                 let same = topo.corner_vertex[o as usize] == topo.corner_vertex[c as usize];
@@ -92,6 +92,7 @@ pub fn orient(mesh: &mut Mesh, report: &mut Report) {
             })
             .collect()
     };
+    let unchanged = flipped.is_empty() && inward.is_empty();
     if !flipped.is_empty() {
         let n = flipped.len();
         report.add(
@@ -116,6 +117,7 @@ pub fn orient(mesh: &mut Mesh, report: &mut Report) {
             face_elements(mesh, inward),
         );
     }
+    unchanged.then_some(topo)
 }
 
 /// Signed volume enclosed by `faces` (positive when they face outwards), computed about their

@@ -69,8 +69,10 @@ pub fn shorten(token: &str) -> String {
     }
 }
 
-/// Splits a byte buffer into lines (LF or CRLF), yielding (1-based line number, bytes).
+/// Splits a byte buffer into lines (LF or CRLF; a leading UTF-8 byte-order mark is skipped),
+/// yielding (1-based line number, bytes).
 pub fn lines(bytes: &[u8]) -> impl Iterator<Item = (u32, &[u8])> {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     bytes.split(|&b| b == b'\n').enumerate().map(|(i, l)| {
         let l = l.strip_suffix(b"\r").unwrap_or(l);
         (u32::try_from(i + 1).unwrap_or(u32::MAX), l)

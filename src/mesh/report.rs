@@ -28,6 +28,8 @@ pub enum FindingKind {
     RepeatedVertex,
     /// A face had fewer than 3 distinct vertices or a non-consecutive repeat; it was dropped (Warning).
     DroppedFace,
+    /// A face with the same vertices as an earlier face (either orientation); dropped (Warning).
+    DuplicateFace,
     /// A face with (relative) zero area; kept (Warning).
     ZeroAreaFace,
     /// A polygon whose vertices leave its best-fit plane beyond the tolerance; kept (Warning).

@@ -1,7 +1,10 @@
 //! The facts `apatch info` prints: counts, topology, bounding box, convexity classes of both
 //! papers, and the findings.
 
-use super::convexity::{edge_convexity, polygon_is_convex, triangle_convexity, Convexity};
+use super::convexity::{
+    edge_convexity, edge_convexity_1994, polygon_is_convex, triangle_convexity,
+    triangle_convexity_1994, Convexity,
+};
 use super::normals::{above_face_failures, vertex_normals, NormalMethod};
 use super::topology::Topology;
 use super::{triangulate, Mesh, Report};
@@ -78,6 +81,10 @@ pub struct Summary {
     pub triangles_2001: Option<ClassCounts>,
     /// True when the 2001 classes were computed on an ear-clipped triangulation.
     pub triangulated_for_2001: bool,
+    /// 1994 classes (Definition 3.1) of the mesh's edges.
+    pub edges_1994: Option<ClassCounts>,
+    /// 1994 classes (Definition 3.2) of the triangles of the (ear-clipped, if needed) mesh.
+    pub triangles_1994: Option<ClassCounts>,
     /// 1994: polygon faces that are convex in their plane.
     pub convex_faces_1994: usize,
     /// 1994: polygon faces that are not convex.
@@ -138,7 +145,13 @@ pub fn summary(mesh: &Mesh, report: &Report, normals: NormalMethod) -> Summary {
         mesh
     };
     let classes = n.as_ref().ok().map(|n| {
-        let tt = Topology::new(tm.positions.len(), &tm.faces);
+        let rebuilt;
+        let tt = if triangulated {
+            rebuilt = Topology::new(tm.positions.len(), &tm.faces);
+            &rebuilt
+        } else {
+            &topo
+        };
         let p = &tm.positions;
         let mut edges = ClassCounts::default();
         for [i, j] in &tt.edges {
@@ -146,11 +159,19 @@ pub fn summary(mesh: &Mesh, report: &Report, normals: NormalMethod) -> Summary {
             edges.add(edge_convexity(p[i], n[i], p[j], n[j]));
         }
         let mut triangles = ClassCounts::default();
+        let mut triangles_1994 = ClassCounts::default();
         for f in &tm.faces {
             let [a, b, c] = [f[0] as usize, f[1] as usize, f[2] as usize];
-            triangles.add(triangle_convexity([p[a], p[b], p[c]], [n[a], n[b], n[c]]));
+            let (tp, tn) = ([p[a], p[b], p[c]], [n[a], n[b], n[c]]);
+            triangles.add(triangle_convexity(tp, tn));
+            triangles_1994.add(triangle_convexity_1994(tp, tn));
         }
-        (edges, triangles)
+        let mut edges_1994 = ClassCounts::default();
+        for [i, j] in &topo.edges {
+            let (i, j) = (*i as usize, *j as usize);
+            edges_1994.add(edge_convexity_1994(p[i], n[i], p[j], n[j]));
+        }
+        (edges, triangles, edges_1994, triangles_1994)
     });
     let convex = mesh
         .faces
@@ -178,6 +199,8 @@ pub fn summary(mesh: &Mesh, report: &Report, normals: NormalMethod) -> Summary {
         normals_error: n.as_ref().err().map(ToString::to_string),
         edges_2001: classes.map(|c| c.0),
         triangles_2001: classes.map(|c| c.1),
+        edges_1994: classes.map(|c| c.2),
+        triangles_1994: classes.map(|c| c.3),
         triangulated_for_2001: triangulated,
         convex_faces_1994: convex,
         nonconvex_faces_1994: mesh.faces.len() - convex,

@@ -16,6 +16,9 @@ pub struct Topology {
     pub corner_face: Vec<u32>,
     /// #C undirected edge of the half-edge starting at each corner.
     pub corner_edge: Vec<u32>,
+    /// #C the other corner of the same edge when the edge has exactly two corners, else
+    /// `u32::MAX` (boundary or non-manifold edge).
+    pub corner_mate: Vec<u32>,
     /// #E undirected edges, smaller vertex first, sorted.
     pub edges: Vec<[u32; 2]>,
     /// #E + 1 offsets into `edge_corner_list`.
@@ -82,6 +85,17 @@ impl Topology {
         }
         edge_start.push(edge_corner_list.len() as u32);
         drop(keyed);
+        let mut corner_mate = vec![u32::MAX; n_corners];
+        for w in edge_start.windows(2) {
+            if w[1] - w[0] == 2 {
+                let (a, b) = (
+                    edge_corner_list[w[0] as usize],
+                    edge_corner_list[w[0] as usize + 1],
+                );
+                corner_mate[a as usize] = b;
+                corner_mate[b as usize] = a;
+            }
+        }
         // Corners per vertex (counting sort).
         let mut vertex_start = vec![0u32; n_vertices + 1];
         for &v in &corner_vertex {
@@ -101,6 +115,7 @@ impl Topology {
             corner_vertex,
             corner_face,
             corner_edge,
+            corner_mate,
             edges,
             edge_start,
             edge_corner_list,
@@ -161,12 +176,9 @@ impl Topology {
     /// faces that traverse it in opposite directions.
     #[must_use]
     pub fn twin(&self, c: u32) -> Option<u32> {
-        let cs = self.edge_corners(self.corner_edge[c as usize]);
-        if cs.len() != 2 {
-            return None;
-        }
-        let o = if cs[0] == c { cs[1] } else { cs[0] };
-        (self.corner_vertex[o as usize] == self.head(c)).then_some(o)
+        let o = self.corner_mate[c as usize];
+        (o != u32::MAX && self.corner_vertex[o as usize] != self.corner_vertex[c as usize])
+            .then_some(o)
     }
 
     /// True when edge `e` has exactly one face.

@@ -15,8 +15,9 @@ pub const ZERO_AREA_TOL: f64 = 1e-12;
 /// well below it).
 pub const PLANARITY_TOL: f64 = 1e-4;
 
-/// Adds the geometric and topological findings of `mesh` to `report`; returns its topology.
-pub fn validate(mesh: &Mesh, report: &mut Report) -> Topology {
+/// Adds the geometric and topological findings of `mesh` to `report`; returns its topology
+/// (`topology`, when given, must be that of `mesh`).
+pub fn validate(mesh: &Mesh, topology: Option<Topology>, report: &mut Report) -> Topology {
     let mut zero = Vec::new();
     let mut non_planar = Vec::new();
     let mut worst = 0.0f64;
@@ -56,7 +57,7 @@ pub fn validate(mesh: &Mesh, report: &mut Report) -> Topology {
         );
     }
 
-    let topo = Topology::new(mesh.positions.len(), &mesh.faces);
+    let topo = topology.unwrap_or_else(|| Topology::new(mesh.positions.len(), &mesh.faces));
     let edge_line = |e: u32| {
         let c = topo.edge_corners(e)[0];
         mesh.face_lines[topo.corner_face[c as usize] as usize]
@@ -106,7 +107,7 @@ pub fn validate(mesh: &Mesh, report: &mut Report) -> Topology {
         report.add(
             FindingKind::NonManifoldVertex,
             format!(
-                "{} vertices are non-manifold (their faces do not form one fan)",
+                "{} vertices are non-manifold (their faces do not form one consistently oriented fan)",
                 bad_vertices.len()
             ),
             bad_vertices,

@@ -52,6 +52,11 @@
 //! only). Positive (negative) convex faces on which F > 0 (< 0) somewhere are treated as
 //! nonconvex (the paper's rule would put the surface outside the hull); they are counted in
 //! [`RationalBuild::promoted_faces`].
+//!
+//! Fallback for bad normals: a vertex normal that is not strictly above one of its triangles
+//! (Loop limit normals at sharp creases) is replaced by the angle-weighted normal of its
+//! triangles when that one is above all of them (counted in
+//! [`RationalBuild::replaced_normals`]); otherwise the build fails naming the triangle.
 
 pub mod bound;
 pub mod eval;
@@ -226,6 +231,9 @@ pub struct RationalBuild {
     pub free_values: Vec<[f64; 2]>,
     /// Face sides raised after the final edge check.
     pub raised_faces: usize,
+    /// Vertex normals replaced by the fallback (see the module docs); `complex.normals` holds
+    /// the replacements.
+    pub replaced_normals: usize,
 }
 
 fn class_index(c: Convexity) -> usize {
@@ -362,8 +370,18 @@ pub fn build(
     };
     let mut refined = 0;
     let mut rounds = 0;
+    let mut replaced_normals = repair_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals);
     let hull = loop {
-        let hull = outer::build(&mesh.positions, &mesh.triangles, &mesh.normals, &hopts)?;
+        let hull = outer::build(&mesh.positions, &mesh.triangles, &mesh.normals, &hopts)
+            .map_err(|e| {
+                if rounds == 0 {
+                    e
+                } else {
+                    Error::Invalid(format!(
+                        "after {refined} edges were refined because adjacent face tetrahedra intersected (§3.1): {e}"
+                    ))
+                }
+            })?;
         let bad = hull.bad_edges(&mesh.positions, &mesh.triangles);
         if bad.is_empty() {
             break hull;
@@ -382,6 +400,7 @@ pub fn build(
         let n = outer::refine::split_edges(&mut mesh, &bad)?;
         refined += n;
         rounds += 1;
+        replaced_normals += repair_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals);
     };
     let RefineMesh {
         positions,
@@ -389,9 +408,77 @@ pub fn build(
         triangles,
         origin,
     } = mesh;
-    assemble(
+    let mut b = assemble(
         &positions, &triangles, &normals, &origin, &hull, refined, opts,
-    )
+    )?;
+    b.replaced_normals = replaced_normals;
+    Ok(b)
+}
+
+/// The documented fallback for vertex normals that are not strictly above every triangle
+/// around them (n_ijk · n_l ≤ 1e-9, which §3.1 cannot handle; Loop limit normals do this at
+/// sharp creases): such a normal is replaced by the normalised angle-weighted sum of its
+/// triangles' normals (each oriented to the side of its corners' normals) when that one is
+/// above all of them; otherwise it is left for [`outer::build`] to report. Returns how many
+/// normals were replaced.
+fn repair_normals(positions: &[DVec3], triangles: &[[u32; 3]], normals: &mut [DVec3]) -> usize {
+    let nv = positions.len();
+    if nv != normals.len() || triangles.iter().flatten().any(|&i| i as usize >= nv) {
+        return 0;
+    }
+    // Each triangle's unit normal on the side of its corners' normals.
+    let oriented = |tri: &[u32; 3], normals: &[DVec3]| -> Option<DVec3> {
+        let p = tri.map(|i| positions[i as usize]);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
+        let s: DVec3 = tri.iter().map(|&i| normals[i as usize]).sum();
+        Some(if n.dot(s) < 0.0 { -n } else { n })
+    };
+    let nf: Vec<Option<DVec3>> = triangles.iter().map(|t| oriented(t, normals)).collect();
+    let mut bad = vec![false; nv];
+    for (tri, f) in triangles.iter().zip(&nf) {
+        let Some(f) = f else { continue };
+        for &v in tri {
+            if f.dot(normals[v as usize]) <= 1e-9 {
+                bad[v as usize] = true;
+            }
+        }
+    }
+    if !bad.contains(&true) {
+        return 0;
+    }
+    let mut sum = vec![DVec3::ZERO; nv];
+    for (tri, f) in triangles.iter().zip(&nf) {
+        let Some(f) = f else { continue };
+        for c in 0..3 {
+            let v = tri[c] as usize;
+            if bad[v] {
+                let p = positions[v];
+                let a = (positions[tri[(c + 1) % 3] as usize] - p).normalize_or_zero();
+                let b = (positions[tri[(c + 2) % 3] as usize] - p).normalize_or_zero();
+                sum[v] += *f * a.dot(b).clamp(-1.0, 1.0).acos();
+            }
+        }
+    }
+    let mut ok = vec![true; nv];
+    for (tri, f) in triangles.iter().zip(&nf) {
+        let Some(f) = f else { continue };
+        for &v in tri {
+            let v = v as usize;
+            if bad[v] && f.dot(sum[v].normalize_or_zero()) <= 1e-9 {
+                ok[v] = false;
+            }
+        }
+    }
+    let mut count = 0;
+    for v in 0..nv {
+        if bad[v] && ok[v] {
+            if let Some(n) = sum[v].try_normalize() {
+                normals[v] = n;
+                count += 1;
+            }
+        }
+    }
+    count
 }
 
 #[allow(clippy::too_many_lines)]
@@ -768,5 +855,6 @@ fn assemble(
         lower_bounds,
         free_values,
         raised_faces: raised.iter().flatten().filter(|&&r| r).count(),
+        replaced_normals: 0,
     })
 }

@@ -7,8 +7,9 @@
 //! - f *touches* zero at t: |f| ≤ τ around a point where f is not monotone (a tangency or
 //!   double root that rounding may have lifted slightly above zero or pushed slightly below).
 //!
-//! So tangential touches are **reported** (at the touching point, to within ≈ √(τ/|f″|) in t),
-//! whichever side rounding puts them on. Where f stays within τ of zero over a stretch (roots of
+//! So tangential touches are **reported**, whichever side rounding puts them on: at the
+//! touching point (the extremum of f), or at the first of the two roots rounding split it into
+//! (≈ √(rounding/|f″|) ≈ 1e-8 before it). Where f stays within τ of zero over a stretch (roots of
 //! high multiplicity), the first point of that stretch is reported. An identically zero
 //! polynomial (s = 0), an empty slice, or non-finite coefficients give `None`.
 //!
@@ -19,14 +20,22 @@
 //!    Bernstein basis), which is polished by Newton's method safeguarded by bisection inside
 //!    the sign bracket. Intervals where f is monotone (all control-polygon slopes beyond ±τ)
 //!    and whose ends share a sign are dropped.
-//! 3. Intervals narrower than 2⁻³⁰ of [0, 1] that survive are touches: their midpoint is
-//!    reported (or their root, if their ends differ in sign).
+//! 3. Intervals narrower than 2⁻³⁰ of [0, 1] that survive are touches (or their root is
+//!    polished, if their ends differ in sign): Newton on f′ of the whole polynomial refines
+//!    the touch to the nearby extremum, and a sign change between the two is bisected.
+//!
+//! Simple roots come out to a few ulps (Newton stops once in its quadratic phase). The search
+//! is monomorphised for each length 1..=16, so its loops unroll and nothing allocates.
+//!
+//! # Continuing after a rejected root
+//! An exact root at `lo` is reported again: to look past a root r, call
+//! `first_root_in(c, r + δ, hi)` with some δ > 0 suited to the caller's scale.
 
-use super::{eval_with_derivative, subdivide_into, STACK_LEN};
+use super::STACK_LEN;
 
 /// Relative tolerance τ/max|ck| under which a coefficient counts as touching zero. Rounding in
 /// a restricted segment polynomial is a few ulps of the largest weight; 1e-13 leaves ~500×
-/// headroom over that while placing tangencies to ≈ 3e-7 of the interval.
+/// headroom over that. A touch is detected within √(τ/|f″|) of it, then refined.
 pub const TOUCH_TOL: f64 = 1e-13;
 
 /// Width (relative to [0, 1]) below which an unresolved interval is reported as a touch.
@@ -38,8 +47,10 @@ const MAX_SPLITS: usize = 4096;
 /// Newton iterations at most in the polish (bisection guarantees ≥ 1 bit per two steps).
 const MAX_POLISH: usize = 100;
 
-/// The smallest root of f in [0, 1] under the policy of this module; no heap allocation for
-/// up to [`STACK_LEN`] coefficients.
+/// The smallest root of f in [0, 1] under the policy of this module; no heap allocation.
+///
+/// # Panics
+/// When `c` has more than [`STACK_LEN`] coefficients.
 #[inline]
 #[must_use]
 pub fn first_root(c: &[f64]) -> Option<f64> {
@@ -50,11 +61,25 @@ pub fn first_root(c: &[f64]) -> Option<f64> {
 /// when lo > hi or either is NaN). Used to continue the search after rejecting a root.
 ///
 /// # Panics
-/// When `c` has more than 64 coefficients.
+/// When `c` has more than [`STACK_LEN`] coefficients.
 #[must_use]
 pub fn first_root_in(c: &[f64], lo: f64, hi: f64) -> Option<f64> {
-    let len = c.len();
-    if len == 0 || lo.is_nan() || hi.is_nan() || lo > hi {
+    macro_rules! dispatch {
+        ($($n:literal)*) => {
+            match c.len() {
+                0 => None,
+                $($n => first_root_fixed::<$n>(c.try_into().expect("length checked"), lo, hi),)*
+                len => panic!("first_root supports at most {STACK_LEN} coefficients, got {len}"),
+            }
+        };
+    }
+    dispatch!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+}
+
+/// [`first_root_in`] for exactly N coefficients: every loop has a constant trip count.
+#[inline]
+fn first_root_fixed<const N: usize>(c: &[f64; N], lo: f64, hi: f64) -> Option<f64> {
+    if lo.is_nan() || hi.is_nan() {
         return None;
     }
     let (lo, hi) = (lo.max(0.0), hi.min(1.0));
@@ -69,48 +94,73 @@ pub fn first_root_in(c: &[f64], lo: f64, hi: f64) -> Option<f64> {
         return None;
     }
     let tol = TOUCH_TOL * scale;
-    if len <= STACK_LEN {
-        first_root_fixed::<STACK_LEN>(c, lo, hi, tol)
-    } else {
-        assert!(
-            len <= 64,
-            "first_root supports at most 64 coefficients, got {len}"
-        );
-        first_root_fixed::<64>(c, lo, hi, tol)
-    }
-}
-
-#[inline]
-fn first_root_fixed<const N: usize>(c: &[f64], lo: f64, hi: f64, tol: f64) -> Option<f64> {
-    let len = c.len();
     if lo == 0.0 && hi == 1.0 {
         if excluded(c, tol) {
             return None;
         }
-        let mut ctx = Search { tol, splits: 0 };
-        return ctx.search::<N>(c, 0.0, 1.0);
+        return Search {
+            tol,
+            splits: 0,
+            top: c,
+            top_a: 0.0,
+            top_w: 1.0,
+        }
+        .search(c, 0.0, 1.0);
     }
     if lo == hi {
-        let (f, _) = eval_with_derivative(c, lo);
+        let (f, _) = eval_d(c, lo);
         return (f.abs() <= tol).then_some(lo);
     }
     // Coefficients on [lo, hi]: split at hi, then the left part at lo/hi.
-    let mut left = [0.0; N];
-    let mut right = [0.0; N];
-    let mut part = [0.0; N];
-    subdivide_into(c, hi, &mut left, &mut right);
-    subdivide_into(&left[..len], lo / hi, &mut right, &mut part);
-    let b = &part[..len];
-    if excluded(b, tol) {
+    let (left, _) = split(c, hi);
+    let (_, b) = split(&left, lo / hi);
+    if excluded(&b, tol) {
         return None;
     }
-    let mut ctx = Search { tol, splits: 0 };
-    ctx.search::<N>(b, lo, hi - lo)
+    Search {
+        tol,
+        splits: 0,
+        top: &b,
+        top_a: lo,
+        top_w: hi - lo,
+    }
+    .search(&b, lo, hi - lo)
+}
+
+/// (f(t), f′(t)) by de Casteljau on exactly N coefficients.
+#[inline(always)]
+fn eval_d<const N: usize>(c: &[f64; N], t: f64) -> (f64, f64) {
+    if N == 1 {
+        return (c[0], 0.0);
+    }
+    let mut b = *c;
+    let s = 1.0 - t;
+    for r in (2..N).rev() {
+        for i in 0..r {
+            b[i] = s * b[i] + t * b[i + 1];
+        }
+    }
+    (s * b[0] + t * b[1], (N - 1) as f64 * (b[1] - b[0]))
+}
+
+/// De Casteljau subdivision at t into the pieces on [0, t] and [t, 1].
+#[inline(always)]
+fn split<const N: usize>(c: &[f64; N], t: f64) -> ([f64; N], [f64; N]) {
+    let mut right = *c;
+    let mut left = *c;
+    let s = 1.0 - t;
+    for r in 1..N {
+        for i in 0..N - r {
+            right[i] = s * right[i] + t * right[i + 1];
+        }
+        left[r] = right[0];
+    }
+    (left, right)
 }
 
 /// True when every coefficient is beyond τ on the same side: no root, no touch.
-#[inline]
-fn excluded(b: &[f64], tol: f64) -> bool {
+#[inline(always)]
+fn excluded<const N: usize>(b: &[f64; N], tol: f64) -> bool {
     let (mut mn, mut mx) = (f64::INFINITY, f64::NEG_INFINITY);
     for &x in b {
         mn = mn.min(x);
@@ -120,8 +170,8 @@ fn excluded(b: &[f64], tol: f64) -> bool {
 }
 
 /// Number of sign changes in the sequence, exact zeros skipped.
-#[inline]
-fn variations(b: &[f64]) -> usize {
+#[inline(always)]
+fn variations<const N: usize>(b: &[f64; N]) -> usize {
     let mut v = 0;
     let mut last = 0.0;
     for &x in b {
@@ -136,26 +186,35 @@ fn variations(b: &[f64]) -> usize {
 }
 
 /// True when every control-polygon slope b_{i+1} − b_i is beyond τ on the same side.
-#[inline]
-fn monotone(b: &[f64], tol: f64) -> bool {
+#[inline(always)]
+fn monotone<const N: usize>(b: &[f64; N], tol: f64) -> bool {
     let (mut up, mut down) = (true, true);
-    for w in b.windows(2) {
-        let d = w[1] - w[0];
+    for i in 0..N - 1 {
+        let d = b[i + 1] - b[i];
         up &= d > tol;
         down &= d < -tol;
     }
     up || down
 }
 
-struct Search {
+struct Search<'a, const N: usize> {
     tol: f64,
     splits: usize,
+    /// The whole polynomial on [top_a, top_a + top_w] (for refining touches).
+    top: &'a [f64; N],
+    top_a: f64,
+    top_w: f64,
 }
 
-impl Search {
+/// How far (in the whole interval's parameter) a touch leaf may be from the extremum it is
+/// refined to: the stretch where |f| ≤ τ around a tangency is √(τ/|f″|) wide, 3e-4 even for
+/// |f″| = 1e-6·max|c|.
+const TOUCH_WINDOW: f64 = 1e-2;
+
+impl<const N: usize> Search<'_, N> {
     /// First root of the polynomial with coefficients `b` on [a, a+w] (global parameter).
-    fn search<const N: usize>(&mut self, b: &[f64], a: f64, w: f64) -> Option<f64> {
-        let n = b.len() - 1;
+    fn search(&mut self, b: &[f64; N], a: f64, w: f64) -> Option<f64> {
+        let n = N - 1;
         if b[0] == 0.0 {
             return Some(a);
         }
@@ -176,31 +235,112 @@ impl Search {
             if b[n] != 0.0 && (b[0] > 0.0) != (b[n] > 0.0) {
                 return Some(a + w * polish(b));
             }
-            return Some(a + 0.5 * w);
+            return Some(self.touch(a + 0.5 * w));
         }
         self.splits += 1;
-        let mut left = [0.0; N];
-        let mut right = [0.0; N];
-        subdivide_into(b, 0.5, &mut left, &mut right);
+        let (left, right) = split(b, 0.5);
         let h = 0.5 * w;
-        if !excluded(&left[..=n], self.tol) {
-            if let Some(t) = self.search::<N>(&left[..=n], a, h) {
+        if !excluded(&left, self.tol) {
+            if let Some(t) = self.search(&left, a, h) {
                 return Some(t);
             }
         }
-        if !excluded(&right[..=n], self.tol) {
-            return self.search::<N>(&right[..=n], a + h, h);
+        if !excluded(&right, self.tol) {
+            return self.search(&right, a + h, h);
         }
         None
     }
 }
 
+impl<const N: usize> Search<'_, N> {
+    /// Refines a touch leaf at global `t`: Newton on f′ of the whole polynomial finds the
+    /// nearby extremum; a sign change between the leaf and the extremum is bisected to the
+    /// first root, otherwise the extremum is the touching point (when |f| ≤ τ there). Falls
+    /// back to `t` when the refinement does not settle within [`TOUCH_WINDOW`].
+    fn touch(&self, t: f64) -> f64 {
+        if N < 3 {
+            return t;
+        }
+        let to_global = |u: f64| self.top_a + u * self.top_w;
+        let u0 = (t - self.top_a) / self.top_w;
+        let (f0, _, _) = eval_d2(self.top, u0);
+        let mut u = u0;
+        let mut settled = false;
+        for _ in 0..40 {
+            let (_, d1, d2) = eval_d2(self.top, u);
+            if d2 == 0.0 {
+                break;
+            }
+            let step = d1 / d2;
+            u -= step;
+            if !((u - u0).abs() <= TOUCH_WINDOW && (0.0..=1.0).contains(&u)) {
+                return t;
+            }
+            if step.abs() <= 4.0 * f64::EPSILON * u.abs().max(1e-3) {
+                settled = true;
+                break;
+            }
+        }
+        if !settled {
+            return t;
+        }
+        let (fe, _, _) = eval_d2(self.top, u);
+        if fe == 0.0 {
+            return to_global(u);
+        }
+        if f0 != 0.0 && (fe > 0.0) != (f0 > 0.0) {
+            // A genuine crossing between the leaf and the extremum: bisect to it.
+            let (mut lo, mut hi) = (u0.min(u), u0.max(u));
+            let lo_positive = eval_d2(self.top, lo).0 > 0.0;
+            for _ in 0..80 {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                if (eval_d2(self.top, mid).0 > 0.0) == lo_positive {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return to_global(0.5 * (lo + hi));
+        }
+        if fe.abs() <= self.tol {
+            return to_global(u);
+        }
+        t
+    }
+}
+
+/// (f, f′, f″) at t by de Casteljau down to the quadratic level (N ≥ 3).
+#[inline]
+fn eval_d2<const N: usize>(c: &[f64; N], t: f64) -> (f64, f64, f64) {
+    let n = (N - 1) as f64;
+    let mut b = *c;
+    let s = 1.0 - t;
+    for r in (3..N).rev() {
+        for i in 0..r {
+            b[i] = s * b[i] + t * b[i + 1];
+        }
+    }
+    let (b0, b1, b2) = (b[0], b[1], b[2]);
+    let f = s * s * b0 + 2.0 * s * t * b1 + t * t * b2;
+    let d1 = n * (s * (b1 - b0) + t * (b2 - b1));
+    let d2 = n * (n - 1.0) * (b0 - 2.0 * b1 + b2);
+    (f, d1, d2)
+}
+
+/// Below this Newton correction (in the interval's own parameter) the iteration has reached
+/// its quadratic phase: the error after the step is ~|f″/f′|·step² ≲ 1e-18·|f″/f′|.
+const NEWTON_DONE: f64 = 1e-9;
+
 /// The root in (0, 1) of a polynomial whose first and last coefficients are non-zero with
 /// opposite signs: Newton from the control polygon's first crossing, kept inside the sign
 /// bracket; a bisection replaces any step that leaves the bracket or that would not halve the
 /// step before last (the `rtsafe` safeguard).
-fn polish(b: &[f64]) -> f64 {
-    let n = b.len() - 1;
+#[inline]
+fn polish<const N: usize>(b: &[f64; N]) -> f64 {
+    let n = N - 1;
     let positive_at_lo = b[0] > 0.0;
     // Start at the control polygon's first crossing of zero.
     let mut u = 0.5;
@@ -212,8 +352,9 @@ fn polish(b: &[f64]) -> f64 {
     }
     let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
     let (mut dx, mut dx_old) = (1.0_f64, 1.0_f64);
+    let mut newton_steps = 0;
     for _ in 0..MAX_POLISH {
-        let (f, df) = eval_with_derivative(b, u);
+        let (f, df) = eval_d(b, u);
         if f == 0.0 {
             return u;
         }
@@ -222,17 +363,28 @@ fn polish(b: &[f64]) -> f64 {
         } else {
             hi = u;
         }
-        let newton = u - f / df;
+        let step = f / df;
+        if step.abs() <= 2.0 * f64::EPSILON * u {
+            // Converged: the correction is below the resolution of u.
+            return u;
+        }
+        let newton = u - step;
         if !(newton > lo && newton < hi) || (2.0 * f).abs() > (dx_old * df).abs() {
             dx_old = dx;
             dx = 0.5 * (hi - lo);
             u = lo + dx;
+            newton_steps = 0;
         } else {
             dx_old = dx;
-            dx = u - newton;
+            dx = step;
             u = newton;
+            newton_steps += 1;
+            // Two successive Newton steps, the last one tiny: quadratic convergence.
+            if newton_steps >= 2 && step.abs() <= NEWTON_DONE {
+                return u;
+            }
         }
-        if dx.abs() <= 2.0 * f64::EPSILON * u || hi - lo <= 2.0 * f64::EPSILON * hi {
+        if hi - lo <= 2.0 * f64::EPSILON * hi {
             return u;
         }
     }
@@ -253,8 +405,9 @@ mod tests {
 
     /// Simple roots are polished to a few ulps.
     const SIMPLE: f64 = 1e-14;
-    /// Tangencies are placed to √(τ/|f″|) ≈ √(1e-13) ≈ 3e-7 (policy of the module).
-    const TOUCH: f64 = 1e-6;
+    /// Tangencies are refined to the extremum (or to the first of two roots rounding split
+    /// them into): √(rounding/|f″|) ≈ √(1e-15) ≈ 3e-8.
+    const TOUCH: f64 = 1e-7;
 
     #[test]
     fn simple_roots() {

@@ -2,6 +2,9 @@
 //! split at its butterfly point (Dyn, Levin and Gregory 1990, tension w = 1/16) and both
 //! triangles are split in two; the new vertex's normal is the same butterfly stencil applied to
 //! the normals, normalised (n_a + n_b normalised when the stencil is incomplete or degenerate).
+//! When the butterfly point would leave a corner normal on the wrong side of a new triangle,
+//! the edge is split at its midpoint instead (the new triangles stay in the old planes and
+//! n_a + n_b is above both).
 
 use super::{edge_map, NO_FACE};
 use crate::error::Result;
@@ -67,6 +70,25 @@ pub fn split_edges(mesh: &mut RefineMesh, edges: &[u32]) -> Result<usize> {
             .try_normalize()
             .or_else(|| (n(a) + n(b)).try_normalize())
             .unwrap_or(n(a));
+        // Every corner normal must stay strictly above the four new triangles; otherwise
+        // split at the plain midpoint (new triangles in the old planes, normal n_a + n_b).
+        let above = |pm: DVec3, nm: DVec3| -> bool {
+            [(a, k), (b, k), (a, l), (b, l)].iter().all(|&(x, z)| {
+                let f = (p(x) - pm).cross(p(z) - pm);
+                let s = n(x) + n(z) + nm;
+                let f = if f.dot(s) < 0.0 { -f } else { f };
+                let Some(f) = f.try_normalize() else {
+                    return false;
+                };
+                [n(x), n(z), nm].iter().all(|v| f.dot(*v) > 1e-9)
+            })
+        };
+        let (pm, nm) = if above(pm, nm) {
+            (pm, nm)
+        } else {
+            let mid = 0.5 * (p(a) + p(b));
+            (mid, (n(a) + n(b)).try_normalize().unwrap_or(n(a)))
+        };
         let m = mesh.positions.len() as u32;
         mesh.positions.push(pm);
         mesh.normals.push(nm);
