@@ -14,6 +14,25 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+/// CPU seconds used by this process so far (Linux `/proc/self/stat`, 100 ticks/s), or NaN:
+/// the machine is shared, so rays per CPU-second is the figure that does not depend on load.
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return f64::NAN;
+    };
+    let Some(rest) = stat.rsplit_once(')').map(|r| r.1) else {
+        return f64::NAN;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let tick = |i: usize| {
+        f.get(i)
+            .and_then(|x| x.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
+    // Fields 14 and 15 (utime, stime) are at 11 and 12 after the command name.
+    (tick(11) + tick(12)) / 100.0
+}
+
 fn bench(name: &str, complex: &apatch::complex::PatchComplex, settings: &trace::RenderSettings) {
     let geo = match Geometry::new(complex) {
         Ok(g) => g,
@@ -36,13 +55,16 @@ fn bench(name: &str, complex: &apatch::complex::PatchComplex, settings: &trace::
             s.mode = mode;
             s.threads = threads;
             let t = Instant::now();
+            let cpu = cpu_seconds();
             let f = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
             let secs = t.elapsed().as_secs_f64();
+            let cpu = cpu_seconds() - cpu;
             let hit = f.pixels.iter().filter(|p| p.alpha > 0.0).count();
             println!(
-                "  {mode:?}, {threads} thread(s): {:.3} s, {:.2} M primary rays/s ({:.0} % of pixels hit)",
+                "  {mode:?}, {threads} thread(s): {:.3} s, {:.2} M primary rays/s, {:.2} M rays per CPU-second ({:.0} % of pixels hit)",
                 secs,
                 1024.0 * 1024.0 / secs / 1e6,
+                1024.0 * 1024.0 / cpu / 1e6,
                 100.0 * hit as f64 / (1024.0 * 1024.0)
             );
         }

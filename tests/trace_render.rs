@@ -280,3 +280,53 @@ output = "out/s.png"
     assert!(e.contains("bad.json:1"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn rational_complex_renders_identically_with_any_thread_count() {
+    use apatch::mesh::{self, NormalMethod};
+    use apatch::scheme::rational_c1::{build, RationalOptions};
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models/icosahedron.obj");
+    let (m, _) = mesh::load(&path).unwrap();
+    let tri = mesh::triangulate(&m);
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let triangles: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    let b = build(
+        &tri.positions,
+        &triangles,
+        &normals,
+        &RationalOptions::default(),
+    )
+    .unwrap();
+    let geo = Geometry::new(&b.complex).unwrap();
+    let (_, mut s) = setup(Mode::Shaded, 1);
+    s.camera = Camera::look_at(
+        DVec3::new(1.5, 2.0, 4.0),
+        DVec3::ZERO,
+        DVec3::Y,
+        35.0,
+        FovAxis::X,
+        40,
+        30,
+        0.01,
+    )
+    .unwrap();
+    let run = |threads: usize| {
+        let mut s = s.clone();
+        s.threads = threads;
+        let f = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
+        output::channels(&f)
+            .into_iter()
+            .flat_map(|(_, v)| v.into_iter().map(f32::to_bits))
+            .collect::<Vec<u32>>()
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(0));
+    s.threads = 0;
+    let f = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
+    assert!(f.pixels.iter().filter(|p| p.alpha > 0.0).count() > 200);
+    for (name, data) in output::channels(&f) {
+        assert!(data.iter().all(|x| x.is_finite()), "{name}");
+    }
+}

@@ -161,7 +161,7 @@ impl Geometry {
             return None;
         }
         let (t0, t1, a0, rate) = p.clip(o, d)?;
-        let pad = CLIP_PAD * (t1 - t0) + 1e-15 * t0.abs().max(t1.abs());
+        let pad = CLIP_PAD * (t1 - t0) + 1e-14 * t0.abs().max(t1.abs()).max(1e-300);
         let (t0, t1) = (t0 - pad, t1 + pad);
         let lo_t = t0.max(tmin);
         let hi_t = t1.min(tmax);
@@ -182,7 +182,7 @@ impl Geometry {
         let s_hi = ((hi_t - t0) / len).min(1.0);
         let mut s_lo = ((lo_t - t0) / len).max(0.0);
         for _ in 0..16 {
-            let s = poly::first_root_in(&c, n, s_lo, s_hi)?;
+            let s = poly::first_root_in_tol(&c, n, s_lo, s_hi, p.zero_tol)?;
             let mut alpha = [0.0; 4];
             for k in 0..4 {
                 alpha[k] = (1.0 - s) * a[k] + s * b[k];

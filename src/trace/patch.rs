@@ -11,6 +11,9 @@ use crate::complex::{Patch, SheetRule};
 use glam::{DMat3, DVec3};
 use std::sync::OnceLock;
 
+/// Relative size of an empty ray interval [t0, t1] (t0 > t1) still treated as a touching point.
+const CLIP_SLACK: f64 = 1e-12;
+
 /// Largest polynomial degree a patch may have.
 pub const MAX_PATCH_DEGREE: usize = 7;
 const MAX_COEFFS: usize = num_coeffs(MAX_PATCH_DEGREE);
@@ -105,6 +108,9 @@ pub struct CompiledPatch {
     /// True when every weight (rational blends included) has the same strict sign: by the
     /// convex hull property F has no zero in the tetrahedron and rays skip the patch.
     pub no_zero: bool,
+    /// Values of the cleared segment polynomial below this count as zero at a segment's ends:
+    /// rounding of F near its zeros, from the patch's largest weight.
+    pub zero_tol: f64,
 }
 
 fn multinomial(l: [u8; 4]) -> f64 {
@@ -280,7 +286,9 @@ impl CompiledPatch {
             (l.min(w), h.max(w))
         });
         let no_zero = lo > 0.0 || hi < 0.0;
+        let zero_tol = 64.0 * f64::EPSILON * lo.abs().max(hi.abs()) * segment_degree as f64;
         Ok(CompiledPatch {
+            zero_tol,
             no_zero,
             base_order,
             top_weight,
@@ -328,8 +336,17 @@ impl CompiledPatch {
                 return None;
             }
         }
-        if t0 > t1 || !t0.is_finite() || !t1.is_finite() {
+        if !t0.is_finite() || !t1.is_finite() {
             return None;
+        }
+        if t0 > t1 {
+            // A ray through a vertex or edge touches the closed tetrahedron in one point, which
+            // rounding can turn into an empty interval: keep it when the gap is rounding-sized.
+            if t0 - t1 > CLIP_SLACK * (t0.abs() + t1.abs()) {
+                return None;
+            }
+            let m = 0.5 * (t0 + t1);
+            return Some((m, m, a, rate));
         }
         Some((t0, t1, a, rate))
     }

@@ -128,6 +128,14 @@ const MIN_WIDTH: f64 = 1e-13;
 /// coefficients). A value within rounding of zero at `lo` is a root at `lo`.
 #[must_use]
 pub fn first_root_in(c: &[f64], n: usize, lo: f64, hi: f64) -> Option<f64> {
+    first_root_in_tol(c, n, lo, hi, 0.0)
+}
+
+/// [`first_root_in`] where values up to `zero` in magnitude also count as zero at the ends
+/// (the caller's scale: e.g. a patch's largest weight, when the segment is so short that its
+/// own coefficients are all rounding noise — a ray through a mesh vertex).
+#[must_use]
+pub fn first_root_in_tol(c: &[f64], n: usize, lo: f64, hi: f64, zero: f64) -> Option<f64> {
     if lo > hi || n > MAX_DEGREE {
         return None;
     }
@@ -135,7 +143,7 @@ pub fn first_root_in(c: &[f64], n: usize, lo: f64, hi: f64) -> Option<f64> {
     if scale == 0.0 {
         return Some(lo);
     }
-    let zero = END_ZERO * scale * (n.max(1) as f64);
+    let zero = zero.max(END_ZERO * scale * (n.max(1) as f64));
     // Restrict to [lo, hi] first.
     let mut work = [0.0; MAX_DEGREE + 1];
     work[..=n].copy_from_slice(&c[..=n]);

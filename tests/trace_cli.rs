@@ -1,0 +1,90 @@
+//! `apatch render` end to end: overrides, outputs (PNG + EXR, no temporary files left), and
+//! one-line errors with exit code 2 that name the scene file and key.
+
+use apatch::fixtures::{quadric_complex, Quadric};
+use glam::DVec3;
+use std::path::PathBuf;
+use std::process::Command;
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("apatch-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const SCENE: &str = r#"
+[model]
+patches = "sphere.json"
+[camera]
+origin = [0, 0, 4]
+target = [0, 0, 0]
+up = [0, 1, 0]
+fov = 40
+width = 320
+height = 240
+[film]
+spp = 8
+[[lights]]
+type = "directional"
+direction = [-1, -1, -1]
+irradiance = 3.0
+[render]
+output = "out/sphere.png"
+"#;
+
+fn setup(name: &str, scene: &str) -> PathBuf {
+    let dir = scratch(name);
+    let q = Quadric::sphere(DVec3::ZERO, 1.0);
+    let c = quadric_complex(&q, DVec3::splat(-1.2), DVec3::splat(1.2), 2, 2);
+    std::fs::write(dir.join("sphere.json"), serde_json::to_string(&c).unwrap()).unwrap();
+    std::fs::write(dir.join("s.toml"), scene).unwrap();
+    dir
+}
+
+#[test]
+fn render_writes_png_and_exr_with_overrides() {
+    let dir = setup("ok", SCENE);
+    let out = Command::new(env!("CARGO_BIN_EXE_apatch"))
+        .args([
+            "render", "s.toml", "--width", "24", "--height", "16", "--spp", "1",
+        ])
+        .args(["--mode", "normal", "--threads", "1", "--output", "o/x.exr"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let png = image::open(dir.join("o/x.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (24, 16));
+    assert!(dir.join("o/x.exr").exists());
+    let files: Vec<_> = std::fs::read_dir(dir.join("o")).unwrap().collect();
+    assert_eq!(files.len(), 2, "temporary files left behind");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_scene_exits_2_naming_file_and_key() {
+    let dir = setup("bad", &SCENE.replace("fov = 40", "fov = 40\nfocal = 3"));
+    let out = Command::new(env!("CARGO_BIN_EXE_apatch"))
+        .args(["render", "s.toml"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("s.toml") && err.contains("focal"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    std::fs::write(dir.join("s.toml"), SCENE).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_apatch"))
+        .args(["render", "s.toml", "--mode", "fancy"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    // This scene is fine; the override is not.
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--mode"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
