@@ -17,7 +17,7 @@ struct Cli {
 enum Command {
     /// Measure a patch complex: continuity, interpolation, sheets. Non-zero exit on failure.
     Check(cli::check::CheckArgs),
-    /// Write the patch complex (JSON) or a Mitsuba 3 scene.
+    /// Write the patch complex as JSON.
     #[command(subcommand)]
     Export(cli::export::ExportCommand),
     /// Describe a mesh: counts, topology, convexity, validation findings.
