@@ -2,7 +2,7 @@
 //! closed, oriented 2-manifold of the input's genus, outward, on the surface, through the mesh
 //! vertices.
 
-use apatch::complex::PatchComplex;
+use apatch::complex::{PatchComplex, Role};
 use apatch::export::{tessellate, TriMesh};
 use apatch::scheme::rational_c1::{build, RationalOptions};
 use glam::DVec3;
@@ -230,5 +230,12 @@ fn octahedron_is_a_closed_sphere() {
 
 #[test]
 fn torus_has_genus_one() {
-    check_closed(&torus(12, 8), 4, 1, "torus");
+    let c = torus(12, 8);
+    // The inner ring is saddle-shaped: nonconvex faces with negative-side (v) tetrahedra, so
+    // the two-sided path is exercised.
+    assert!(c
+        .patches
+        .iter()
+        .any(|p| p.role == Role::Face && p.weights.last().is_some_and(|w| *w < 0.0)));
+    check_closed(&c, 4, 1, "torus");
 }

@@ -461,3 +461,39 @@ fn strip_triangles(a: &[u32], c: &[u32], pos: &[DVec3], out: &mut Vec<[u32; 3]>)
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures::{quadric_complex, Quadric};
+
+    /// Both orientations of a segment give bit-identical grid points (the watertightness key).
+    #[test]
+    fn segment_points_do_not_depend_on_orientation() {
+        let a = DVec3::new(0.1, -0.3, 0.7);
+        let b = DVec3::new(-1.3, 0.37, 0.2);
+        for n in 1..9 {
+            for k in 0..=n {
+                assert_eq!(key(seg_point(a, b, k, n)), key(seg_point(b, a, n - k, n)));
+            }
+        }
+        let p = [a, b, DVec3::new(0.3, 0.3, 0.3)];
+        let q = [b, p[2], a];
+        // (i, j, k) of p is (j, k, i) of q.
+        assert_eq!(key(tri_point(p, 2, 3, 0, 5)), key(tri_point(q, 3, 0, 2, 5)));
+    }
+
+    /// Single-sheet (`SheetRule::Any`) complexes are refused with the documented message.
+    #[test]
+    fn any_rule_complexes_are_refused() {
+        let q = Quadric::sphere(DVec3::ZERO, 0.7);
+        let c = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 2);
+        let e = tessellate(&c, 2).unwrap_err().to_string();
+        assert!(
+            e.contains("tessellation needs shooting-rule patches"),
+            "{e}"
+        );
+        let e = tessellate(&c, 0).unwrap_err().to_string();
+        assert!(e.contains("resolution"), "{e}");
+    }
+}
