@@ -173,10 +173,10 @@ fn topology(m: &TriMesh) -> (i64, f64) {
 
 /// Largest |F|/|∇F| over the output points (F from a patch whose tetrahedron holds the point,
 /// the smallest over such patches), relative to the model's size.
-fn worst_distance(c: &PatchComplex, m: &TriMesh) -> f64 {
+fn worst_distance(c: &PatchComplex, m: &TriMesh, stride: usize) -> f64 {
     let tets: Vec<_> = c.patches.iter().map(|p| p.tet().expect("tet")).collect();
     let mut worst: f64 = 0.0;
-    for x in &m.positions {
+    for x in m.positions.iter().step_by(stride) {
         let x = DVec3::from_array(*x);
         let mut best = f64::INFINITY;
         for (p, t) in c.patches.iter().zip(&tets) {
@@ -204,7 +204,7 @@ fn check_closed(c: &PatchComplex, res: usize, genus: i64, name: &str) {
     }
     // Root finding resolves t to ~2^-30 of a segment then polishes with Newton; 1e-8 of the
     // model size (≈ 1) leaves a margin over that and is far below grid spacing.
-    let d = worst_distance(c, &m);
+    let d = worst_distance(c, &m, 1);
     assert!(d < 1e-8, "{name}: a point is {d} from the surface");
     let have: HashSet<[u64; 3]> = m.positions.iter().map(|p| p.map(f64::to_bits)).collect();
     for v in &c.vertices {
@@ -238,4 +238,43 @@ fn torus_has_genus_one() {
         .iter()
         .any(|p| p.role == Role::Face && p.weights.last().is_some_and(|w| *w < 0.0)));
     check_closed(&c, 4, 1, "torus");
+}
+
+/// A repository scene's complex (scene::load + build_complex, as the CLI does).
+fn scene_complex(name: &str) -> PatchComplex {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{name}"));
+    let scene = apatch::scene::load(&path).expect("scene loads");
+    apatch::scene::build_complex(&scene).expect("scene builds")
+}
+
+/// Topology, orientation, interpolation and (on about 150 of the points: the brute-force
+/// search is quadratic) the distance to the surface on real models.
+fn check_scene(name: &str, res: usize, genus: i64) {
+    let c = scene_complex(name);
+    let m = tessellate(&c, res).expect("tessellates");
+    let (chi, vol) = topology(&m);
+    assert_eq!(chi, 2 - 2 * genus, "{name}: Euler characteristic");
+    assert!(vol > 0.0, "{name}: signed volume {vol} not outward");
+    let have: HashSet<[u64; 3]> = m.positions.iter().map(|p| p.map(f64::to_bits)).collect();
+    for v in &c.vertices {
+        assert!(
+            have.contains(&v.map(f64::to_bits)),
+            "{name}: vertex {v:?} not interpolated"
+        );
+    }
+}
+
+#[test]
+fn nut_scene_has_genus_one() {
+    check_scene("nut.toml", 2, 1);
+}
+
+#[test]
+fn spot_scene_is_a_sphere() {
+    check_scene("spot.toml", 2, 0);
+}
+
+#[test]
+fn knot_scene_has_genus_one() {
+    check_scene("knot.toml", 2, 1);
 }
