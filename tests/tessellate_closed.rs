@@ -198,9 +198,17 @@ fn check_closed(c: &PatchComplex, res: usize, genus: i64, name: &str) {
     let (chi, vol) = topology(&m);
     assert_eq!(chi, 2 - 2 * genus, "{name}: Euler characteristic");
     assert!(vol > 0.0, "{name}: signed volume {vol} not outward");
-    // Normals: unit and on the outer side of their triangles on average.
+    // Normals: unit (to rounding), and every triangle faces the way its vertices' ∇F normals
+    // point (orientation agrees with the outward gradient everywhere, not just on average).
     for nn in &m.normals {
         assert!((DVec3::from_array(*nn).length() - 1.0).abs() < 1e-12);
+    }
+    let p = |i: u32| DVec3::from_array(m.positions[i as usize]);
+    let nv = |i: u32| DVec3::from_array(m.normals[i as usize]);
+    for t in &m.triangles {
+        let g = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+        let n = nv(t[0]) + nv(t[1]) + nv(t[2]);
+        assert!(g.dot(n) > 0.0, "{name}: triangle {t:?} faces against ∇F");
     }
     // Root finding resolves t to ~2^-30 of a segment then polishes with Newton; 1e-8 of the
     // model size (≈ 1) leaves a margin over that and is far below grid spacing.
@@ -266,6 +274,11 @@ fn check_scene(name: &str, res: usize, genus: i64) {
 
 #[test]
 fn nut_scene_has_genus_one() {
+    // The nut has zero-convex (planar) faces: the planar path is exercised.
+    assert!(scene_complex("nut.toml")
+        .patches
+        .iter()
+        .any(|p| p.role == Role::Planar));
     check_scene("nut.toml", 2, 1);
 }
 
