@@ -17,7 +17,8 @@
 //! with ∇F (outward: F > 0 outside). Vertex normals are ∇F/|∇F| (the complex's normals at mesh
 //! vertices). Only [`SheetRule::Shooting`] complexes with the 2001 layouts (face: base [0,1,2]
 //! top [3]; edge: base [0,1] top [2,3]) and planar patches are supported; anything else is an
-//! error ("tessellation needs shooting-rule patches").
+//! error ("tessellation needs shooting-rule patches"). Mesh edges with one face (open meshes)
+//! get no strip, so open inputs give open tessellations.
 
 use crate::bb::uni::first_root;
 use crate::bb::{index_of, Tet};
@@ -212,12 +213,22 @@ impl Builder<'_> {
 /// Tessellates `complex` with `resolution` grid intervals per patch edge.
 ///
 /// # Errors
-/// A resolution outside 1..=[`MAX_RESOLUTION`], or a complex that is not made of shooting-rule
+/// A resolution outside 1..=[`MAX_RESOLUTION`] or one that could give more than `i32::MAX`
+/// vertices, or a complex that is not made of shooting-rule
 /// face/edge patches and planar patches ("tessellation needs shooting-rule patches").
 pub fn tessellate(complex: &PatchComplex, resolution: usize) -> anyhow::Result<TriMesh> {
     let n = resolution;
     if n == 0 || n > MAX_RESOLUTION {
         anyhow::bail!("resolution must be in 1..={MAX_RESOLUTION}, got {n}");
+    }
+    // Every patch contributes at most (n+1)(n+2)/2 new points (edge strips (n+1)², fewer).
+    let bound = complex.patches.len().saturating_mul((n + 1) * (n + 1));
+    if bound > i32::MAX as usize {
+        anyhow::bail!(
+            "resolution {n} on {} patches could exceed {} vertices; use a smaller resolution",
+            complex.patches.len(),
+            i32::MAX
+        );
     }
     let face_rule = SheetRule::Shooting {
         base: vec![0, 1, 2],
