@@ -90,8 +90,8 @@ fn bunny_scene() {
     // Measured cause of the residuals (not a C¹ break): the edge tetrahedra of nearly flat
     // dihedrals are thin (relative volume down to 6e-6, edge 2992), and C¹ forces their cubic
     // to bend across that thin direction: `apatch check scenes/bunny.toml` reports Hessian
-    // jumps of 7e7 (relative) at exactly that pair (face 3702 / edge 2992). A sample point carries rounding of
-    // 1e-16 × |x| ≈ 1e-15 (coordinates up to ~10), which moves ∇F there by up to ~1e-7
+    // jumps of 7e7 (relative) at exactly that pair (face 3702 / edge 2992). A sample point
+    // carries rounding of 1e-16 × |x| ≈ 1e-15 (coordinates up to ~10), which moves ∇F by ~1e-7
     // relative: that is the gradient "jump" this world-space test sees (the check command,
     // evaluating both patches at the same barycentric point, measures 4e-13) and the 1e-10
     // normal deviation at corners. Tolerances: 10x above those; a real C¹ break is ≥ 1e-4.
