@@ -18,6 +18,13 @@ fn run(name: &str) {
 }
 
 fn run_with(name: &str, opts: &RationalOptions) {
+    run_full(name, opts, NormalMethod::Loop, [INTERP_TOL, JUMP_TOL]);
+}
+
+/// `tol`: tolerances of the normal interpolation (unit-vector distance) and of the relative
+/// gradient jumps.
+fn run_full(name: &str, opts: &RationalOptions, method: NormalMethod, tol: [f64; 2]) {
+    let [grad_tol, jump_tol] = tol;
     let path = Path::new("/work/shared/meshes").join(format!("{name}.obj"));
     if !path.exists() {
         eprintln!("{name}: not present, skipped");
@@ -25,7 +32,7 @@ fn run_with(name: &str, opts: &RationalOptions) {
     }
     let (mesh, _report) = load(&path).expect("loads");
     let mesh = triangulate(&mesh);
-    let normals = vertex_normals(&mesh, NormalMethod::Loop).expect("normals");
+    let normals = vertex_normals(&mesh, method).expect("normals");
     let tris: Vec<[u32; 3]> = mesh.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
     let b = match build(&mesh.positions, &tris, &normals, opts) {
         Ok(b) => b,
@@ -51,11 +58,11 @@ fn run_with(name: &str, opts: &RationalOptions) {
         cont.max_sharing
     );
     assert!(
-        fv < INTERP_TOL && gv < INTERP_TOL,
+        fv < INTERP_TOL && gv < grad_tol,
         "{name}: interpolation {fv} {gv}"
     );
     assert!(
-        cont.max_value_jump < JUMP_TOL && cont.max_grad_jump < JUMP_TOL,
+        cont.max_value_jump < JUMP_TOL && cont.max_grad_jump < jump_tol,
         "{name}: jumps"
     );
     assert!(
@@ -71,10 +78,30 @@ fn run_with(name: &str, opts: &RationalOptions) {
 fn spot() {
     run("spot");
 }
+/// The README's render: `scenes/bunny.toml` (angle-weighted normals, ε = 0.02, up to 8
+/// refinement rounds). Regression for the 1e-5 gradient jumps once reported on it.
 #[test]
-#[ignore = "known failure: with ε = 0.01 it builds (11 edges refined) but interpolation of the \
-            normals is 4e-8 and gradient jumps 1e-5 (unexplained; suspect thin tetrahedra \
-            after refinement); with the default ε refinement does not converge"]
+fn bunny_scene() {
+    let opts = RationalOptions {
+        epsilon: 0.02,
+        refine_rounds: 8,
+        ..RationalOptions::default()
+    };
+    // Measured cause of the residuals (not a C¹ break): the edge tetrahedra of nearly flat
+    // dihedrals are thin (relative volume down to 6e-6, edge 2992), and C¹ forces their cubic
+    // to bend across that thin direction: `apatch check scenes/bunny.toml` reports Hessian
+    // jumps of 7e7 (relative) at exactly that pair (face 3702 / edge 2992). A sample point
+    // carries rounding of 1e-16 × |x| ≈ 1e-15 (coordinates up to ~10), which moves ∇F by ~1e-7
+    // relative: that is the gradient "jump" this world-space test sees (the check command,
+    // evaluating both patches at the same barycentric point, measures 4e-13) and the 1e-10
+    // normal deviation at corners. Tolerances: 10x above those; a real C¹ break is ≥ 1e-4.
+    run_full("bunny_npm_lowres", &opts, NormalMethod::Angle, [1e-9, 1e-6]);
+}
+#[test]
+#[ignore = "known limitation: with Loop normals and ε = 0.01 the edge tetrahedron of edge 850 \
+            has relative volume 2e-7 (nearly coplanar u_A, u_B, p_i, p_j): its cubic bends sharply \
+            across the thin direction, so rounding of the evaluation point moves ∇F at vertex \
+            320 by 4e-8 (the face patches interpolate to 1e-14); see bunny_scene"]
 fn bunny() {
     // With the default ε = 0.05 two face tetrahedra pairs keep intersecting through the
     // refinement rounds; a smaller ε (flatter tetrahedra) builds after refining a few edges.
