@@ -81,12 +81,15 @@ def render(scene_path, out_path, spp, variant, quiet):
             "the mitsuba Python package is missing: "
             "python3 -m venv .venv && .venv/bin/pip install mitsuba numpy"
         )
+    if not os.path.isfile(scene_path):
+        raise RuntimeError("%s: no such file" % scene_path)
+    out_dir = os.path.dirname(out_path) or "."
+    if not os.path.isdir(out_dir):
+        raise RuntimeError("%s: directory %s does not exist" % (out_path, out_dir))
     variant = choose_variant(variant, mi)
     mi.set_variant(variant)
     if not quiet:
         print("mitsuba %s, variant %s" % (mi.__version__, variant), file=sys.stderr)
-    if not os.path.isfile(scene_path):
-        raise RuntimeError("%s: no such file" % scene_path)
     try:
         scene = mi.load_file(scene_path)
     except Exception as e:  # Mitsuba raises plain Exceptions with multi-line text
