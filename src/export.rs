@@ -1,1 +1,0 @@
-//! `export` module (see ARCHITECTURE.md).

@@ -1,0 +1,42 @@
+//! Every scene shipped in `scenes/` and `scenes/paper2001/` loads, builds its patch complex and
+//! passes `apatch check` with the default tolerances (the product's promise for what we ship:
+//! a scene that does not build belongs in `scenes/pending/`).
+
+use apatch::check::{check, CheckOptions};
+use apatch::scene;
+use std::path::{Path, PathBuf};
+
+fn scenes(dir: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let mut v: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn shipped_scenes_build_and_pass_check() {
+    let all: Vec<_> = scenes("scenes")
+        .into_iter()
+        .chain(scenes("scenes/paper2001"))
+        .collect();
+    // At least the four real models that build today and the paper's figures.
+    assert!(all.len() >= 10, "{all:?}");
+    let mut failures = Vec::new();
+    for path in &all {
+        let result = scene::load(path).and_then(|s| scene::build_complex(&s));
+        match result {
+            Err(e) => failures.push(format!("{}: {e:#}", path.display())),
+            Ok(complex) => {
+                let report = check(&complex, &CheckOptions::default());
+                if !report.passed() {
+                    failures.push(format!("{}: {:?}", path.display(), report.failures()));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
