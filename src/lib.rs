@@ -20,6 +20,7 @@
 
 pub mod bb;
 pub mod check;
+pub mod compare;
 pub mod complex;
 pub mod complex_io;
 pub mod error;

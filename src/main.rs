@@ -17,6 +17,8 @@ struct Cli {
 enum Command {
     /// Measure a patch complex: continuity, interpolation, sheets. Non-zero exit on failure.
     Check(cli::check::CheckArgs),
+    /// Compare two EXR renders: RMSE, PSNR, SSIM, difference pictures.
+    Compare(cli::compare::CompareArgs),
     /// Write the patch complex as JSON.
     #[command(subcommand)]
     Export(cli::export::ExportCommand),
@@ -32,6 +34,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Check(a) => cli::check::run(a),
+        Command::Compare(a) => cli::compare::run(a),
         Command::Export(a) => cli::export::run(a),
         Command::Info(a) => cli::info::run(a),
         Command::Render(a) => cli::render::run(a),

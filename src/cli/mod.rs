@@ -2,6 +2,7 @@
 //! the process exit code; errors become one line on stderr and exit code 2 (see `main.rs`).
 
 pub mod check;
+pub mod compare;
 pub mod export;
 pub mod info;
 pub mod render;
