@@ -1,4 +1,4 @@
-//! `apatch export patches|…`.
+//! `apatch export patches|mitsuba`.
 
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
@@ -9,6 +9,8 @@ use std::process::ExitCode;
 pub enum ExportCommand {
     /// The patch complex as JSON (format `apatch-patches`, version 1).
     Patches(PatchesArgs),
+    /// A Mitsuba 3 scene: `<dir>/<stem>.xml` plus the tessellated surface `<dir>/<stem>.ply`.
+    Mitsuba(MitsubaArgs),
 }
 
 /// Arguments of `apatch export patches`.
@@ -21,12 +23,46 @@ pub struct PatchesArgs {
     pub output: PathBuf,
 }
 
+/// Arguments of `apatch export mitsuba`.
+#[derive(Args, Debug)]
+pub struct MitsubaArgs {
+    /// The scene (.toml).
+    pub scene: PathBuf,
+    /// Output directory (created when missing).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Grid intervals per patch edge of the tessellation.
+    #[arg(long, default_value_t = 8)]
+    pub resolution: usize,
+}
+
 /// Runs `apatch export …`.
 pub fn run(cmd: ExportCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         ExportCommand::Patches(a) => {
             let complex = super::check::load_complex(&a.input)?;
             apatch::complex_io::write_json_file(&complex, &a.output)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        ExportCommand::Mitsuba(a) => {
+            let is_toml = a
+                .scene
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+            if !is_toml {
+                anyhow::bail!("{}: expected a scene .toml", a.scene.display());
+            }
+            let scene = apatch::scene::load(&a.scene)?;
+            let complex = super::check::load_complex(&a.scene)?;
+            let done = apatch::export::mitsuba::export(&scene, &complex, &a.output, a.resolution)?;
+            println!(
+                "{}: {} ({} vertices, {} triangles)",
+                done.xml.display(),
+                done.ply.display(),
+                done.vertices,
+                done.triangles
+            );
             Ok(ExitCode::SUCCESS)
         }
     }

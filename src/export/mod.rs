@@ -1,6 +1,7 @@
 //! Exporters of the A-patch surface: tessellation to a triangle mesh ([`tessellate`]) and the
-//! PLY / OBJ writers ([`ply`], [`obj`]).
+//! PLY / OBJ writers ([`ply`], [`obj`]), and Mitsuba 3 scenes ([`mitsuba`]).
 
+pub mod mitsuba;
 pub mod obj;
 pub mod ply;
 pub mod tessellate;

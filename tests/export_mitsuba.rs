@@ -1,0 +1,241 @@
+//! `apatch export mitsuba` from the command line: the XML read back (plain string parsing) carries
+//! the scene's sensor, film, sampler and emitters, and the PLY beside it has the vertex count of
+//! `tessellate`; a bad scene is one line, exit 2, and no output.
+
+use apatch::trace::Light;
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tmp(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("export_mitsuba_{name}"))
+}
+
+fn apatch(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_apatch"))
+        .args(args)
+        .output()
+        .expect("run apatch")
+}
+
+fn cube() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cube.toml")
+}
+
+/// The value of attribute `name` in the first element of `xml` that starts with `head`.
+fn attr(xml: &str, head: &str, name: &str) -> String {
+    let start = xml
+        .find(head)
+        .unwrap_or_else(|| panic!("no `{head}` in\n{xml}"));
+    let element = &xml[start..start + xml[start..].find('>').expect("element closes")];
+    let key = format!(" {name}=\"");
+    let a = element
+        .find(&key)
+        .unwrap_or_else(|| panic!("no {name} in {element}"))
+        + key.len();
+    element[a..a + element[a..].find('"').unwrap()].to_string()
+}
+
+fn triple(s: &str) -> DVec3 {
+    let v: Vec<f64> = s.split(',').map(|t| t.trim().parse().unwrap()).collect();
+    assert_eq!(v.len(), 3, "{s}");
+    DVec3::new(v[0], v[1], v[2])
+}
+
+fn num<T: std::str::FromStr>(s: &str) -> T
+where
+    T::Err: std::fmt::Debug,
+{
+    s.parse().unwrap()
+}
+
+/// The `element vertex N` count of a PLY header.
+fn ply_vertices(path: &Path) -> usize {
+    let bytes = std::fs::read(path).unwrap();
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .expect("PLY header");
+    let header = std::str::from_utf8(&bytes[..end]).unwrap();
+    assert!(header.contains("property float nx"), "normals: {header}");
+    header
+        .lines()
+        .find_map(|l| l.strip_prefix("element vertex "))
+        .expect("vertex element")
+        .trim()
+        .parse()
+        .unwrap()
+}
+
+#[test]
+fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
+    let dir = tmp("cube");
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = apatch(&[
+        "export",
+        "mitsuba",
+        cube().to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+        "--resolution",
+        "3",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let xml = std::fs::read_to_string(dir.join("cube.xml")).unwrap();
+    let scene = apatch::scene::load(&cube()).unwrap();
+    let s = &scene.settings;
+    let c = &s.camera;
+
+    assert_eq!(attr(&xml, "<scene", "version"), "3.0.0");
+    // Sensor: the file's own look-at (cube.toml: origin, target [0,0,0], up [0,1,0]) and fov.
+    assert_eq!(attr(&xml, "<sensor", "type"), "perspective");
+    assert_eq!(triple(&attr(&xml, "<lookat", "origin")), c.origin);
+    assert_eq!(triple(&attr(&xml, "<lookat", "target")), DVec3::ZERO);
+    assert_eq!(triple(&attr(&xml, "<lookat", "up")), DVec3::Y);
+    assert_eq!(
+        num::<f64>(&attr(&xml, "<float name=\"fov\"", "value")),
+        c.fov
+    );
+    assert_eq!(attr(&xml, "<string name=\"fov_axis\"", "value"), "x");
+    assert_eq!(
+        num::<f64>(&attr(&xml, "<float name=\"near_clip\"", "value")),
+        c.near_clip
+    );
+    // Film, sampler, integrator, material.
+    assert_eq!(attr(&xml, "<film", "type"), "hdrfilm");
+    assert_eq!(
+        num::<u32>(&attr(&xml, "<integer name=\"width\"", "value")),
+        c.width
+    );
+    assert_eq!(
+        num::<u32>(&attr(&xml, "<integer name=\"height\"", "value")),
+        c.height
+    );
+    assert_eq!(attr(&xml, "<string name=\"pixel_format\"", "value"), "rgba");
+    assert_eq!(attr(&xml, "<rfilter", "type"), "box");
+    assert_eq!(attr(&xml, "<sampler", "type"), "independent");
+    assert_eq!(
+        num::<u32>(&attr(&xml, "<integer name=\"sample_count\"", "value")),
+        s.spp
+    );
+    assert_eq!(attr(&xml, "<integrator", "type"), "direct");
+    assert_eq!(
+        triple(&attr(&xml, "<rgb name=\"reflectance\"", "value")),
+        s.lighting.albedo
+    );
+    // Emitters, in scene order (cube.toml: directional, constant).
+    let emitters: Vec<&str> = xml.split("<emitter ").skip(1).collect();
+    assert_eq!(emitters.len(), s.lighting.lights.len());
+    for (e, light) in emitters.iter().zip(&s.lighting.lights) {
+        let e = format!("<emitter {e}");
+        match *light {
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                assert_eq!(attr(&e, "<emitter", "type"), "directional");
+                let d = DVec3::new(
+                    num(&attr(&e, "<vector", "x")),
+                    num(&attr(&e, "<vector", "y")),
+                    num(&attr(&e, "<vector", "z")),
+                );
+                assert_eq!(d, direction);
+                assert_eq!(
+                    triple(&attr(&e, "<rgb name=\"irradiance\"", "value")),
+                    irradiance
+                );
+            }
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                assert_eq!(attr(&e, "<emitter", "type"), "point");
+                let p = DVec3::new(
+                    num(&attr(&e, "<point", "x")),
+                    num(&attr(&e, "<point", "y")),
+                    num(&attr(&e, "<point", "z")),
+                );
+                assert_eq!(p, position);
+                assert_eq!(
+                    triple(&attr(&e, "<rgb name=\"intensity\"", "value")),
+                    intensity
+                );
+            }
+            Light::Constant { radiance } => {
+                assert_eq!(attr(&e, "<emitter", "type"), "constant");
+                assert_eq!(
+                    triple(&attr(&e, "<rgb name=\"radiance\"", "value")),
+                    radiance
+                );
+            }
+        }
+    }
+    // The mesh: a path relative to the XML, there, with tessellate's vertex count.
+    let ply = attr(&xml, "<string name=\"filename\"", "value");
+    assert_eq!(ply, "cube.ply");
+    let complex = apatch::scene::build_complex(&scene).unwrap();
+    let mesh = apatch::export::tessellate(&complex, 3).unwrap();
+    assert_eq!(ply_vertices(&dir.join(&ply)), mesh.positions.len());
+}
+
+#[test]
+fn depth_mode_exports_the_aov_integrator() {
+    let dir = tmp("depth");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(cube())
+        .unwrap()
+        .replace("mode = \"shaded\"", "mode = \"depth\"")
+        .replace(
+            "models/",
+            &format!("{}/scenes/models/", env!("CARGO_MANIFEST_DIR")),
+        );
+    let toml = dir.join("d.toml");
+    std::fs::write(&toml, text).unwrap();
+    let out = dir.join("out");
+    let o = apatch(&[
+        "export",
+        "mitsuba",
+        toml.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--resolution",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let xml = std::fs::read_to_string(out.join("d.xml")).unwrap();
+    assert_eq!(attr(&xml, "<integrator", "type"), "aov");
+    assert_eq!(
+        attr(&xml, "<string name=\"aovs\"", "value"),
+        "nn:sh_normal,dd:depth"
+    );
+    assert!(out.join("d.ply").exists());
+}
+
+#[test]
+fn bad_scene_is_one_line_exit_2_and_writes_nothing() {
+    let dir = tmp("bad");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = dir.join("bad.toml");
+    let text = std::fs::read_to_string(cube())
+        .unwrap()
+        .replace("fov = 30", "fov = 300");
+    std::fs::write(&toml, text).unwrap();
+    let out = dir.join("out");
+    let o = apatch(&[
+        "export",
+        "mitsuba",
+        toml.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("bad.toml") && err.contains("camera.fov"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
