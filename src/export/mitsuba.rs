@@ -32,60 +32,20 @@ pub struct LookAt {
 }
 
 impl LookAt {
-    /// The look-at of `camera`'s frame: `target = origin + f`, `up = y`. Mitsuba builds the same
-    /// frame from it as from the scene file's own origin, target and up.
+    /// The look-at `camera` was built from: the scene's own origin, target and up.
     #[must_use]
     pub fn from_camera(camera: &Camera) -> Self {
         LookAt {
             origin: camera.origin,
-            target: camera.origin + camera.f,
-            up: camera.y,
+            target: camera.target,
+            up: camera.up,
         }
     }
 
-    /// The `[camera]` `origin`, `target` and `up` (default `[0, 1, 0]`) of scene TOML `text`,
-    /// or `None` when they are missing or not three numbers each.
-    #[must_use]
-    pub fn from_scene_toml(text: &str) -> Option<Self> {
-        let table: toml::Table = toml::from_str(text).ok()?;
-        let camera = table.get("camera")?.as_table()?;
-        let vec3 = |key: &str| -> Option<DVec3> {
-            let a = camera.get(key)?.as_array()?;
-            if a.len() != 3 {
-                return None;
-            }
-            let mut v = [0.0; 3];
-            for (vi, x) in v.iter_mut().zip(a) {
-                *vi = x.as_float().or_else(|| x.as_integer().map(|i| i as f64))?;
-            }
-            Some(DVec3::from_array(v))
-        };
-        let up = match camera.get("up") {
-            Some(_) => vec3("up")?,
-            None => DVec3::Y,
-        };
-        Some(LookAt {
-            origin: vec3("origin")?,
-            target: vec3("target")?,
-            up,
-        })
-    }
-
-    /// The look-at of `scene`: its file's own values when the file still reads and agrees with
-    /// the scene's camera, else [`LookAt::from_camera`].
+    /// The look-at of `scene`'s camera.
     #[must_use]
     pub fn of_scene(scene: &Scene) -> Self {
-        let camera = &scene.settings.camera;
-        std::fs::read_to_string(&scene.path)
-            .ok()
-            .and_then(|t| LookAt::from_scene_toml(&t))
-            .filter(|l| {
-                // The file may have changed since it was loaded: accept it only when it gives
-                // the loaded camera's eye and view direction (to rounding).
-                let f = (l.target - l.origin).normalize_or_zero();
-                l.origin == camera.origin && f.dot(camera.f) > 1.0 - 1e-12
-            })
-            .unwrap_or_else(|| LookAt::from_camera(camera))
+        LookAt::from_camera(&scene.settings.camera)
     }
 }
 
@@ -354,14 +314,12 @@ mode = "depth"
 "#;
 
     #[test]
-    fn look_at_reads_the_file_values_and_defaults_up() {
-        let l = LookAt::from_scene_toml(SCENE).unwrap();
+    fn look_at_is_the_scene_files_values() {
+        let scene = crate::scene::parse(SCENE, Path::new("x.toml")).unwrap();
+        let l = LookAt::of_scene(&scene);
         assert_eq!(l.origin, DVec3::new(1.0, 2.5, 6.0));
         assert_eq!(l.target, DVec3::new(0.0, 0.25, 0.0));
         assert_eq!(l.up, DVec3::Z);
-        let no_up = SCENE.replace("up = [0, 0, 1]\n", "");
-        assert_eq!(LookAt::from_scene_toml(&no_up).unwrap().up, DVec3::Y);
-        assert!(LookAt::from_scene_toml("[camera]\norigin = [1, 2]\ntarget = [0, 0, 0]").is_none());
     }
 
     #[test]
@@ -389,7 +347,7 @@ mode = "depth"
     #[test]
     fn xml_carries_mode_film_material_and_point_light() {
         let scene = crate::scene::parse(SCENE, Path::new("x.toml")).unwrap();
-        let l = LookAt::from_scene_toml(SCENE).unwrap();
+        let l = LookAt::of_scene(&scene);
         let x = scene_xml(&scene, &l, "a&b.ply");
         assert!(x.contains(r#"<integrator type="aov">"#), "{x}");
         assert!(x.contains(r#"value="nn:sh_normal,dd:depth""#), "{x}");

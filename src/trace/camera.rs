@@ -59,6 +59,10 @@ impl FromStr for FovAxis {
 pub struct Camera {
     /// Eye position.
     pub origin: DVec3,
+    /// The look-at target the camera was built from (kept for exporters).
+    pub target: DVec3,
+    /// The up hint the camera was built from (kept for exporters).
+    pub up: DVec3,
     /// Local +X (image left).
     pub x: DVec3,
     /// Local +Y (image up).
@@ -141,6 +145,8 @@ impl Camera {
         };
         Ok(Camera {
             origin,
+            target,
+            up,
             x,
             y,
             f,
