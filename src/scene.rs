@@ -51,7 +51,7 @@
 //! patch_boundaries = true
 //! ```
 
-use crate::complex::{PatchComplex, FORMAT};
+use crate::complex::PatchComplex;
 use crate::mesh::{self, NormalMethod};
 use crate::scheme::rational_c1;
 use crate::trace::{Camera, FovAxis, Light, Lighting, Mode, ModeOptions, RenderSettings};
