@@ -5,14 +5,19 @@
 // Index loops over the four barycentric components read better than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
-use super::poly::{self, Coeffs, MAX_DEGREE};
-use crate::bb::{index_of, multi_indices, num_coeffs};
+use crate::bb::{index_of, multi_indices, num_coeffs, poly, uni};
 use crate::complex::{Patch, SheetRule};
 use glam::{DMat3, DVec3};
 use std::sync::OnceLock;
 
 /// Relative size of an empty ray interval [t0, t1] (t0 > t1) still treated as a touching point.
 const CLIP_SLACK: f64 = 1e-12;
+
+/// Highest degree a segment polynomial may have (the stack limit of [`uni::first_root_in_tol`]).
+pub const MAX_DEGREE: usize = uni::STACK_LEN - 1;
+
+/// Coefficient storage for one segment polynomial.
+pub type Coeffs = [f64; MAX_DEGREE + 1];
 
 /// Largest polynomial degree a patch may have.
 pub const MAX_PATCH_DEGREE: usize = 7;
@@ -122,30 +127,36 @@ fn multinomial(l: [u8; 4]) -> f64 {
 /// Bernstein coefficients (degree |μ|) of α(s)^μ with α(s) = (1−s)a + s·b.
 fn monomial_segment(mu: [u8; 4], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
     out[0] = 1.0;
-    let mut deg = 0;
+    let mut len = 1;
     let mut tmp = [0.0; MAX_DEGREE + 1];
     for i in 0..4 {
         for _ in 0..mu[i] {
-            poly::product(out, deg, &[a[i], b[i]], 1, &mut tmp);
-            deg += 1;
-            out[..=deg].copy_from_slice(&tmp[..=deg]);
+            len = uni::multiply_into(&out[..len], &[a[i], b[i]], &mut tmp);
+            out[..len].copy_from_slice(&tmp[..len]);
         }
     }
-    deg
+    len - 1
 }
 
 /// Sum into `acc` (degree `*deg`) the polynomial `p` of degree `d`, elevating as needed.
 fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
     let mut q = *p;
-    if d < *deg {
-        poly::elevate(&mut q, d, *deg);
-    } else if d > *deg {
-        poly::elevate(acc, *deg, d);
-        *deg = d;
+    let mut dq = d;
+    while dq < *deg {
+        dq = uni::elevate_in_place(&mut q, dq + 1) - 1;
+    }
+    while *deg < dq {
+        *deg = uni::elevate_in_place(acc, *deg + 1) - 1;
     }
     for k in 0..=*deg {
         acc[k] += q[k];
     }
+}
+
+/// `out[..=m+n]` = the product of `p[..=m]` and `q[..=n]`.
+#[inline]
+fn product(p: &Coeffs, m: usize, q: &Coeffs, n: usize, out: &mut Coeffs) {
+    uni::multiply_into(&p[..=m], &q[..=n], out);
 }
 
 impl CompiledPatch {
@@ -355,12 +366,8 @@ impl CompiledPatch {
     /// rational denominators cleared (multiplied by their positive values). Returns the degree.
     pub fn segment(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
         let n = self.degree;
-        // Polynomial part: c_k = blossom(a^(n−k), b^k), with scratch sized to the degree.
-        match n {
-            0..=3 => self.polynomial_segment::<20>(a, b, out),
-            4..=5 => self.polynomial_segment::<56>(a, b, out),
-            _ => self.polynomial_segment::<MAX_COEFFS>(a, b, out),
-        }
+        // Polynomial part: c_k = blossom(a^(n−k), b^k).
+        poly::restrict(n, &self.weights, *a, *b, out);
         if self.groups.is_empty() {
             return n;
         }
@@ -396,47 +403,23 @@ impl CompiledPatch {
                     *x *= mult;
                 }
                 let mut prod = [0.0; MAX_DEGREE + 1];
-                poly::product(&num, dnum, &bern, dk, &mut prod);
+                product(&num, dnum, &bern, dk, &mut prod);
                 add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
             }
             let mut left = [0.0; MAX_DEGREE + 1];
-            poly::product(out, deg, &den, dden, &mut left);
+            product(out, deg, &den, dden, &mut left);
             let mut right = [0.0; MAX_DEGREE + 1];
-            poly::product(&sum, dsum, &q, qdeg, &mut right);
+            product(&sum, dsum, &q, qdeg, &mut right);
             let mut dl = deg + dden;
             add_poly(&mut left, &mut dl, &right, dsum + qdeg);
             *out = left;
             deg = dl;
             let mut nq = [0.0; MAX_DEGREE + 1];
-            poly::product(&q, qdeg, &den, dden, &mut nq);
+            product(&q, qdeg, &den, dden, &mut nq);
             q = nq;
             qdeg += dden;
         }
         deg
-    }
-
-    /// The polynomial part of [`CompiledPatch::segment`]; `M` ≥ C(n+3, 3).
-    #[inline]
-    fn polynomial_segment<const M: usize>(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) {
-        let n = self.degree;
-        let mut bk = [0.0; M];
-        let mut tmp = [0.0; M];
-        let mut work = [0.0; M];
-        bk[..self.weights.len()].copy_from_slice(&self.weights);
-        for k in 0..=n {
-            // bk has degree n − k here.
-            let m = n - k;
-            work[..num_coeffs(m)].copy_from_slice(&bk[..num_coeffs(m)]);
-            for level in (1..=m).rev() {
-                contract(&work, level, *a, &mut tmp);
-                work[..num_coeffs(level - 1)].copy_from_slice(&tmp[..num_coeffs(level - 1)]);
-            }
-            out[k] = work[0];
-            if m > 0 {
-                contract(&bk, m, *b, &mut tmp);
-                bk[..num_coeffs(m - 1)].copy_from_slice(&tmp[..num_coeffs(m - 1)]);
-            }
-        }
     }
 
     /// F, its gradient and Hessian with respect to the four barycentric variables at `alpha`.
@@ -644,7 +627,10 @@ mod tests {
                 let s = k as f64 / 4.0;
                 let want = q.value(x0.lerp(x1, s));
                 // Blossom rounding on O(1) weights.
-                assert!((poly::eval(&co, d, s) - want).abs() < 1e-13, "n={n} s={s}");
+                assert!(
+                    (uni::eval(&co[..=d], s) - want).abs() < 1e-13,
+                    "n={n} s={s}"
+                );
             }
             let x = DVec3::new(0.2, 0.3, 0.35);
             let (v, g, h) = c.derivatives(&c.bary(x));
@@ -691,7 +677,7 @@ mod tests {
             let s = k as f64 / 4.0;
             let x = x0.lerp(x1, s);
             // Rounding of O(1) products.
-            assert!((poly::eval(&co, d, s) - f(x) * den(x)).abs() < 1e-13);
+            assert!((uni::eval(&co[..=d], s) - f(x) * den(x)).abs() < 1e-13);
         }
         let x = DVec3::new(0.25, 0.3, 0.2);
         let (_, g, h) = c.derivatives(&c.bary(x));
