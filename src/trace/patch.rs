@@ -5,8 +5,9 @@
 // Index loops over the four barycentric components read better than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
+use crate::bb::rational::{multinomial, term_jet};
 use crate::bb::{index_of, multi_indices, num_coeffs, poly, uni};
-use crate::complex::{Patch, SheetRule};
+use crate::complex::{Patch, RationalTerm, SheetRule};
 use glam::{DMat3, DVec3};
 use std::sync::OnceLock;
 
@@ -99,6 +100,8 @@ pub struct CompiledPatch {
     pub degree: usize,
     weights: Vec<f64>,
     groups: Vec<RationalGroup>,
+    /// The rational terms as given (for derivatives at a hit).
+    rational: Vec<RationalTerm>,
     /// The sheet rule.
     pub sheet: Sheet,
     /// Degree of the segment polynomial once denominators are cleared.
@@ -116,12 +119,6 @@ pub struct CompiledPatch {
     /// Values of the cleared segment polynomial below this count as zero at a segment's ends:
     /// rounding of F near its zeros, from the patch's largest weight.
     pub zero_tol: f64,
-}
-
-fn multinomial(l: [u8; 4]) -> f64 {
-    let f = |k: u8| (1..=u64::from(k)).product::<u64>() as f64;
-    let n: u8 = l.iter().sum();
-    f(n) / (f(l[0]) * f(l[1]) * f(l[2]) * f(l[3]))
 }
 
 /// Bernstein coefficients (degree |μ|) of α(s)^μ with α(s) = (1−s)a + s·b.
@@ -308,6 +305,7 @@ impl CompiledPatch {
             degree: n,
             weights: patch.weights.clone(),
             groups,
+            rational: patch.rational.clone(),
             sheet,
             segment_degree,
         })
@@ -452,18 +450,14 @@ impl CompiledPatch {
                 jet.g[i] = nf * ci;
             }
         }
-        for g in &self.groups {
-            let mut den = Jet::default();
-            for mu in &g.denominator {
-                den = den.add(&Jet::monomial(*mu, alpha));
-            }
-            for (kappa, mult, numer) in &g.terms {
-                let mut num = Jet::default();
-                for (w, mu) in numer {
-                    num = num.add(&Jet::monomial(*mu, alpha).scale(*w));
+        for term in &self.rational {
+            let (v, g, h) = term_jet(term, n, *alpha);
+            jet.v += v;
+            for i in 0..4 {
+                jet.g[i] += g[i];
+                for k in 0..4 {
+                    jet.h[i][k] += h[i][k];
                 }
-                let bern = Jet::monomial(*kappa, alpha).scale(*mult);
-                jet = jet.add(&num.div(&den).mul(&bern));
             }
         }
         jet
@@ -500,6 +494,11 @@ impl CompiledPatch {
                         + g.terms.iter().map(|t| 48 + t.2.len() * 16).sum::<usize>()
                 })
                 .sum::<usize>()
+            + self
+                .rational
+                .iter()
+                .map(|r| std::mem::size_of::<RationalTerm>() + r.terms.len() * 16)
+                .sum::<usize>()
     }
 }
 
@@ -512,76 +511,6 @@ pub struct Jet {
     pub g: [f64; 4],
     /// Hessian.
     pub h: [[f64; 4]; 4],
-}
-
-impl Jet {
-    fn constant(v: f64) -> Self {
-        Jet {
-            v,
-            ..Jet::default()
-        }
-    }
-    fn variable(i: usize, x: f64) -> Self {
-        let mut j = Jet::constant(x);
-        j.g[i] = 1.0;
-        j
-    }
-    fn monomial(mu: [u8; 4], alpha: &[f64; 4]) -> Self {
-        let mut j = Jet::constant(1.0);
-        for i in 0..4 {
-            for _ in 0..mu[i] {
-                j = j.mul(&Jet::variable(i, alpha[i]));
-            }
-        }
-        j
-    }
-    fn add(&self, o: &Jet) -> Jet {
-        let mut r = *self;
-        r.v += o.v;
-        for i in 0..4 {
-            r.g[i] += o.g[i];
-            for k in 0..4 {
-                r.h[i][k] += o.h[i][k];
-            }
-        }
-        r
-    }
-    fn scale(&self, s: f64) -> Jet {
-        let mut r = *self;
-        r.v *= s;
-        for i in 0..4 {
-            r.g[i] *= s;
-            for k in 0..4 {
-                r.h[i][k] *= s;
-            }
-        }
-        r
-    }
-    fn mul(&self, o: &Jet) -> Jet {
-        let mut r = Jet::constant(self.v * o.v);
-        for i in 0..4 {
-            r.g[i] = self.g[i] * o.v + self.v * o.g[i];
-            for k in 0..4 {
-                r.h[i][k] = self.h[i][k] * o.v
-                    + self.v * o.h[i][k]
-                    + self.g[i] * o.g[k]
-                    + self.g[k] * o.g[i];
-            }
-        }
-        r
-    }
-    fn div(&self, o: &Jet) -> Jet {
-        // 1/o as a jet, then a product.
-        let inv = 1.0 / o.v;
-        let mut r = Jet::constant(inv);
-        for i in 0..4 {
-            r.g[i] = -o.g[i] * inv * inv;
-            for k in 0..4 {
-                r.h[i][k] = 2.0 * o.g[i] * o.g[k] * inv * inv * inv - o.h[i][k] * inv * inv;
-            }
-        }
-        self.mul(&r)
-    }
 }
 
 #[cfg(test)]
