@@ -6,10 +6,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::bb::rational::{multinomial, term_jet};
-use crate::bb::{index_of, multi_indices, num_coeffs, poly, uni};
+use crate::bb::{index_of, num_coeffs, poly, uni};
 use crate::complex::{Patch, RationalTerm, SheetRule};
 use glam::{DMat3, DVec3};
-use std::sync::OnceLock;
 
 /// Relative size of an empty ray interval [t0, t1] (t0 > t1) still treated as a touching point.
 const CLIP_SLACK: f64 = 1e-12;
@@ -23,43 +22,6 @@ pub type Coeffs = [f64; MAX_DEGREE + 1];
 /// Largest polynomial degree a patch may have.
 pub const MAX_PATCH_DEGREE: usize = 7;
 const MAX_COEFFS: usize = num_coeffs(MAX_PATCH_DEGREE);
-
-/// For each degree m in 1..=MAX_PATCH_DEGREE and each multi-index μ of degree m−1 (in order),
-/// the positions of μ + e_i among the degree-m multi-indices.
-fn raise_tables() -> &'static [Vec<[u16; 4]>] {
-    static TABLES: OnceLock<Vec<Vec<[u16; 4]>>> = OnceLock::new();
-    TABLES.get_or_init(|| {
-        let mut t = vec![Vec::new()];
-        for m in 1..=MAX_PATCH_DEGREE {
-            let rows = multi_indices(m - 1)
-                .into_iter()
-                .map(|mu| {
-                    let mut r = [0u16; 4];
-                    for (i, ri) in r.iter_mut().enumerate() {
-                        let mut l = mu;
-                        l[i] += 1;
-                        *ri = index_of(l) as u16;
-                    }
-                    r
-                })
-                .collect();
-            t.push(rows);
-        }
-        t
-    })
-}
-
-/// One blossom step: the degree-(m−1) coefficients Σ_i β_i c_{μ+e_i} of the degree-m `src`.
-#[inline]
-fn contract(src: &[f64], m: usize, beta: [f64; 4], dst: &mut [f64]) {
-    let table = &raise_tables()[m];
-    for (d, idx) in dst.iter_mut().zip(table.iter()) {
-        *d = beta[0] * src[idx[0] as usize]
-            + beta[1] * src[idx[1] as usize]
-            + beta[2] * src[idx[2] as usize]
-            + beta[3] * src[idx[3] as usize];
-    }
-}
 
 /// Position of e_i + e_j among the degree-2 multi-indices.
 const IDX2: [[usize; 4]; 4] = [[0, 1, 2, 3], [1, 4, 5, 6], [2, 5, 7, 8], [3, 6, 8, 9]];
@@ -432,11 +394,9 @@ impl CompiledPatch {
             }
         } else {
             let mut work = [0.0; MAX_COEFFS];
-            let mut tmp = [0.0; MAX_COEFFS];
             work[..self.weights.len()].copy_from_slice(&self.weights);
             for level in (3..=n).rev() {
-                contract(&work, level, *alpha, &mut tmp);
-                work[..num_coeffs(level - 1)].copy_from_slice(&tmp[..num_coeffs(level - 1)]);
+                poly::step_in_place_fast(&mut work, level, *alpha);
             }
             let nf = n as f64;
             for i in 0..4 {
