@@ -51,7 +51,7 @@
 //! patch_boundaries = true
 //! ```
 
-use crate::complex::{PatchComplex, FORMAT};
+use crate::complex::PatchComplex;
 use crate::mesh::{self, NormalMethod};
 use crate::scheme::rational_c1;
 use crate::trace::{Camera, FovAxis, Light, Lighting, Mode, ModeOptions, RenderSettings};
@@ -536,29 +536,15 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
     }
 }
 
-/// Reads a patch complex JSON file (as written by `apatch export patches`).
+/// Reads a patch complex JSON file (as written by `apatch export patches`) with the validating
+/// reader [`crate::complex_io::read_json_file`].
 ///
 /// # Errors
-/// Unreadable files, JSON errors (with line), a wrong `format`.
+/// Unreadable files, JSON errors, a wrong `format`, and invalid data (wrong weight counts,
+/// non-finite values, degenerate tetrahedra, rational terms of too high a degree), each message
+/// naming the file and, where one is at fault, the patch.
 pub fn read_patches(path: &Path) -> anyhow::Result<PatchComplex> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    let c: PatchComplex = serde_json::from_str(&text).map_err(|e| {
-        anyhow!(
-            "{}:{}: {}",
-            path.display(),
-            e.line(),
-            e.to_string().replace('\n', " ")
-        )
-    })?;
-    if c.format != FORMAT {
-        bail!(
-            "{}: `format` is `{}`, expected `{FORMAT}`",
-            path.display(),
-            c.format
-        );
-    }
-    Ok(c)
+    Ok(crate::complex_io::read_json_file(path)?)
 }
 
 #[cfg(test)]
@@ -618,5 +604,32 @@ irradiance = 2.0
         let s = parse(&text, Path::new("s.toml")).unwrap();
         let e = format!("{:#}", build_complex(&s).unwrap_err());
         assert!(e.contains("not implemented yet"), "{e}");
+    }
+
+    #[test]
+    fn bad_patch_files_are_rejected_with_file_and_patch() {
+        let dir = std::env::temp_dir().join(format!("apatch-scene-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("bad.json");
+        let mut c = crate::fixtures::quadric_complex(
+            &crate::fixtures::Quadric::sphere(DVec3::ZERO, 0.5),
+            DVec3::splat(-1.0),
+            DVec3::splat(1.0),
+            1,
+            2,
+        );
+        let good = crate::complex_io::to_json_string(&c).unwrap();
+        std::fs::write(&path, &good).unwrap();
+        assert_eq!(read_patches(&path).unwrap().patches.len(), c.patches.len());
+        // One weight too few in patch 3: plain serde accepted this and the tracer failed later.
+        c.patches[3].weights.pop();
+        let bad = serde_json::to_string(&c).unwrap();
+        std::fs::write(&path, bad).unwrap();
+        let e = format!("{:#}", read_patches(&path).unwrap_err());
+        assert!(e.contains("bad.json") && e.contains("patch 3"), "{e}");
+        std::fs::write(&path, "{").unwrap();
+        let e = format!("{:#}", read_patches(&path).unwrap_err());
+        assert!(e.contains("bad.json"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -6,7 +6,7 @@
 
 mod root;
 
-pub use root::{first_root, first_root_in, TOUCH_TOL};
+pub use root::{first_root, first_root_in, first_root_in_tol, TOUCH_TOL};
 
 /// Longest coefficient slice handled with stack scratch space (degree 15).
 pub const STACK_LEN: usize = 16;
@@ -208,6 +208,24 @@ pub fn elevate_in_place(c: &mut [f64], len: usize) -> usize {
     len + 1
 }
 
+/// Divides out a factor t: when f(t) = t·h(t) (so c0 = 0, up to rounding that is ignored),
+/// the first `len` values of `c` become the len − 1 coefficients of h (h_k = c_{k+1}·n/(k+1)
+/// with n = len − 1); returns len − 1. Used where a factor of the parametrisation vanishes at
+/// t = 0 by construction (a cleared rational denominator), whose root there is not a zero of
+/// the function itself.
+///
+/// # Panics
+/// When `len` is 0 or exceeds `c.len()`.
+#[inline]
+pub fn deflate_at_zero(c: &mut [f64], len: usize) -> usize {
+    assert!(len > 0 && len <= c.len(), "deflation of {len} coefficients");
+    let n = len - 1;
+    for k in 0..n {
+        c[k] = c[k + 1] * n as f64 / (k + 1) as f64;
+    }
+    n
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -246,5 +264,19 @@ mod tests {
         assert_eq!(elevate_in_place(&mut e, 5), 6);
         // Rounding only.
         assert!((eval(&e[..6], 0.37) - eval(&a, 0.37)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn deflation_divides_out_t() {
+        // f(t) = t·h(t) with h = a (degree 4): deflation must give back h.
+        let a = [0.3, -1.2, 2.0, 0.7, -0.4];
+        let mut f = [0.0; 8];
+        let len = multiply_into(&a, &[0.0, 1.0], &mut f);
+        assert_eq!(len, 6);
+        assert_eq!(deflate_at_zero(&mut f, len), 5);
+        for &t in &[0.0, 0.3, 0.77, 1.0] {
+            // Rounding only.
+            assert!((eval(&f[..5], t) - eval(&a, t)).abs() < 1e-14, "t={t}");
+        }
     }
 }

@@ -9,8 +9,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::bvh::{Bounds, Bvh};
-use super::patch::{CompiledPatch, Sheet};
-use super::poly::{self, MAX_DEGREE};
+use super::patch::{CompiledPatch, Sheet, MAX_DEGREE};
+use crate::bb::uni;
 use crate::complex::{PatchComplex, Role};
 use glam::DVec3;
 
@@ -182,7 +182,7 @@ impl Geometry {
         let s_hi = ((hi_t - t0) / len).min(1.0);
         let mut s_lo = ((lo_t - t0) / len).max(0.0);
         for _ in 0..16 {
-            let s = poly::first_root_in_tol(&c, n, s_lo, s_hi, p.zero_tol)?;
+            let s = uni::first_root_in_tol(&c[..=n], s_lo, s_hi, p.zero_tol)?;
             let mut alpha = [0.0; 4];
             for k in 0..4 {
                 alpha[k] = (1.0 - s) * a[k] + s * b[k];
@@ -230,16 +230,13 @@ impl Geometry {
         let mut c = [0.0; MAX_DEGREE + 1];
         let mut n = p.segment(&q, &u, &mut c);
         for _ in 0..p.base_order.min(n) {
-            // G(t) = t·H(t): h_k = g_{k+1}·m/(k+1).
-            for k in 0..n {
-                c[k] = c[k + 1] * n as f64 / (k + 1) as f64;
-            }
-            n -= 1;
+            // G(t) = t·H(t): the base point's root of a vanishing denominator is not F's.
+            n = uni::deflate_at_zero(&mut c, n + 1) - 1;
         }
         // (4.5)–(4.7): F at the base point must not have the top weight's strict sign.
         if c[0] * p.top_weight > 0.0 {
             return false;
         }
-        poly::first_root_in(&c, n, 0.0, t - SHEET_TOL).is_none()
+        uni::first_root_in(&c[..=n], 0.0, t - SHEET_TOL).is_none()
     }
 }

@@ -7,8 +7,8 @@
 //! deterministic finishing pass; [`write_exr`] / [`write_png`] write the [`Frame`].
 //!
 //! Modules: `camera` (sensor), `bvh` (the only obvhs user), `patch` (compiled patches, segment
-//! restriction, derivatives), `poly` (univariate Bernstein roots), `intersect` (closest hit and
-//! occlusion), `shade` (lights, modes), `film` (sampling, parallel rows, finishing),
+//! restriction, derivatives; the univariate Bernstein work and root finder are [`crate::bb`]'s),
+//! `intersect` (closest hit and occlusion), `shade` (lights, modes), `film` (sampling, parallel rows, finishing),
 //! `output` (files; the EXR channel list is documented there).
 
 pub mod bvh;
@@ -17,7 +17,6 @@ pub mod film;
 pub mod intersect;
 pub mod output;
 pub mod patch;
-pub mod poly;
 pub mod shade;
 
 pub use camera::{Camera, FovAxis};

@@ -5,55 +5,23 @@
 // Index loops over the four barycentric components read better than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
-use super::poly::{self, Coeffs, MAX_DEGREE};
-use crate::bb::{index_of, multi_indices, num_coeffs};
-use crate::complex::{Patch, SheetRule};
+use crate::bb::rational::{multinomial, term_jet};
+use crate::bb::{index_of, num_coeffs, poly, uni};
+use crate::complex::{Patch, RationalTerm, SheetRule};
 use glam::{DMat3, DVec3};
-use std::sync::OnceLock;
 
 /// Relative size of an empty ray interval [t0, t1] (t0 > t1) still treated as a touching point.
 const CLIP_SLACK: f64 = 1e-12;
 
+/// Highest degree a segment polynomial may have (the stack limit of [`uni::first_root_in_tol`]).
+pub const MAX_DEGREE: usize = uni::STACK_LEN - 1;
+
+/// Coefficient storage for one segment polynomial.
+pub type Coeffs = [f64; MAX_DEGREE + 1];
+
 /// Largest polynomial degree a patch may have.
 pub const MAX_PATCH_DEGREE: usize = 7;
 const MAX_COEFFS: usize = num_coeffs(MAX_PATCH_DEGREE);
-
-/// For each degree m in 1..=MAX_PATCH_DEGREE and each multi-index μ of degree m−1 (in order),
-/// the positions of μ + e_i among the degree-m multi-indices.
-fn raise_tables() -> &'static [Vec<[u16; 4]>] {
-    static TABLES: OnceLock<Vec<Vec<[u16; 4]>>> = OnceLock::new();
-    TABLES.get_or_init(|| {
-        let mut t = vec![Vec::new()];
-        for m in 1..=MAX_PATCH_DEGREE {
-            let rows = multi_indices(m - 1)
-                .into_iter()
-                .map(|mu| {
-                    let mut r = [0u16; 4];
-                    for (i, ri) in r.iter_mut().enumerate() {
-                        let mut l = mu;
-                        l[i] += 1;
-                        *ri = index_of(l) as u16;
-                    }
-                    r
-                })
-                .collect();
-            t.push(rows);
-        }
-        t
-    })
-}
-
-/// One blossom step: the degree-(m−1) coefficients Σ_i β_i c_{μ+e_i} of the degree-m `src`.
-#[inline]
-fn contract(src: &[f64], m: usize, beta: [f64; 4], dst: &mut [f64]) {
-    let table = &raise_tables()[m];
-    for (d, idx) in dst.iter_mut().zip(table.iter()) {
-        *d = beta[0] * src[idx[0] as usize]
-            + beta[1] * src[idx[1] as usize]
-            + beta[2] * src[idx[2] as usize]
-            + beta[3] * src[idx[3] as usize];
-    }
-}
 
 /// Position of e_i + e_j among the degree-2 multi-indices.
 const IDX2: [[usize; 4]; 4] = [[0, 1, 2, 3], [1, 4, 5, 6], [2, 5, 7, 8], [3, 6, 8, 9]];
@@ -94,6 +62,8 @@ pub struct CompiledPatch {
     pub degree: usize,
     weights: Vec<f64>,
     groups: Vec<RationalGroup>,
+    /// The rational terms as given (for derivatives at a hit).
+    rational: Vec<RationalTerm>,
     /// The sheet rule.
     pub sheet: Sheet,
     /// Degree of the segment polynomial once denominators are cleared.
@@ -113,39 +83,39 @@ pub struct CompiledPatch {
     pub zero_tol: f64,
 }
 
-fn multinomial(l: [u8; 4]) -> f64 {
-    let f = |k: u8| (1..=u64::from(k)).product::<u64>() as f64;
-    let n: u8 = l.iter().sum();
-    f(n) / (f(l[0]) * f(l[1]) * f(l[2]) * f(l[3]))
-}
-
 /// Bernstein coefficients (degree |μ|) of α(s)^μ with α(s) = (1−s)a + s·b.
 fn monomial_segment(mu: [u8; 4], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
     out[0] = 1.0;
-    let mut deg = 0;
+    let mut len = 1;
     let mut tmp = [0.0; MAX_DEGREE + 1];
     for i in 0..4 {
         for _ in 0..mu[i] {
-            poly::product(out, deg, &[a[i], b[i]], 1, &mut tmp);
-            deg += 1;
-            out[..=deg].copy_from_slice(&tmp[..=deg]);
+            len = uni::multiply_into(&out[..len], &[a[i], b[i]], &mut tmp);
+            out[..len].copy_from_slice(&tmp[..len]);
         }
     }
-    deg
+    len - 1
 }
 
 /// Sum into `acc` (degree `*deg`) the polynomial `p` of degree `d`, elevating as needed.
 fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
     let mut q = *p;
-    if d < *deg {
-        poly::elevate(&mut q, d, *deg);
-    } else if d > *deg {
-        poly::elevate(acc, *deg, d);
-        *deg = d;
+    let mut dq = d;
+    while dq < *deg {
+        dq = uni::elevate_in_place(&mut q, dq + 1) - 1;
+    }
+    while *deg < dq {
+        *deg = uni::elevate_in_place(acc, *deg + 1) - 1;
     }
     for k in 0..=*deg {
         acc[k] += q[k];
     }
+}
+
+/// `out[..=m+n]` = the product of `p[..=m]` and `q[..=n]`.
+#[inline]
+fn product(p: &Coeffs, m: usize, q: &Coeffs, n: usize, out: &mut Coeffs) {
+    uni::multiply_into(&p[..=m], &q[..=n], out);
 }
 
 impl CompiledPatch {
@@ -297,6 +267,7 @@ impl CompiledPatch {
             degree: n,
             weights: patch.weights.clone(),
             groups,
+            rational: patch.rational.clone(),
             sheet,
             segment_degree,
         })
@@ -355,12 +326,8 @@ impl CompiledPatch {
     /// rational denominators cleared (multiplied by their positive values). Returns the degree.
     pub fn segment(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
         let n = self.degree;
-        // Polynomial part: c_k = blossom(a^(n−k), b^k), with scratch sized to the degree.
-        match n {
-            0..=3 => self.polynomial_segment::<20>(a, b, out),
-            4..=5 => self.polynomial_segment::<56>(a, b, out),
-            _ => self.polynomial_segment::<MAX_COEFFS>(a, b, out),
-        }
+        // Polynomial part: c_k = blossom(a^(n−k), b^k).
+        poly::restrict(n, &self.weights, *a, *b, out);
         if self.groups.is_empty() {
             return n;
         }
@@ -396,47 +363,23 @@ impl CompiledPatch {
                     *x *= mult;
                 }
                 let mut prod = [0.0; MAX_DEGREE + 1];
-                poly::product(&num, dnum, &bern, dk, &mut prod);
+                product(&num, dnum, &bern, dk, &mut prod);
                 add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
             }
             let mut left = [0.0; MAX_DEGREE + 1];
-            poly::product(out, deg, &den, dden, &mut left);
+            product(out, deg, &den, dden, &mut left);
             let mut right = [0.0; MAX_DEGREE + 1];
-            poly::product(&sum, dsum, &q, qdeg, &mut right);
+            product(&sum, dsum, &q, qdeg, &mut right);
             let mut dl = deg + dden;
             add_poly(&mut left, &mut dl, &right, dsum + qdeg);
             *out = left;
             deg = dl;
             let mut nq = [0.0; MAX_DEGREE + 1];
-            poly::product(&q, qdeg, &den, dden, &mut nq);
+            product(&q, qdeg, &den, dden, &mut nq);
             q = nq;
             qdeg += dden;
         }
         deg
-    }
-
-    /// The polynomial part of [`CompiledPatch::segment`]; `M` ≥ C(n+3, 3).
-    #[inline]
-    fn polynomial_segment<const M: usize>(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) {
-        let n = self.degree;
-        let mut bk = [0.0; M];
-        let mut tmp = [0.0; M];
-        let mut work = [0.0; M];
-        bk[..self.weights.len()].copy_from_slice(&self.weights);
-        for k in 0..=n {
-            // bk has degree n − k here.
-            let m = n - k;
-            work[..num_coeffs(m)].copy_from_slice(&bk[..num_coeffs(m)]);
-            for level in (1..=m).rev() {
-                contract(&work, level, *a, &mut tmp);
-                work[..num_coeffs(level - 1)].copy_from_slice(&tmp[..num_coeffs(level - 1)]);
-            }
-            out[k] = work[0];
-            if m > 0 {
-                contract(&bk, m, *b, &mut tmp);
-                bk[..num_coeffs(m - 1)].copy_from_slice(&tmp[..num_coeffs(m - 1)]);
-            }
-        }
     }
 
     /// F, its gradient and Hessian with respect to the four barycentric variables at `alpha`.
@@ -451,11 +394,9 @@ impl CompiledPatch {
             }
         } else {
             let mut work = [0.0; MAX_COEFFS];
-            let mut tmp = [0.0; MAX_COEFFS];
             work[..self.weights.len()].copy_from_slice(&self.weights);
             for level in (3..=n).rev() {
-                contract(&work, level, *alpha, &mut tmp);
-                work[..num_coeffs(level - 1)].copy_from_slice(&tmp[..num_coeffs(level - 1)]);
+                poly::step_in_place_fast(&mut work, level, *alpha);
             }
             let nf = n as f64;
             for i in 0..4 {
@@ -469,18 +410,14 @@ impl CompiledPatch {
                 jet.g[i] = nf * ci;
             }
         }
-        for g in &self.groups {
-            let mut den = Jet::default();
-            for mu in &g.denominator {
-                den = den.add(&Jet::monomial(*mu, alpha));
-            }
-            for (kappa, mult, numer) in &g.terms {
-                let mut num = Jet::default();
-                for (w, mu) in numer {
-                    num = num.add(&Jet::monomial(*mu, alpha).scale(*w));
+        for term in &self.rational {
+            let (v, g, h) = term_jet(term, n, *alpha);
+            jet.v += v;
+            for i in 0..4 {
+                jet.g[i] += g[i];
+                for k in 0..4 {
+                    jet.h[i][k] += h[i][k];
                 }
-                let bern = Jet::monomial(*kappa, alpha).scale(*mult);
-                jet = jet.add(&num.div(&den).mul(&bern));
             }
         }
         jet
@@ -517,6 +454,11 @@ impl CompiledPatch {
                         + g.terms.iter().map(|t| 48 + t.2.len() * 16).sum::<usize>()
                 })
                 .sum::<usize>()
+            + self
+                .rational
+                .iter()
+                .map(|r| std::mem::size_of::<RationalTerm>() + r.terms.len() * 16)
+                .sum::<usize>()
     }
 }
 
@@ -529,76 +471,6 @@ pub struct Jet {
     pub g: [f64; 4],
     /// Hessian.
     pub h: [[f64; 4]; 4],
-}
-
-impl Jet {
-    fn constant(v: f64) -> Self {
-        Jet {
-            v,
-            ..Jet::default()
-        }
-    }
-    fn variable(i: usize, x: f64) -> Self {
-        let mut j = Jet::constant(x);
-        j.g[i] = 1.0;
-        j
-    }
-    fn monomial(mu: [u8; 4], alpha: &[f64; 4]) -> Self {
-        let mut j = Jet::constant(1.0);
-        for i in 0..4 {
-            for _ in 0..mu[i] {
-                j = j.mul(&Jet::variable(i, alpha[i]));
-            }
-        }
-        j
-    }
-    fn add(&self, o: &Jet) -> Jet {
-        let mut r = *self;
-        r.v += o.v;
-        for i in 0..4 {
-            r.g[i] += o.g[i];
-            for k in 0..4 {
-                r.h[i][k] += o.h[i][k];
-            }
-        }
-        r
-    }
-    fn scale(&self, s: f64) -> Jet {
-        let mut r = *self;
-        r.v *= s;
-        for i in 0..4 {
-            r.g[i] *= s;
-            for k in 0..4 {
-                r.h[i][k] *= s;
-            }
-        }
-        r
-    }
-    fn mul(&self, o: &Jet) -> Jet {
-        let mut r = Jet::constant(self.v * o.v);
-        for i in 0..4 {
-            r.g[i] = self.g[i] * o.v + self.v * o.g[i];
-            for k in 0..4 {
-                r.h[i][k] = self.h[i][k] * o.v
-                    + self.v * o.h[i][k]
-                    + self.g[i] * o.g[k]
-                    + self.g[k] * o.g[i];
-            }
-        }
-        r
-    }
-    fn div(&self, o: &Jet) -> Jet {
-        // 1/o as a jet, then a product.
-        let inv = 1.0 / o.v;
-        let mut r = Jet::constant(inv);
-        for i in 0..4 {
-            r.g[i] = -o.g[i] * inv * inv;
-            for k in 0..4 {
-                r.h[i][k] = 2.0 * o.g[i] * o.g[k] * inv * inv * inv - o.h[i][k] * inv * inv;
-            }
-        }
-        self.mul(&r)
-    }
 }
 
 #[cfg(test)]
@@ -644,7 +516,10 @@ mod tests {
                 let s = k as f64 / 4.0;
                 let want = q.value(x0.lerp(x1, s));
                 // Blossom rounding on O(1) weights.
-                assert!((poly::eval(&co, d, s) - want).abs() < 1e-13, "n={n} s={s}");
+                assert!(
+                    (uni::eval(&co[..=d], s) - want).abs() < 1e-13,
+                    "n={n} s={s}"
+                );
             }
             let x = DVec3::new(0.2, 0.3, 0.35);
             let (v, g, h) = c.derivatives(&c.bary(x));
@@ -691,7 +566,7 @@ mod tests {
             let s = k as f64 / 4.0;
             let x = x0.lerp(x1, s);
             // Rounding of O(1) products.
-            assert!((poly::eval(&co, d, s) - f(x) * den(x)).abs() < 1e-13);
+            assert!((uni::eval(&co[..=d], s) - f(x) * den(x)).abs() < 1e-13);
         }
         let x = DVec3::new(0.25, 0.3, 0.2);
         let (_, g, h) = c.derivatives(&c.bary(x));

@@ -64,11 +64,26 @@ pub fn first_root(c: &[f64]) -> Option<f64> {
 /// When `c` has more than [`STACK_LEN`] coefficients.
 #[must_use]
 pub fn first_root_in(c: &[f64], lo: f64, hi: f64) -> Option<f64> {
+    first_root_in_tol(c, lo, hi, 0.0)
+}
+
+/// [`first_root_in`] where a value within `zero` of 0 at an end of [lo, hi] also counts as a
+/// root there (at `lo` always; at `hi` when no earlier root exists). `zero` is on the caller's
+/// scale: a ray tracer passes a rounding bound from the patch's largest weight, so that a root
+/// exactly on a face shared by two tetrahedra cannot slip through both neighbours, and a
+/// segment so short that all its coefficients are rounding noise (a ray through a mesh vertex)
+/// still reports its root. With `zero` = 0 this is [`first_root_in`]; an identically zero
+/// polynomial gives `Some(lo)` when `zero` > 0.
+///
+/// # Panics
+/// When `c` has more than [`STACK_LEN`] coefficients.
+#[must_use]
+pub fn first_root_in_tol(c: &[f64], lo: f64, hi: f64, zero: f64) -> Option<f64> {
     macro_rules! dispatch {
         ($($n:literal)*) => {
             match c.len() {
                 0 => None,
-                $($n => first_root_fixed::<$n>(c.try_into().expect("length checked"), lo, hi),)*
+                $($n => first_root_fixed::<$n>(c.try_into().expect("length checked"), lo, hi, zero),)*
                 len => panic!("first_root supports at most {STACK_LEN} coefficients, got {len}"),
             }
         };
@@ -78,7 +93,7 @@ pub fn first_root_in(c: &[f64], lo: f64, hi: f64) -> Option<f64> {
 
 /// [`first_root_in`] for exactly N coefficients: every loop has a constant trip count.
 #[inline]
-fn first_root_fixed<const N: usize>(c: &[f64; N], lo: f64, hi: f64) -> Option<f64> {
+fn first_root_fixed<const N: usize>(c: &[f64; N], lo: f64, hi: f64, zero: f64) -> Option<f64> {
     if lo.is_nan() || hi.is_nan() {
         return None;
     }
@@ -90,41 +105,40 @@ fn first_root_fixed<const N: usize>(c: &[f64; N], lo: f64, hi: f64) -> Option<f6
     for &x in c {
         scale = scale.max(x.abs());
     }
+    if scale == 0.0 && zero > 0.0 {
+        return Some(lo);
+    }
     if !(scale > 0.0 && scale.is_finite()) {
         return None;
     }
     let tol = TOUCH_TOL * scale;
-    if lo == 0.0 && hi == 1.0 {
-        if excluded(c, tol) {
-            return None;
-        }
-        return Search {
-            tol,
-            splits: 0,
-            top: c,
-            top_a: 0.0,
-            top_w: 1.0,
-        }
-        .search(c, 0.0, 1.0);
-    }
     if lo == hi {
         let (f, _) = eval_d(c, lo);
-        return (f.abs() <= tol).then_some(lo);
+        return (f.abs() <= tol.max(zero)).then_some(lo);
     }
     // Coefficients on [lo, hi]: split at hi, then the left part at lo/hi.
-    let (left, _) = split(c, hi);
-    let (_, b) = split(&left, lo / hi);
-    if excluded(&b, tol) {
-        return None;
+    let b = if lo == 0.0 && hi == 1.0 {
+        *c
+    } else {
+        let (left, _) = split(c, hi);
+        split(&left, lo / hi).1
+    };
+    if zero > 0.0 && b[0].abs() <= zero {
+        return Some(lo);
     }
-    Search {
-        tol,
-        splits: 0,
-        top: &b,
-        top_a: lo,
-        top_w: hi - lo,
-    }
-    .search(&b, lo, hi - lo)
+    let root = if excluded(&b, tol) {
+        None
+    } else {
+        Search {
+            tol,
+            splits: 0,
+            top: &b,
+            top_a: lo,
+            top_w: hi - lo,
+        }
+        .search(&b, lo, hi - lo)
+    };
+    root.or_else(|| (zero > 0.0 && b[N - 1].abs() <= zero).then_some(hi))
 }
 
 /// (f(t), f′(t)) by de Casteljau on exactly N coefficients.
@@ -481,5 +495,37 @@ mod tests {
         let c = from_roots(&[0.5; 7]);
         let t = first_root(&c).unwrap();
         assert!((t - 0.5).abs() < 0.02, "t={t}");
+    }
+
+    #[test]
+    fn end_values_within_the_callers_zero_are_roots() {
+        // g = (t − 0.3)(t + 0.5) + 1e-12 is positive and increasing on [0.3, 0.5]: only its
+        // rounding-sized value at the start makes a root, when the caller's zero admits it.
+        let mut c = from_roots(&[0.3, -0.5]);
+        for x in &mut c {
+            *x += 1e-12;
+        }
+        assert_eq!(first_root_in(&c, 0.3, 0.5), None);
+        assert_eq!(first_root_in_tol(&c, 0.3, 0.5, 1e-11), Some(0.3));
+        // h = −(t − 0.3)(t + 0.5) + 1e-12 on [0.1, 0.3]: the same at the end.
+        let h: Vec<f64> = from_roots(&[0.3, -0.5]).iter().map(|x| 1e-12 - x).collect();
+        assert_eq!(first_root_in_tol(&h, 0.1, 0.3, 1e-11), Some(0.3));
+        assert_eq!(first_root_in_tol(&h, 0.1, 0.3, 1e-13), None);
+        // ... but only when nothing precedes it.
+        let c2 = from_roots(&[0.2, 0.3]);
+        let r = first_root_in_tol(&c2, 0.0, 0.3 - 1e-15, 1e-11).unwrap();
+        // The simple root at 0.2 comes first (polished to a few ulps).
+        assert!((r - 0.2).abs() < SIMPLE, "{r}");
+        // All coefficients rounding noise (a segment through a vertex): a root at lo.
+        assert_eq!(
+            first_root_in_tol(&[1e-17, -2e-17, 1e-17], 0.0, 1.0, 1e-15),
+            Some(0.0)
+        );
+        assert_eq!(first_root_in_tol(&[0.0, 0.0], 0.25, 1.0, 1e-15), Some(0.25));
+        // zero = 0 is the plain finder.
+        assert_eq!(
+            first_root_in_tol(&c, 0.3, 0.5, 0.0),
+            first_root_in(&c, 0.3, 0.5)
+        );
     }
 }
