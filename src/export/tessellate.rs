@@ -164,11 +164,7 @@ impl Builder<'_> {
             // vanishes on the base (edge tetrahedra). Divide the factor t out.
             let cmax = c[..len].iter().fold(0.0f64, |m, v| m.max(v.abs()));
             while len > 1 && c[0].abs() <= 1e-13 * cmax {
-                let m = (len - 1) as f64;
-                for k in 1..len {
-                    c[k - 1] = c[k] * m / k as f64;
-                }
-                len -= 1;
+                len = crate::bb::uni::deflate_at_zero(&mut c, len);
             }
             first_root(&c[..len])?
         };
