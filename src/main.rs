@@ -19,7 +19,7 @@ enum Command {
     Check(cli::check::CheckArgs),
     /// Compare two EXR renders: RMSE, PSNR, SSIM, difference pictures.
     Compare(cli::compare::CompareArgs),
-    /// Write the patch complex as JSON.
+    /// Write the patch complex (JSON) or a Mitsuba 3 scene.
     #[command(subcommand)]
     Export(cli::export::ExportCommand),
     /// Describe a mesh: counts, topology, convexity, validation findings.
