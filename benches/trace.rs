@@ -1,6 +1,6 @@
 //! Tracer throughput: `cargo bench --bench trace` (plain harness; prints a table).
 //!
-//! For each model scene (bunny, teapot) and a fixture sphere complex: BVH build time, memory
+//! For each model scene (bunny, spot, teapot) and a fixture sphere complex: BVH build time, memory
 //! per patch, and primary rays per second at 1024×1024, 1 spp, with 1 and 2 threads, in
 //! `shaded` mode (with its shadow rays) and `normal` mode (primary rays only).
 //! The comparison with an obvhs triangle tracer of the tessellation is not here yet: it needs
@@ -73,8 +73,13 @@ fn bench(name: &str, complex: &apatch::complex::PatchComplex, settings: &trace::
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for name in ["bunny", "teapot"] {
-        let path = root.join("scenes").join(format!("{name}.toml"));
+    // The teapot waits in scenes/pending (it does not build yet): its line says why.
+    for (name, dir) in [
+        ("bunny", "scenes"),
+        ("spot", "scenes"),
+        ("teapot", "scenes/pending"),
+    ] {
+        let path = root.join(dir).join(format!("{name}.toml"));
         let sc = match scene::load(&path) {
             Ok(s) => s,
             Err(e) => {
