@@ -171,6 +171,82 @@ pub fn quadric_complex(
     c
 }
 
+/// The regular icosahedron inscribed in the unit sphere: 12 vertices, 20 triangles oriented
+/// outward (counter-clockwise seen from outside). Test meshes for every scheme start here.
+#[must_use]
+pub fn icosahedron() -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let v: Vec<DVec3> = [
+        [-1.0, g, 0.0],
+        [1.0, g, 0.0],
+        [-1.0, -g, 0.0],
+        [1.0, -g, 0.0],
+        [0.0, -1.0, g],
+        [0.0, 1.0, g],
+        [0.0, -1.0, -g],
+        [0.0, 1.0, -g],
+        [g, 0.0, -1.0],
+        [g, 0.0, 1.0],
+        [-g, 0.0, -1.0],
+        [-g, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|a| DVec3::from_array(*a).normalize())
+    .collect();
+    let f = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    (v, f)
+}
+
+/// 1→4 subdivision of a unit-sphere triangulation `levels` times, new (edge-midpoint) vertices
+/// projected to the sphere.
+#[must_use]
+pub fn subdivide_sphere(v: &[DVec3], f: &[[u32; 3]], levels: usize) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let mut v = v.to_vec();
+    let mut f = f.to_vec();
+    for _ in 0..levels {
+        let mut mid: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+        let mut nf = Vec::with_capacity(f.len() * 4);
+        let mut m = |a: u32, b: u32, v: &mut Vec<DVec3>| -> u32 {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                v.push((v[a as usize] + v[b as usize]).normalize());
+                (v.len() - 1) as u32
+            })
+        };
+        for t in &f {
+            let ab = m(t[0], t[1], &mut v);
+            let bc = m(t[1], t[2], &mut v);
+            let ca = m(t[2], t[0], &mut v);
+            nf.push([t[0], ab, ca]);
+            nf.push([t[1], bc, ab]);
+            nf.push([t[2], ca, bc]);
+            nf.push([ab, bc, ca]);
+        }
+        f = nf;
+    }
+    (v, f)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
