@@ -4,25 +4,10 @@
 use apatch::scheme::rational_c1::{build, RationalOptions};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use glam::DVec3;
-use std::collections::HashMap;
 
 fn noisy_sphere(levels: usize, amp: f64) -> (Vec<DVec3>, Vec<[u32; 3]>, Vec<DVec3>) {
-    let (mut v, mut f) = apatch::fixtures::icosahedron();
-    for _ in 0..levels {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut nf = Vec::with_capacity(f.len() * 4);
-        for t in &f {
-            let mut m = |a: u32, b: u32| -> u32 {
-                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                    v.push((v[a as usize] + v[b as usize]).normalize());
-                    (v.len() - 1) as u32
-                })
-            };
-            let (ab, bc, ca) = (m(t[0], t[1]), m(t[1], t[2]), m(t[2], t[0]));
-            nf.extend([[t[0], ab, ca], [t[1], bc, ab], [t[2], ca, bc], [ab, bc, ca]]);
-        }
-        f = nf;
-    }
+    let (v, f) = apatch::fixtures::icosahedron();
+    let (mut v, f) = apatch::fixtures::subdivide_sphere(&v, &f, levels);
     // Seeded radial noise; normals: the exact sphere's (smooth data on a bumpy mesh).
     let mut s = 12345u64;
     let n = v.clone();
@@ -37,28 +22,7 @@ fn noisy_sphere(levels: usize, amp: f64) -> (Vec<DVec3>, Vec<[u32; 3]>, Vec<DVec
 }
 
 fn torus(m: usize, k: usize) -> (Vec<DVec3>, Vec<[u32; 3]>, Vec<DVec3>) {
-    let (big, small) = (1.0, 0.4);
-    let mut v = Vec::new();
-    let mut n = Vec::new();
-    for i in 0..m {
-        let u = i as f64 / m as f64 * std::f64::consts::TAU;
-        for j in 0..k {
-            let w = j as f64 / k as f64 * std::f64::consts::TAU;
-            let dir = DVec3::new(u.cos(), u.sin(), 0.0);
-            let nn = dir * w.cos() + DVec3::Z * w.sin();
-            v.push(dir * big + nn * small);
-            n.push(nn);
-        }
-    }
-    let id = |i: usize, j: usize| ((i % m) * k + (j % k)) as u32;
-    let mut f = Vec::new();
-    for i in 0..m {
-        for j in 0..k {
-            f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            f.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    (v, f, n)
+    apatch::fixtures::torus(1.0, 0.4, m, k)
 }
 
 fn bench(c: &mut Criterion) {

@@ -247,6 +247,33 @@ pub fn subdivide_sphere(v: &[DVec3], f: &[[u32; 3]], levels: usize) -> (Vec<DVec
     (v, f)
 }
 
+/// The torus of radii (`big`, `small`) about the z axis, sampled on an m × k grid of quads split
+/// into outward-oriented triangles: (positions, triangles, exact unit normals).
+#[must_use]
+pub fn torus(big: f64, small: f64, m: usize, k: usize) -> (Vec<DVec3>, Vec<[u32; 3]>, Vec<DVec3>) {
+    let mut v = Vec::new();
+    let mut n = Vec::new();
+    for i in 0..m {
+        let u = i as f64 / m as f64 * std::f64::consts::TAU;
+        for j in 0..k {
+            let w = j as f64 / k as f64 * std::f64::consts::TAU;
+            let dir = DVec3::new(u.cos(), u.sin(), 0.0);
+            let nn = dir * w.cos() + DVec3::Z * w.sin();
+            v.push(dir * big + nn * small);
+            n.push(nn);
+        }
+    }
+    let id = |i: usize, j: usize| ((i % m) * k + (j % k)) as u32;
+    let mut f = Vec::new();
+    for i in 0..m {
+        for j in 0..k {
+            f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            f.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    (v, f, n)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
