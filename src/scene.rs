@@ -523,10 +523,21 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                         .with_context(|| format!("{}", file.display()))?;
                     Ok(built.complex)
                 }
-                "cubic-c1" | "quintic-c2" => bail!(
-                    "{}: scheme `{ty}` is not implemented yet",
-                    scene.path.display()
-                ),
+                "cubic-c1" | "quintic-c2" => {
+                    let method: NormalMethod = normals.parse().map_err(|e: String| {
+                        anyhow!("{}: `model.normals`: {e}", scene.path.display())
+                    })?;
+                    let (m, report) = mesh::load(file)?;
+                    report.require(true)?;
+                    let vn = mesh::vertex_normals(&m, method)?;
+                    let build = if ty == "cubic-c1" {
+                        crate::scheme::cubic_c1::build_from_scene
+                    } else {
+                        crate::scheme::quintic_c2::build_from_scene
+                    };
+                    build(&m, &vn, scheme, &scene.path)
+                        .with_context(|| format!("{}", file.display()))
+                }
                 _ => bail!(
                     "{}: `scheme.type`: `{ty}` is not one of rational-c1, cubic-c1, quintic-c2",
                     scene.path.display()
@@ -599,11 +610,11 @@ irradiance = 2.0
     fn schemes_dispatch_with_clear_errors() {
         let text = MINIMAL.replace(
             "patches = \"sphere.json\"",
-            "file = \"m.obj\"\n[scheme]\ntype = \"quintic-c2\"",
+            "file = \"m.obj\"\n[scheme]\ntype = \"bezier-c9\"",
         );
         let s = parse(&text, Path::new("s.toml")).unwrap();
         let e = format!("{:#}", build_complex(&s).unwrap_err());
-        assert!(e.contains("not implemented yet"), "{e}");
+        assert!(e.contains("s.toml") && e.contains("bezier-c9"), "{e}");
     }
 
     #[test]

@@ -1,0 +1,201 @@
+//! The smoothable simplicial hull Σ = (T, S_f, S_e) of Definition 3.6 (Bajaj, Chen, Xu 1994):
+//! the plain-data contract between the inner hull construction (`hull::inner`, §4–5) and the
+//! polynomial schemes built on it (`scheme::cubic_c1`, `scheme::quintic_c2`, §6).
+//!
+//! T is an edge-convex triangulation whose vertices carry the point and normal data the surface
+//! interpolates (centroids, corner guards, pseudo-centroids). Every triangle of T has one face
+//! tetrahedron (convex face, single sided) or an L-U pair, one on each side (non-convex face).
+//! Between two face tetrahedra on the same side of an edge of T sits a pair of edge tetrahedra
+//! `[p_i p_j q_l s]`, `[p_i p_j q_n s]` with `s = (q_l + q_n)/2` (Def. 3.6 (5)(ii)); those are
+//! derived here, not stored, so every hull builder gets them the same way.
+
+use glam::DVec3;
+use std::collections::HashMap;
+
+/// Which side of a triangle of T a face tetrahedron lies on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// On the side the triangle's normal (counter-clockwise orientation) points to: outside.
+    Outer = 0,
+    /// On the opposite side: inside.
+    Inner = 1,
+}
+
+impl Side {
+    /// Both sides, outer first.
+    pub const BOTH: [Side; 2] = [Side::Outer, Side::Inner];
+}
+
+/// Where a vertex of T comes from in the input polyhedron, for reports and shape control.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PointOrigin {
+    /// Centroid of polygon `face` (convex face).
+    Centroid {
+        /// Input polygon index.
+        face: u32,
+    },
+    /// A corner guard of non-convex polygon `face` (§5).
+    CornerGuard {
+        /// Input polygon index.
+        face: u32,
+    },
+    /// Pseudo-centroid C_0 of non-trihedral input vertex `vertex` (Algorithm 1 step (4)).
+    PseudoCentroid {
+        /// Input vertex index.
+        vertex: u32,
+    },
+    /// Anything else (test hulls, interpolated points of §7.2).
+    Other,
+}
+
+/// A smoothable simplicial hull: T with point normals and the apexes of its face tetrahedra.
+#[derive(Clone, Debug, Default)]
+pub struct SimplicialHull {
+    /// Vertices of T: the points the surface passes through.
+    pub points: Vec<DVec3>,
+    /// Unit normal of the surface at each point (the direction of ∇f there).
+    pub normals: Vec<DVec3>,
+    /// Where each point comes from.
+    pub origins: Vec<PointOrigin>,
+    /// Triangles of T, counter-clockwise seen from outside the polyhedron.
+    pub triangles: Vec<[u32; 3]>,
+    /// Per triangle, the apex of its face tetrahedron on each side (`[outer, inner]`, indexed by
+    /// [`Side`]); at least one is present, both for an L-U pair.
+    pub apexes: Vec<[Option<DVec3>; 2]>,
+    /// Per triangle, the input polyhedron element it was built for (vertex for step (3)/(4)
+    /// triangles, edge for step (5') triangles), for reports.
+    pub element: Vec<u32>,
+}
+
+/// An edge of T with the triangles on both sides.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HullEdge {
+    /// The two points of T, as they run in `triangles[faces[0]]`.
+    pub v: [u32; 2],
+    /// The triangles sharing the edge; `faces[1] == u32::MAX` on a boundary of T.
+    pub faces: [u32; 2],
+}
+
+/// One edge tetrahedron of S_e: `[p_i p_j q s]` with q the apex of `face`'s tetrahedron on `side`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeTet {
+    /// Index into [`SimplicialHull::edges`].
+    pub edge: u32,
+    /// The triangle whose face tetrahedron this edge tetrahedron is glued to.
+    pub face: u32,
+    /// The side both face tetrahedra lie on.
+    pub side: Side,
+    /// `[p_i, p_j, q, s]`, with s the midpoint of the two apexes.
+    pub tet: [DVec3; 4],
+}
+
+impl SimplicialHull {
+    /// The face tetrahedron `[p_i p_j p_k q]` of `triangle` on `side`, if built.
+    #[must_use]
+    pub fn face_tet(&self, triangle: usize, side: Side) -> Option<[DVec3; 4]> {
+        let [a, b, c] = self.triangles[triangle];
+        self.apexes[triangle][side as usize].map(|q| {
+            [
+                self.points[a as usize],
+                self.points[b as usize],
+                self.points[c as usize],
+                q,
+            ]
+        })
+    }
+
+    /// The edges of T in first-seen order. Errors name the edge when more than two triangles
+    /// share it (T must be a manifold).
+    pub fn edges(&self) -> Result<Vec<HullEdge>, String> {
+        let mut map: HashMap<(u32, u32), usize> = HashMap::new();
+        let mut edges: Vec<HullEdge> = Vec::new();
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                match map.get(&key) {
+                    None => {
+                        map.insert(key, edges.len());
+                        edges.push(HullEdge {
+                            v: [a, b],
+                            faces: [t as u32, u32::MAX],
+                        });
+                    }
+                    Some(&e) if edges[e].faces[1] == u32::MAX => edges[e].faces[1] = t as u32,
+                    Some(_) => {
+                        return Err(format!(
+                            "hull edge ({a}, {b}) is shared by more than two triangles"
+                        ))
+                    }
+                }
+            }
+        }
+        Ok(edges)
+    }
+
+    /// The edge tetrahedra S_e: for every interior edge of T and every side on which both
+    /// adjacent triangles have a face tetrahedron, the pair glued to them.
+    pub fn edge_tets(&self) -> Result<Vec<EdgeTet>, String> {
+        let edges = self.edges()?;
+        let mut out = Vec::new();
+        for (e, edge) in edges.iter().enumerate() {
+            let [f0, f1] = edge.faces;
+            if f1 == u32::MAX {
+                continue;
+            }
+            for side in Side::BOTH {
+                let (Some(q0), Some(q1)) = (
+                    self.apexes[f0 as usize][side as usize],
+                    self.apexes[f1 as usize][side as usize],
+                ) else {
+                    continue;
+                };
+                let s = 0.5 * (q0 + q1);
+                let pi = self.points[edge.v[0] as usize];
+                let pj = self.points[edge.v[1] as usize];
+                for (face, q) in [(f0, q0), (f1, q1)] {
+                    out.push(EdgeTet {
+                        edge: e as u32,
+                        face,
+                        side,
+                        tet: [pi, pj, q, s],
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two triangles sharing an edge, both with outer apexes: one edge-tetrahedron pair whose
+    /// shared point is the apexes' midpoint.
+    #[test]
+    fn edge_tets_pair_on_shared_side() {
+        let hull = SimplicialHull {
+            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)],
+            normals: vec![DVec3::Z; 4],
+            origins: vec![PointOrigin::Other; 4],
+            triangles: vec![[0, 1, 2], [2, 1, 3]],
+            apexes: vec![
+                [Some(DVec3::new(0.3, 0.3, 1.0)), None],
+                [
+                    Some(DVec3::new(0.7, 0.7, 2.0)),
+                    Some(DVec3::new(0.7, 0.7, -1.0)),
+                ],
+            ],
+            element: vec![0, 1],
+        };
+        let edges = hull.edges().unwrap();
+        assert_eq!(edges.len(), 5);
+        let et = hull.edge_tets().unwrap();
+        assert_eq!(et.len(), 2);
+        assert!(et.iter().all(|t| t.side == Side::Outer));
+        assert_eq!(et[0].tet[3], DVec3::new(0.5, 0.5, 1.5));
+        assert_eq!(et[0].tet[2], DVec3::new(0.3, 0.3, 1.0));
+        assert_eq!(et[1].tet[2], DVec3::new(0.7, 0.7, 2.0));
+    }
+}
