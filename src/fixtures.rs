@@ -304,3 +304,68 @@ mod tests {
         assert!((vol - 1.0).abs() < 1e-15, "{vol}");
     }
 }
+
+/// The inner simplicial hull of a convex polyhedron whose vertices are all trihedral (cube,
+/// tetrahedron, dodecahedron), by Algorithm 1 step (3) of the 1994 paper alone: T has one
+/// vertex per face (its centroid, with the face normal) and one triangle per polyhedron vertex
+/// (the centroids of its three faces), whose face tetrahedron has the polyhedron vertex as its
+/// outer apex. A test hull for the schemes, independent of `hull::inner`.
+///
+/// # Panics
+/// If a vertex is not trihedral or a face is degenerate (test input only).
+#[must_use]
+pub fn trihedral_hull(mesh: &crate::mesh::Mesh) -> crate::hull::simplicial::SimplicialHull {
+    use crate::hull::simplicial::{PointOrigin, SimplicialHull};
+    let mut hull = SimplicialHull::default();
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let p: Vec<DVec3> = face.iter().map(|&v| mesh.positions[v as usize]).collect();
+        let c = p.iter().copied().sum::<DVec3>() / p.len() as f64;
+        let n = (1..p.len() - 1)
+            .map(|k| (p[k] - p[0]).cross(p[k + 1] - p[0]))
+            .sum::<DVec3>()
+            .normalize();
+        assert!(n.is_finite(), "degenerate face {f}");
+        hull.points.push(c);
+        hull.normals.push(n);
+        hull.origins.push(PointOrigin::Centroid { face: f as u32 });
+    }
+    for (v, &pv) in mesh.positions.iter().enumerate() {
+        let around: Vec<u32> = (0..mesh.faces.len() as u32)
+            .filter(|&f| mesh.faces[f as usize].contains(&(v as u32)))
+            .collect();
+        assert_eq!(around.len(), 3, "vertex {v} is not trihedral");
+        let [a, b, c] = [around[0], around[1], around[2]];
+        let [pa, pb, pc] = [a, b, c].map(|i| hull.points[i as usize]);
+        let outward = (pb - pa).cross(pc - pa).dot(pv - (pa + pb + pc) / 3.0) > 0.0;
+        hull.triangles
+            .push(if outward { [a, b, c] } else { [a, c, b] });
+        hull.apexes.push([Some(pv), None]);
+        hull.element.push(v as u32);
+    }
+    hull
+}
+
+#[cfg(test)]
+mod hull_tests {
+    use super::*;
+
+    /// The cube's trihedral hull: T is an octahedron (6 centroids, 8 triangles, 12 edges), closed,
+    /// with 24 edge tetrahedra (a pair per cube edge) on the outer side.
+    #[test]
+    fn cube_trihedral_hull_is_an_octahedron() {
+        let (m, _) = crate::mesh::load(std::path::Path::new("scenes/models/cube.obj")).unwrap();
+        let hull = trihedral_hull(&m);
+        assert_eq!((hull.points.len(), hull.triangles.len()), (6, 8));
+        let edges = hull.edges().unwrap();
+        assert_eq!(edges.len(), 12);
+        assert!(edges.iter().all(|e| e.faces[1] != u32::MAX));
+        assert_eq!(hull.edge_tets().unwrap().len(), 24);
+        // Every face tetrahedron has positive orientation: the apex lies on the outer side.
+        for t in 0..8 {
+            let [a, b, c, q] = hull
+                .face_tet(t, crate::hull::simplicial::Side::Outer)
+                .unwrap();
+            assert!((b - a).cross(c - a).dot(q - a) > 0.0);
+        }
+    }
+}
