@@ -39,7 +39,8 @@ fn run(name: &str) -> Result<(usize, Vec<String>), String> {
 fn explore_all() {
     for e in std::fs::read_dir("scenes/models").unwrap() {
         let name = e.unwrap().file_name().into_string().unwrap();
-        if !name.ends_with(".obj") {
+        let only = std::env::var("MODEL").unwrap_or_default();
+        if !name.ends_with(".obj") || !name.contains(&only) {
             continue;
         }
         match run(&name) {
@@ -54,11 +55,34 @@ fn explore_all() {
                     "  {name}: {n} triangles, {} violations {kinds:?}",
                     msgs.len()
                 );
-                for m in msgs.iter().take(3) {
+                for m in msgs.iter().take(8) {
                     eprintln!("    {m}");
                 }
             }
             Err(e) => eprintln!("  {name}: ERROR {e}"),
         }
+    }
+}
+
+#[test]
+#[ignore = "exploration"]
+fn debug_one() {
+    let name = std::env::var("MODEL").unwrap();
+    let tri: usize = std::env::var("TRI").unwrap().parse().unwrap();
+    let path = Path::new("scenes/models").join(&name);
+    let (m, _) = mesh::load(&path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+    let t = hull.triangles[tri];
+    let e = hull.element[tri] as usize;
+    eprintln!("vertex {e} at {} n {}", m.positions[e], normals[e]);
+    for &i in &t {
+        eprintln!("  point {i} {:?} at {} n {}", hull.origins[i as usize], hull.points[i as usize], hull.normals[i as usize]);
+    }
+    eprintln!("  apexes {:?}", hull.apexes[tri]);
+    for &i in &t {
+        let (p, n) = (hull.points[i as usize], hull.normals[i as usize]);
+        let others: Vec<f64> = t.iter().map(|&j| hull.points[j as usize]).chain(hull.apexes[tri].iter().flatten().copied()).map(|x| n.dot(x - p)).collect();
+        eprintln!("  at {i}: {others:?}");
     }
 }

@@ -32,9 +32,11 @@ pub const DEGENERATE_VOLUME: f64 = 1e-8;
 /// the coordinates (≈1e-15); a real overlap is a visible fraction of a tetrahedron.
 pub const OVERLAP_DEPTH: f64 = 1e-7;
 
-/// Tangent-containment and sidedness tolerance relative to the tetrahedron's longest edge: a
-/// point within 1e-9 of a plane is on it (rounding of the construction is ≈1e-15).
-pub const PLANE_TOL: f64 = 1e-9;
+/// Tangent-containment tolerance relative to the tetrahedron's longest edge. The tangent plane
+/// at a centroid or corner guard is its polygon's plane, and the construction puts apexes on
+/// polygon edges (steps (3), (5)(i)); input polygons are accepted up to
+/// [`crate::mesh::PLANARITY_TOL`] of non-planarity, so such apexes may lie that far off it.
+pub const PLANE_TOL: f64 = crate::mesh::PLANARITY_TOL;
 
 /// What is wrong.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
