@@ -77,12 +77,20 @@ fn debug_one() {
     let e = hull.element[tri] as usize;
     eprintln!("vertex {e} at {} n {}", m.positions[e], normals[e]);
     for &i in &t {
-        eprintln!("  point {i} {:?} at {} n {}", hull.origins[i as usize], hull.points[i as usize], hull.normals[i as usize]);
+        eprintln!(
+            "  point {i} {:?} at {} n {}",
+            hull.origins[i as usize], hull.points[i as usize], hull.normals[i as usize]
+        );
     }
     eprintln!("  apexes {:?}", hull.apexes[tri]);
     for &i in &t {
         let (p, n) = (hull.points[i as usize], hull.normals[i as usize]);
-        let others: Vec<f64> = t.iter().map(|&j| hull.points[j as usize]).chain(hull.apexes[tri].iter().flatten().copied()).map(|x| n.dot(x - p)).collect();
+        let others: Vec<f64> = t
+            .iter()
+            .map(|&j| hull.points[j as usize])
+            .chain(hull.apexes[tri].iter().flatten().copied())
+            .map(|x| n.dot(x - p))
+            .collect();
         eprintln!("  at {i}: {others:?}");
     }
 }

@@ -172,12 +172,20 @@ pub fn build_with_report(
     let topo = Topology::new(nv, &pieces.faces);
 
     let mut hull = SimplicialHull::default();
-    for (f, piece) in pieces.faces.iter().enumerate() {
-        let c = piece
-            .iter()
+    let mean = |face: &[u32]| {
+        face.iter()
             .map(|&v| mesh.positions[v as usize])
             .sum::<DVec3>()
-            / piece.len() as f64;
+            / face.len() as f64
+    };
+    for (f, piece) in pieces.faces.iter().enumerate() {
+        let mut c = mean(piece);
+        if pieces.guard[f] {
+            // Corner guards of one polygon lie exactly in its plane (through its vertex mean),
+            // so the guard net's edges are zero convex even when the polygon is slightly bent.
+            let o = mean(&mesh.faces[pieces.parent[f] as usize]);
+            c -= pieces.normal[f].dot(c - o) * pieces.normal[f];
+        }
         hull.points.push(c);
         hull.normals.push(pieces.normal[f]);
         let face = pieces.parent[f];
