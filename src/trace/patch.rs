@@ -6,7 +6,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::bb::rational::{multinomial, term_jet};
-use crate::bb::{index_of, num_coeffs, poly, uni};
+use crate::bb::{index_of, multi_indices, num_coeffs, poly, uni};
 use crate::complex::{Patch, RationalTerm, SheetRule};
 use glam::{DMat3, DVec3};
 
@@ -61,6 +61,11 @@ pub struct CompiledPatch {
     /// Polynomial degree n.
     pub degree: usize,
     weights: Vec<f64>,
+    /// BB weights (degree `segment_degree`) of the cleared polynomial G = F·Π D_g when the
+    /// patch has rational terms (empty otherwise: G = F): restricting G to a segment is one
+    /// blossom chain instead of a product of univariate pieces per term.
+    cleared: Vec<f64>,
+    #[cfg(test)]
     groups: Vec<RationalGroup>,
     /// The rational terms as given (for derivatives at a hit).
     rational: Vec<RationalTerm>,
@@ -83,6 +88,7 @@ pub struct CompiledPatch {
     pub zero_tol: f64,
 }
 
+#[cfg(test)]
 /// Bernstein coefficients (degree |μ|) of α(s)^μ with α(s) = (1−s)a + s·b.
 fn monomial_segment(mu: [u8; 4], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
     out[0] = 1.0;
@@ -97,6 +103,7 @@ fn monomial_segment(mu: [u8; 4], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -
     len - 1
 }
 
+#[cfg(test)]
 /// Sum into `acc` (degree `*deg`) the polynomial `p` of degree `d`, elevating as needed.
 fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
     let mut q = *p;
@@ -112,10 +119,92 @@ fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
     }
 }
 
+#[cfg(test)]
 /// `out[..=m+n]` = the product of `p[..=m]` and `q[..=n]`.
 #[inline]
 fn product(p: &Coeffs, m: usize, q: &Coeffs, n: usize, out: &mut Coeffs) {
     uni::multiply_into(&p[..=m], &q[..=n], out);
+}
+
+/// BB weights of the product of two homogeneous BB polynomials of degrees `m` and `k`:
+/// B^m_λ·B^k_μ = (m!/λ!)(k!/μ!)/((m+k)!/(λ+μ)!)·B^(m+k)_(λ+μ).
+fn bb_product(m: usize, p: &[f64], k: usize, q: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; num_coeffs(m + k)];
+    let (lp, lq) = (multi_indices(m), multi_indices(k));
+    for (i, l) in lp.iter().enumerate() {
+        if p[i] == 0.0 {
+            continue;
+        }
+        for (j, u) in lq.iter().enumerate() {
+            if q[j] == 0.0 {
+                continue;
+            }
+            let s = [l[0] + u[0], l[1] + u[1], l[2] + u[2], l[3] + u[3]];
+            out[index_of(s)] += p[i] * q[j] * multinomial(*l) * multinomial(*u) / multinomial(s);
+        }
+    }
+    out
+}
+
+/// `p` (degree `m`) elevated to degree `e` ≥ m (multiplied by (Σα)^(e−m) = 1).
+fn bb_elevate_to(m: usize, p: Vec<f64>, e: usize) -> Vec<f64> {
+    (m..e).fold(p, |c, d| poly::elevate(d, &c))
+}
+
+/// Sum of two BB polynomials, at the larger degree.
+fn bb_add(m: usize, p: Vec<f64>, k: usize, q: Vec<f64>) -> (usize, Vec<f64>) {
+    let e = m.max(k);
+    let mut p = bb_elevate_to(m, p, e);
+    let q = bb_elevate_to(k, q, e);
+    for (x, y) in p.iter_mut().zip(&q) {
+        *x += y;
+    }
+    (e, p)
+}
+
+/// The monomial α^μ as a BB polynomial of degree |μ|: B_μ / (|μ|!/μ!).
+fn bb_monomial(mu: [u8; 4]) -> (usize, Vec<f64>) {
+    let d: usize = mu.iter().map(|&x| usize::from(x)).sum();
+    let mut c = vec![0.0; num_coeffs(d)];
+    c[index_of(mu)] = 1.0 / multinomial(mu);
+    (d, c)
+}
+
+/// BB weights of the cleared polynomial G = P·Π_g D_g + Σ_g (Σ_r N_r·B_κr)·Π_{g'≠g} D_g' of a
+/// patch with polynomial part `weights` (degree `n`) and rational `groups`, following the
+/// degrees of the univariate construction (so its degree is the patch's `segment_degree`).
+fn clear_denominators(n: usize, weights: &[f64], groups: &[RationalGroup]) -> Vec<f64> {
+    let (mut deg, mut out) = (n, weights.to_vec());
+    let (mut qdeg, mut q) = (0usize, vec![1.0]);
+    for g in groups {
+        let (mut dden, mut den) = (0usize, vec![0.0]);
+        for mu in &g.denominator {
+            let (d, m) = bb_monomial(*mu);
+            (dden, den) = bb_add(dden, den, d, m);
+        }
+        let (mut dsum, mut sum) = (0usize, vec![0.0]);
+        for (kappa, _, numer) in &g.terms {
+            let (mut dnum, mut num) = (0usize, vec![0.0]);
+            for (w, mu) in numer {
+                let (d, mut m) = bb_monomial(*mu);
+                for x in &mut m {
+                    *x *= w;
+                }
+                (dnum, num) = bb_add(dnum, num, d, m);
+            }
+            // B^n_κ: weight 1 at κ.
+            let mut bern = vec![0.0; num_coeffs(n)];
+            bern[index_of(*kappa)] = 1.0;
+            let prod = bb_product(dnum, &num, n, &bern);
+            (dsum, sum) = bb_add(dsum, sum, dnum + n, prod);
+        }
+        let left = bb_product(deg, &out, dden, &den);
+        let right = bb_product(dsum, &sum, qdeg, &q);
+        (deg, out) = bb_add(deg + dden, left, dsum + qdeg, right);
+        q = bb_product(qdeg, &q, dden, &den);
+        qdeg += dden;
+    }
+    out
 }
 
 impl CompiledPatch {
@@ -255,7 +344,17 @@ impl CompiledPatch {
         let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), w| {
             (l.min(w), h.max(w))
         });
-        let no_zero = lo > 0.0 || hi < 0.0;
+        let cleared = if groups.is_empty() {
+            Vec::new()
+        } else {
+            clear_denominators(n, &patch.weights, &groups)
+        };
+        debug_assert!(cleared.is_empty() || cleared.len() == num_coeffs(segment_degree));
+        // G = F·Π D_g with D_g ≥ 0 in the tetrahedron: weights of G of one strict sign also
+        // exclude a zero (the convex hull property of G).
+        let g_sign =
+            |w: &[f64]| !w.is_empty() && (w.iter().all(|&x| x > 0.0) || w.iter().all(|&x| x < 0.0));
+        let no_zero = lo > 0.0 || hi < 0.0 || g_sign(&cleared);
         let zero_tol = 64.0 * f64::EPSILON * lo.abs().max(hi.abs()) * segment_degree as f64;
         Ok(CompiledPatch {
             zero_tol,
@@ -266,6 +365,8 @@ impl CompiledPatch {
             grad,
             degree: n,
             weights: patch.weights.clone(),
+            cleared,
+            #[cfg(test)]
             groups,
             rational: patch.rational.clone(),
             sheet,
@@ -324,62 +425,15 @@ impl CompiledPatch {
 
     /// Bernstein coefficients on s ∈ [0, 1] of F((1−s)·a + s·b) (barycentric endpoints), with
     /// rational denominators cleared (multiplied by their positive values). Returns the degree.
+    #[inline]
     pub fn segment(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
-        let n = self.degree;
-        // Polynomial part: c_k = blossom(a^(n−k), b^k).
-        poly::restrict(n, &self.weights, *a, *b, out);
-        if self.groups.is_empty() {
-            return n;
+        if self.cleared.is_empty() {
+            poly::restrict(self.degree, &self.weights, *a, *b, out);
+            self.degree
+        } else {
+            poly::restrict(self.segment_degree, &self.cleared, *a, *b, out);
+            self.segment_degree
         }
-        // Rational terms: G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group.
-        let mut deg = n;
-        let mut q = [0.0; MAX_DEGREE + 1]; // Π of the denominators so far
-        q[0] = 1.0;
-        let mut qdeg = 0;
-        for g in &self.groups {
-            let mut den = [0.0; MAX_DEGREE + 1];
-            let mut dden = 0;
-            for mu in &g.denominator {
-                let mut m = [0.0; MAX_DEGREE + 1];
-                let d = monomial_segment(*mu, a, b, &mut m);
-                add_poly(&mut den, &mut dden, &m, d);
-            }
-            let mut sum = [0.0; MAX_DEGREE + 1];
-            let mut dsum = 0;
-            for (kappa, mult, numer) in &g.terms {
-                let mut num = [0.0; MAX_DEGREE + 1];
-                let mut dnum = 0;
-                for (w, mu) in numer {
-                    let mut m = [0.0; MAX_DEGREE + 1];
-                    let d = monomial_segment(*mu, a, b, &mut m);
-                    for x in &mut m[..=d] {
-                        *x *= w;
-                    }
-                    add_poly(&mut num, &mut dnum, &m, d);
-                }
-                let mut bern = [0.0; MAX_DEGREE + 1];
-                let dk = monomial_segment(*kappa, a, b, &mut bern);
-                for x in &mut bern[..=dk] {
-                    *x *= mult;
-                }
-                let mut prod = [0.0; MAX_DEGREE + 1];
-                product(&num, dnum, &bern, dk, &mut prod);
-                add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
-            }
-            let mut left = [0.0; MAX_DEGREE + 1];
-            product(out, deg, &den, dden, &mut left);
-            let mut right = [0.0; MAX_DEGREE + 1];
-            product(&sum, dsum, &q, qdeg, &mut right);
-            let mut dl = deg + dden;
-            add_poly(&mut left, &mut dl, &right, dsum + qdeg);
-            *out = left;
-            deg = dl;
-            let mut nq = [0.0; MAX_DEGREE + 1];
-            product(&q, qdeg, &den, dden, &mut nq);
-            q = nq;
-            qdeg += dden;
-        }
-        deg
     }
 
     /// F, its gradient and Hessian with respect to the four barycentric variables at `alpha`.
@@ -445,15 +499,7 @@ impl CompiledPatch {
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<Self>()
             + self.weights.len() * 8
-            + self
-                .groups
-                .iter()
-                .map(|g| {
-                    std::mem::size_of::<RationalGroup>()
-                        + g.denominator.len() * 4
-                        + g.terms.iter().map(|t| 48 + t.2.len() * 16).sum::<usize>()
-                })
-                .sum::<usize>()
+            + self.cleared.len() * 8
             + self
                 .rational
                 .iter()
@@ -471,6 +517,69 @@ pub struct Jet {
     pub g: [f64; 4],
     /// Hessian.
     pub h: [[f64; 4]; 4],
+}
+
+#[cfg(test)]
+impl CompiledPatch {
+    /// [`Self::segment`] computed the slow, independent way: univariate products of every
+    /// term's monomials along the segment (the reference for the BB-form clearing).
+    pub fn segment_by_products(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
+        let n = self.degree;
+        // Polynomial part: c_k = blossom(a^(n−k), b^k).
+        poly::restrict(n, &self.weights, *a, *b, out);
+        if self.groups.is_empty() {
+            return n;
+        }
+        // Rational terms: G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group.
+        let mut deg = n;
+        let mut q = [0.0; MAX_DEGREE + 1]; // Π of the denominators so far
+        q[0] = 1.0;
+        let mut qdeg = 0;
+        for g in &self.groups {
+            let mut den = [0.0; MAX_DEGREE + 1];
+            let mut dden = 0;
+            for mu in &g.denominator {
+                let mut m = [0.0; MAX_DEGREE + 1];
+                let d = monomial_segment(*mu, a, b, &mut m);
+                add_poly(&mut den, &mut dden, &m, d);
+            }
+            let mut sum = [0.0; MAX_DEGREE + 1];
+            let mut dsum = 0;
+            for (kappa, mult, numer) in &g.terms {
+                let mut num = [0.0; MAX_DEGREE + 1];
+                let mut dnum = 0;
+                for (w, mu) in numer {
+                    let mut m = [0.0; MAX_DEGREE + 1];
+                    let d = monomial_segment(*mu, a, b, &mut m);
+                    for x in &mut m[..=d] {
+                        *x *= w;
+                    }
+                    add_poly(&mut num, &mut dnum, &m, d);
+                }
+                let mut bern = [0.0; MAX_DEGREE + 1];
+                let dk = monomial_segment(*kappa, a, b, &mut bern);
+                for x in &mut bern[..=dk] {
+                    *x *= mult;
+                }
+                let mut prod = [0.0; MAX_DEGREE + 1];
+                product(&num, dnum, &bern, dk, &mut prod);
+                add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
+            }
+            let mut left = [0.0; MAX_DEGREE + 1];
+            product(out, deg, &den, dden, &mut left);
+            let mut right = [0.0; MAX_DEGREE + 1];
+            product(&sum, dsum, &q, qdeg, &mut right);
+            let mut dl = deg + dden;
+            add_poly(&mut left, &mut dl, &right, dsum + qdeg);
+            *out = left;
+            deg = dl;
+            let mut nq = [0.0; MAX_DEGREE + 1];
+            product(&q, qdeg, &den, dden, &mut nq);
+            q = nq;
+            qdeg += dden;
+        }
+        deg
+    }
 }
 
 #[cfg(test)]
@@ -585,6 +694,56 @@ mod tests {
                 "{hd} vs {}",
                 h.col(axis)
             );
+        }
+    }
+
+    #[test]
+    fn bb_cleared_form_matches_the_univariate_products() {
+        // Two denominator groups (an edge-patch style α3 + α4 and a face-patch style
+        // α1α2 + α1α3 + α2α3), three terms: the BB-form G restricted to random segments must
+        // equal the term-by-term univariate construction.
+        let q = Quadric::sphere(DVec3::new(0.3, 0.3, 0.3), 0.4);
+        let mut p = patch(&q, 3);
+        p.rational.push(RationalTerm {
+            index: [1, 0, 1, 1],
+            terms: vec![(0.7, [0, 0, 1, 0]), (-1.3, [0, 0, 0, 1])],
+        });
+        p.rational.push(RationalTerm {
+            index: [0, 1, 1, 1],
+            terms: vec![(2.0, [0, 0, 0, 1]), (0.4, [0, 0, 1, 0])],
+        });
+        p.rational.push(RationalTerm {
+            index: [1, 1, 1, 0],
+            terms: vec![
+                (0.5, [1, 1, 0, 0]),
+                (-0.2, [1, 0, 1, 0]),
+                (1.1, [0, 1, 1, 0]),
+            ],
+        });
+        let c = CompiledPatch::new(&p, 0).unwrap();
+        assert_eq!(c.segment_degree, 6);
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..50 {
+            let mut pick = || {
+                let w = [rnd(), rnd(), rnd(), rnd()];
+                let s: f64 = w.iter().sum();
+                w.map(|x| x / s)
+            };
+            let (a, b) = (pick(), pick());
+            let (mut x, mut y) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+            let dx = c.segment(&a, &b, &mut x);
+            let dy = c.segment_by_products(&a, &b, &mut y);
+            assert_eq!(dx, dy);
+            for k in 0..=dx {
+                // Both are sums of O(1) products of O(1) barycentrics: rounding only.
+                assert!((x[k] - y[k]).abs() < 1e-13, "{k}: {} vs {}", x[k], y[k]);
+            }
         }
     }
 }
