@@ -88,3 +88,43 @@ fn bad_scene_exits_2_naming_file_and_key() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--mode"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn ctrl_c_stops_the_render_and_leaves_no_file() {
+    use std::io::{BufRead, BufReader};
+    // A render that takes minutes on one thread (4096² pixels × 64 spp): SIGINT arrives long
+    // before it could finish, and it stops at the next row (4096 × 64 samples, well under a
+    // second), so the outcome does not depend on timing.
+    let dir = setup("sigint", SCENE);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_apatch"))
+        .args(["render", "s.toml", "--width", "4096", "--height", "4096"])
+        .args(["--spp", "64", "--threads", "1"])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut first = String::new();
+    err.read_line(&mut first).unwrap();
+    assert!(first.contains("rendering"), "{first}");
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let mut rest = String::new();
+    for line in err.lines() {
+        rest.push_str(&line.unwrap());
+        rest.push('\n');
+    }
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{rest}");
+    assert!(rest.contains("interrupted"), "{rest}");
+    // Neither the outputs nor their temporary siblings exist (nor their directory's content).
+    let out = dir.join("out");
+    let left: Vec<_> = std::fs::read_dir(&out)
+        .map(|d| d.map(|e| e.unwrap().file_name()).collect())
+        .unwrap_or_default();
+    assert!(left.is_empty(), "left behind: {left:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

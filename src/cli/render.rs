@@ -88,6 +88,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
 
     let _ = ctrlc::set_handler(|| CANCEL.store(true, Ordering::Relaxed));
     let s = &scene.settings;
+    // One line before the (terminal-only) progress bar: says what runs, and tells scripts and
+    // tests that rendering has started and Ctrl-C is now handled.
+    eprintln!(
+        "apatch: rendering {}×{} at {} spp, {} patches (Ctrl-C stops without writing)",
+        s.camera.width,
+        s.camera.height,
+        s.spp,
+        complex.patches.len()
+    );
     let bar = indicatif::ProgressBar::new(u64::from(s.camera.height));
     bar.set_style(
         indicatif::ProgressStyle::with_template(

@@ -263,7 +263,10 @@ pub fn radiance(
     out
 }
 
-fn cosine_direction(n: DVec3, rnd: [f64; 2]) -> DVec3 {
+/// A cosine-weighted direction about the unit normal `n` from two uniform numbers (the sampling
+/// of the `constant` emitter's shadow rays; public so other tracers can sample alike).
+#[must_use]
+pub fn cosine_direction(n: DVec3, rnd: [f64; 2]) -> DVec3 {
     let r = rnd[0].sqrt();
     let phi = 2.0 * std::f64::consts::PI * rnd[1];
     let (t, b) = n.any_orthonormal_pair();
