@@ -42,6 +42,52 @@ fn trihedral_solids_are_c1() {
                 "{model}"
             );
             assert!(r.passed(), "{model} {:?}", r.failures());
+            // Every patch promises a j-vertex (face) or j-edge (edge) and keeps it.
+            assert!(
+                r.sheets.j_patches == r.patches && r.sheets.j_lines > 0,
+                "{model}"
+            );
         }
     }
+}
+
+fn quadratic_patch(weights_by_level: [f64; 3]) -> apatch::complex::PatchComplex {
+    use apatch::complex::{Patch, PatchComplex, Role, SheetRule};
+    let weights = apatch::bb::multi_indices(2)
+        .iter()
+        .map(|l| weights_by_level[usize::from(l[3])])
+        .collect();
+    let mut c = PatchComplex::new("test");
+    c.patches.push(Patch {
+        tet: [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ],
+        degree: 2,
+        weights,
+        rational: Vec::new(),
+        sheet: SheetRule::Any,
+        role: Role::Face,
+        element: 0,
+        jvertex: Some(3),
+        jedge: None,
+    });
+    c
+}
+
+/// The j-line check can fail: F = (α4 − 0.3)(α4 − 0.7) (BB weights 0.21, −0.29, 0.21 by the
+/// level λ4) is crossed twice by every line from vertex 3; F = α4 − 0.5 (weights −0.5, 0, 0.5)
+/// once.
+#[test]
+fn j_line_check_sees_two_sheets() {
+    let two = check(
+        &quadratic_patch([0.21, -0.29, 0.21]),
+        &CheckOptions::default(),
+    );
+    assert!(two.sheets.j_patches == 1 && two.sheets.j_multi_lines == two.sheets.j_lines);
+    assert!(two.failures().contains(&"multiple sheets along j-lines"));
+    let one = check(&quadratic_patch([-0.5, 0.0, 0.5]), &CheckOptions::default());
+    assert!(one.sheets.j_lines > 0 && one.sheets.j_multi_lines == 0);
 }

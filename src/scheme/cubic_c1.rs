@@ -23,6 +23,7 @@ pub mod weights;
 
 use crate::complex::{Patch, PatchComplex, Role};
 use crate::error::{Error, Result};
+use crate::hull::inner::InnerOptions;
 use crate::hull::simplicial::{Side, SimplicialHull};
 use crate::mesh::Mesh;
 use anyhow::{anyhow, Context};
@@ -349,6 +350,10 @@ fn patch(tet: [DVec3; 4], w: &[f64; 20], role: Role, element: u32) -> Patch {
         sheet: crate::complex::SheetRule::Any,
         role,
         element,
+        // Face tetrahedra: a j-patch for the apex; edge tetrahedra: single sheeted between
+        // [p_i p_j] and [q s] (see `weights`).
+        jvertex: (role == Role::Face).then_some(3),
+        jedge: (role == Role::Edge).then_some([0, 1]),
     }
 }
 
@@ -398,79 +403,61 @@ fn validate(hull: &SimplicialHull, options: &CubicOptions) -> Result<()> {
     Ok(())
 }
 
-/// Reads the scheme options from a scene's `[scheme]` table (keys other than `type` and
-/// `alpha`, which belongs to the hull).
+/// Reads the scheme options from a scene's `[scheme]` table: the hull's keys
+/// ([`InnerOptions::KEYS`]) by [`InnerOptions::from_toml`], and this scheme's `level`, `center`,
+/// `gradient_scale`, `levels`. Without `level`, the hull's `trihedral_level` (in [0, 1]) is used,
+/// kept 0.02 away from the bottom and the top (a level of exactly 0 or 1 puts the zero on a
+/// boundary of the tetrahedron).
 ///
 /// # Errors
-/// Unknown keys and bad values, naming the key.
-pub fn options_from_toml(table: &toml::Table) -> std::result::Result<(CubicOptions, f64), String> {
-    let mut o = CubicOptions::default();
-    let mut alpha = 0.5;
+/// Unknown keys and bad values, naming the scene file and the key.
+pub fn options_from_toml(
+    table: &toml::Table,
+    scene: &Path,
+) -> anyhow::Result<(CubicOptions, InnerOptions)> {
+    let inner = InnerOptions::from_toml(table, scene)?;
+    let mut o = CubicOptions {
+        level: inner.trihedral_level.clamp(0.02, 0.98),
+        ..CubicOptions::default()
+    };
+    let bad = |m: String| anyhow!("{}: {m}", scene.display());
     let num = |k: &str, v: &toml::Value| {
         v.as_float()
             .or_else(|| v.as_integer().map(|i| i as f64))
-            .ok_or_else(|| format!("`scheme.{k}` must be a number"))
+            .ok_or_else(|| {
+                bad(format!(
+                    "`scheme.{k}`: expected a number, found {}",
+                    v.type_str()
+                ))
+            })
     };
     for (k, v) in table {
         match k.as_str() {
             "type" => {}
-            "alpha" => alpha = num(k, v)?,
+            k if InnerOptions::KEYS.contains(&k) => {}
             "level" => o.level = num(k, v)?,
             "center" => o.center = num(k, v)?,
             "gradient_scale" => o.gradient_scale = num(k, v)?,
             "levels" => {
-                let t = v
-                    .as_table()
-                    .ok_or("`scheme.levels` must be a table { \"element\" = level }")?;
+                let t = v.as_table().ok_or_else(|| {
+                    bad("`scheme.levels` must be a table { \"element\" = level }".into())
+                })?;
                 for (e, l) in t {
-                    let id: u32 = e
-                        .parse()
-                        .map_err(|_| format!("`scheme.levels`: key `{e}` is not an element id"))?;
+                    let id: u32 = e.parse().map_err(|_| {
+                        bad(format!("`scheme.levels`: key `{e}` is not an element id"))
+                    })?;
                     o.levels.insert(id, num(&format!("levels.{e}"), l)?);
                 }
             }
             _ => {
-                return Err(format!(
-                    "unknown key `scheme.{k}` (cubic-c1 has alpha, level, center, gradient_scale, levels)"
-                ))
+                return Err(bad(format!(
+                    "unknown key `scheme.{k}` (cubic-c1 has alpha, trihedral_level, fix_normals, \
+                     level, center, gradient_scale, levels)"
+                )))
             }
         }
     }
-    if !(alpha > 0.0 && alpha < 1.0) {
-        return Err(format!("`scheme.alpha` = {alpha} is not in (0, 1)"));
-    }
-    Ok((o, alpha))
-}
-
-/// The hull of `mesh`: [`crate::hull::inner::build`]; while that cannot build a mesh whose
-/// vertices are all trihedral, the test hull [`crate::fixtures::trihedral_hull`] (Algorithm 1
-/// step (3) alone, exact for such meshes).
-///
-/// # Errors
-/// The inner hull's error when the fallback does not apply.
-pub fn hull_of(mesh: &Mesh, normals: &[DVec3], alpha: f64) -> Result<SimplicialHull> {
-    // The inner hull gains options on its own branch; keep the remaining ones at their defaults.
-    #[allow(clippy::needless_update)]
-    let opts = crate::hull::inner::InnerOptions {
-        alpha,
-        ..Default::default()
-    };
-    match crate::hull::inner::build(mesh, normals, &opts) {
-        Ok(h) => Ok(h),
-        Err(e) => {
-            let mut valence = vec![0usize; mesh.positions.len()];
-            for f in &mesh.faces {
-                for &v in f {
-                    valence[v as usize] += 1;
-                }
-            }
-            if valence.iter().all(|&k| k == 3) {
-                Ok(crate::fixtures::trihedral_hull(mesh))
-            } else {
-                Err(e)
-            }
-        }
-    }
+    Ok((o, inner))
 }
 
 /// Builds the `cubic-c1` patch complex of `mesh` with unit vertex normals `normals`; `scheme` is
@@ -485,8 +472,8 @@ pub fn build_from_scene(
     scheme: &toml::Table,
     scene: &Path,
 ) -> anyhow::Result<PatchComplex> {
-    let (options, alpha) =
-        options_from_toml(scheme).map_err(|m| anyhow!("{}: {m}", scene.display()))?;
-    let hull = hull_of(mesh, normals, alpha).with_context(|| format!("{}", scene.display()))?;
+    let (options, inner) = options_from_toml(scheme, scene)?;
+    let hull = crate::hull::inner::build(mesh, normals, &inner)
+        .with_context(|| format!("{}", scene.display()))?;
     build(&hull, &options).with_context(|| format!("{}", scene.display()))
 }

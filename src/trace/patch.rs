@@ -607,6 +607,8 @@ mod tests {
             sheet: SheetRule::Any,
             role: Role::Other,
             element: 0,
+            jvertex: None,
+            jedge: None,
         }
     }
 
