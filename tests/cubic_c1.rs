@@ -91,3 +91,35 @@ fn j_line_check_sees_two_sheets() {
     let one = check(&quadratic_patch([-0.5, 0.0, 0.5]), &CheckOptions::default());
     assert!(one.sheets.j_lines > 0 && one.sheets.j_multi_lines == 0);
 }
+
+/// Exploration: counters of the build on every paper1994 model (`MODEL=name`).
+#[test]
+#[ignore = "exploration"]
+fn explore_models() {
+    use apatch::hull::inner::{self, InnerOptions};
+    let only = std::env::var("MODEL").unwrap_or_default();
+    for name in [
+        "octahedron.obj",
+        "l_prism.obj",
+        "torus_quad.obj",
+        "letter_P_poly.obj",
+        "star_prism.obj",
+    ] {
+        if !name.contains(&only) {
+            continue;
+        }
+        let (m, _) = apatch::mesh::load(&Path::new("scenes/models").join(name)).unwrap();
+        let vn = apatch::mesh::vertex_normals(&m, apatch::mesh::NormalMethod::Angle).unwrap();
+        let hull = inner::build(&m, &vn, &InnerOptions::default()).unwrap();
+        let two = hull
+            .apexes
+            .iter()
+            .filter(|a| a[0].is_some() && a[1].is_some())
+            .count();
+        let inner_only = hull.apexes.iter().filter(|a| a[0].is_none()).count();
+        let b = build_full(&hull, &CubicOptions::default()).unwrap();
+        let r = check(&b.complex, &CheckOptions::default());
+        eprintln!("{name}: tris {} LU {two} inner-only {inner_only} flat {} raised {} unsigned {} grad {:e} at {:?} j-multi {:?}",
+            hull.triangles.len(), b.flat_edges, b.raised, b.unsigned, r.gradient_jump.worst, r.gradient_jump.at, r.sheets.j_multi_at);
+    }
+}

@@ -33,6 +33,7 @@
 //! patch's largest weight S: a root of the shooting polynomial φ(t) is simple when
 //! |φ′(t)| > tolerance · S.
 
+pub mod distance;
 pub mod eval;
 mod faces;
 mod interp;

@@ -19,6 +19,7 @@
 //! levels = { "7" = 0.9 } # per input element (vertex) overrides of `level` (§7 free weights)
 //! ```
 
+pub mod flat;
 pub mod weights;
 
 use crate::complex::{Patch, PatchComplex, Role};
@@ -31,6 +32,9 @@ use glam::DVec3;
 use std::collections::HashMap;
 use std::path::Path;
 use weights::{bary_in, e3, gradient_weight, ix, level_height, level_mean, EdgeBlossom};
+
+/// Largest group of coupled flat-edge equations solved (a dense m×m elimination).
+pub const MAX_FLAT_GROUP: usize = 1500;
 
 /// Shape control of the cubic scheme (§7.1 and the free weights of §6).
 #[derive(Clone, Debug, PartialEq)]
@@ -65,9 +69,12 @@ impl Default for CubicOptions {
 pub struct CubicBuild {
     /// The patches.
     pub complex: PatchComplex,
-    /// Edges of T where the adjacent triangles are coplanar (the paper's singular case): C¹
-    /// there needs the in-plane data to agree (it does when T is flat with equal normals).
+    /// Edges of T where the adjacent triangles are coplanar (the paper's singular case): the
+    /// number 2 weights of the triangles there are adjusted ([`flat`]).
     pub flat_edges: usize,
+    /// Flat-edge equations in groups too large to solve (larger than [`MAX_FLAT_GROUP`]); C¹
+    /// may fail there.
+    pub flat_unsolved: usize,
     /// Number 4 / 6 weights raised above the `level` rule for the sign conditions.
     pub raised: usize,
     /// Edge tetrahedra whose midpoint s is not on the apex side of the face tetrahedron's base
@@ -104,12 +111,13 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
     let mut out = CubicBuild {
         complex: PatchComplex::new("cubic-c1"),
         flat_edges: 0,
+        flat_unsolved: 0,
         raised: 0,
         unsigned: 0,
     };
 
     // Number 2: a_1110 per triangle (shared by both sides of an L-U pair), quadratic precision.
-    let center: Vec<f64> = hull
+    let mut center: Vec<f64> = hull
         .triangles
         .iter()
         .map(|tri| {
@@ -126,6 +134,35 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
         })
         .collect();
 
+    // Number 2 where T is flat at an edge: the least change making the blossoms exist.
+    let mut flat_eqs = Vec::new();
+    for e in &edges {
+        let [t0, t1] = e.faces;
+        if t1 == u32::MAX {
+            continue;
+        }
+        let [i, j] = e.v.map(|v| v as usize);
+        let third = |t: u32| {
+            hull.triangles[t as usize]
+                .iter()
+                .map(|&v| v as usize)
+                .find(|&v| v != i && v != j)
+                .unwrap_or(i)
+        };
+        if let Some((a, b)) = flat::flat_coords(p[i], p[j], p[third(t0)], p[third(t1)]) {
+            let ai = gradient_weight(p[i], g[i], p[j]);
+            let aj = gradient_weight(p[j], g[j], p[i]);
+            flat_eqs.push(flat::FlatEquation {
+                from: t0 as usize,
+                to: t1 as usize,
+                b,
+                rhs: (1.0 - a - b) * ai + a * aj,
+            });
+        }
+    }
+    out.flat_edges = flat_eqs.len();
+    out.flat_unsolved = flat::adjust(&mut center, &flat_eqs, MAX_FLAT_GROUP);
+
     // Number 3: the edge blossoms.
     let mut blossom: HashMap<(u32, u32), EdgeBlossom> = HashMap::new();
     for e in &edges {
@@ -141,7 +178,6 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
         }
         let prior = (g[i as usize] + g[j as usize]) / 6.0;
         let b = EdgeBlossom::fit(pi, gradient_weight(pi, g[i as usize], pj), &known, prior);
-        out.flat_edges += usize::from(b.flat && e.faces[1] != u32::MAX);
         blossom.insert((i.min(j), i.max(j)), b);
     }
     let edge_blossom = |a: u32, b: u32| blossom[&(a.min(b), a.max(b))];
