@@ -1,33 +1,267 @@
 //! The inner "corner-cutting" simplicial hull of Bajaj, Chen, Xu (1994), §3–5 and appendices
 //! A–C: from a simple polyhedron with vertex normals to a smoothable simplicial hull
 //! ([`SimplicialHull`], Definition 3.6).
+//!
+//! Pipeline ([`build_with_report`]):
+//! 1. [`decompose`]: non-convex polygons are split into convex pieces whose centroids are the
+//!    corner guards (Algorithm 2 reduced to Algorithm 1, as §4 allows).
+//! 2. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
+//!    Appendix C) by rotating it where needed; corners where no direction is above all faces
+//!    are reported as errors.
+//! 3. [`corner`]: Algorithm 1 steps (3)–(5) vertex by vertex: T and the face tetrahedra.
+//! 4. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//!
+//! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
+//!
+//! Shape control (§7.1) splits into a hull part and a weight part. The hull part is α
+//! ([`InnerOptions::alpha`]): how deep a non-trihedral corner is cut. For a trihedral corner the
+//! hull is fixed (the face tetrahedron [C_1C_2C_3V] has V as its top: "as high as the vertex V"
+//! and "the top of the face-tetrahedron" coincide), so its level — where between the bottom
+//! triangle (0) and V (1) the patch rises — is a weight choice of the scheme; the hull only
+//! carries it ([`InnerOptions::trihedral_level`]).
+
+pub mod above;
+pub mod corner;
+pub mod decompose;
+pub mod verify;
+
+pub use verify::{verify, HullViolation, ViolationKind};
 
 use crate::error::{Error, Result};
-use crate::hull::simplicial::SimplicialHull;
-use crate::mesh::Mesh;
+use crate::hull::simplicial::{PointOrigin, SimplicialHull};
+use crate::mesh::{Mesh, Topology};
 use glam::DVec3;
+use std::path::Path;
 
 /// Shape-control parameters of the hull (§7.1).
 #[derive(Clone, Debug, PartialEq)]
 pub struct InnerOptions {
-    /// α of the pseudo-centroid C_0 = αV + (1-α)V̄ of a non-trihedral vertex (Algorithm 1 (4)).
+    /// α of the pseudo-centroid C_0 = αV + (1-α)V̄ of a non-trihedral vertex (Algorithm 1 (4)),
+    /// in (0, 1): close to 1 cuts little off the corner, close to 0 almost all of it.
     pub alpha: f64,
+    /// For trihedral corners (step (3)): how high the surface rises in the face tetrahedron
+    /// [C_1C_2C_3V], from 0 (its bottom triangle) to 1 (the vertex V, its top). A weight
+    /// parameter for the schemes; the hull does not depend on it.
+    pub trihedral_level: f64,
+    /// Rotate vertex normals that are not "above face" (Appendix C); when false such normals
+    /// are errors.
+    pub fix_normals: bool,
 }
 
 impl Default for InnerOptions {
     fn default() -> Self {
-        InnerOptions { alpha: 0.5 }
+        InnerOptions {
+            alpha: 0.5,
+            trihedral_level: 0.5,
+            fix_normals: true,
+        }
     }
+}
+
+impl InnerOptions {
+    /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
+    pub const KEYS: [&'static str; 3] = ["alpha", "trihedral_level", "fix_normals"];
+
+    /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]) and `fix_normals`
+    /// (boolean) from a scene's `[scheme]` table; absent keys keep their defaults, other keys
+    /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
+    ///
+    /// # Errors
+    /// A key of the wrong type or out of range, naming the scene file and the key.
+    pub fn from_toml(table: &toml::Table, scene: &Path) -> Result<InnerOptions> {
+        let bad = |message: String| Error::Input {
+            path: scene.to_path_buf(),
+            message,
+        };
+        let number = |key: &str| -> Result<Option<f64>> {
+            match table.get(key) {
+                None => Ok(None),
+                Some(toml::Value::Float(x)) => Ok(Some(*x)),
+                Some(toml::Value::Integer(i)) => Ok(Some(*i as f64)),
+                Some(v) => Err(bad(format!(
+                    "`scheme.{key}`: expected a number, found {}",
+                    v.type_str()
+                ))),
+            }
+        };
+        let mut o = InnerOptions::default();
+        if let Some(a) = number("alpha")? {
+            if !(a > 0.0 && a < 1.0) {
+                return Err(bad(format!(
+                    "`scheme.alpha` = {a}: must lie strictly between 0 and 1"
+                )));
+            }
+            o.alpha = a;
+        }
+        if let Some(l) = number("trihedral_level")? {
+            if !(0.0..=1.0).contains(&l) {
+                return Err(bad(format!(
+                    "`scheme.trihedral_level` = {l}: must lie in [0, 1]"
+                )));
+            }
+            o.trihedral_level = l;
+        }
+        match table.get("fix_normals") {
+            None => {}
+            Some(toml::Value::Boolean(b)) => o.fix_normals = *b,
+            Some(v) => {
+                return Err(bad(format!(
+                    "`scheme.fix_normals`: expected a boolean, found {}",
+                    v.type_str()
+                )))
+            }
+        }
+        Ok(o)
+    }
+}
+
+/// What [`build_with_report`] changed or decided, for users and tests.
+#[derive(Clone, Debug, Default)]
+pub struct InnerReport {
+    /// Vertices whose normal was rotated to be "above face" (Appendix C), with the new normal.
+    pub adjusted_normals: Vec<(u32, DVec3)>,
+    /// Non-convex input polygons split into convex pieces (corner guards), with the piece count.
+    pub split_faces: Vec<(u32, usize)>,
+    /// Non-trihedral vertices that are unseparable from their face centroids (C_0 = V).
+    pub unseparable: Vec<u32>,
+    /// How the face tetrahedra were chosen.
+    pub cases: corner::CaseCounts,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
 /// unit vertex normals `normals`.
 ///
 /// # Errors
-/// Not implemented yet.
+/// See [`build_with_report`].
 pub fn build(mesh: &Mesh, normals: &[DVec3], options: &InnerOptions) -> Result<SimplicialHull> {
-    let _ = (mesh, normals, options);
-    Err(Error::Invalid(
-        "the inner simplicial hull (1994) is not implemented yet".into(),
-    ))
+    build_with_report(mesh, normals, options).map(|(h, _)| h)
+}
+
+/// [`build`], also returning what was changed on the way.
+///
+/// T's points are, in order: one per convex piece of every polygon (its centroid; normal = the
+/// polygon's normal), then one pseudo-centroid per non-trihedral vertex. Triangles are emitted
+/// vertex by vertex; `element` is the input vertex.
+///
+/// # Errors
+/// Bad options, a normal count that is not #V, non-finite normals, a mesh that is not a closed
+/// 2-manifold (naming the vertex and its line), zero-area faces, and corners where no normal is
+/// above all faces (or where one is not and `fix_normals` is off).
+pub fn build_with_report(
+    mesh: &Mesh,
+    normals: &[DVec3],
+    options: &InnerOptions,
+) -> Result<(SimplicialHull, InnerReport)> {
+    if !(options.alpha > 0.0 && options.alpha < 1.0) {
+        return Err(Error::Invalid(format!(
+            "inner hull: alpha = {} must lie strictly between 0 and 1",
+            options.alpha
+        )));
+    }
+    let nv = mesh.positions.len();
+    if normals.len() != nv {
+        return Err(Error::Invalid(format!(
+            "inner hull: {} normals for {nv} vertices",
+            normals.len()
+        )));
+    }
+    let line = |v: usize| mesh.vertex_lines.get(v).copied().unwrap_or(0);
+    let mut report = InnerReport::default();
+    let pieces = decompose::convex_pieces(mesh)?;
+    report.split_faces.clone_from(&pieces.split);
+    let topo = Topology::new(nv, &pieces.faces);
+
+    let mut hull = SimplicialHull::default();
+    let mean = |face: &[u32]| {
+        face.iter()
+            .map(|&v| mesh.positions[v as usize])
+            .sum::<DVec3>()
+            / face.len() as f64
+    };
+    for (f, piece) in pieces.faces.iter().enumerate() {
+        let mut c = mean(piece);
+        if pieces.guard[f] {
+            // Corner guards of one polygon lie exactly in its plane (through its vertex mean),
+            // so the guard net's edges are zero convex even when the polygon is slightly bent.
+            let o = mean(&mesh.faces[pieces.parent[f] as usize]);
+            c -= pieces.normal[f].dot(c - o) * pieces.normal[f];
+        }
+        hull.points.push(c);
+        hull.normals.push(pieces.normal[f]);
+        let face = pieces.parent[f];
+        hull.origins.push(if pieces.guard[f] {
+            PointOrigin::CornerGuard { face }
+        } else {
+            PointOrigin::Centroid { face }
+        });
+    }
+    let mut ring = Vec::new();
+    #[allow(clippy::needless_range_loop)] // v indexes positions, normals, lines and topology
+    for v in 0..nv {
+        if topo.vertex_corners(v as u32).is_empty() {
+            continue; // unreferenced: not part of the polyhedron
+        }
+        let fan = match topo.vertex_fan(v as u32) {
+            Some(f) if f.closed => f,
+            Some(_) => {
+                return Err(Error::Invalid(format!(
+                "vertex {v} (line {}) is on a boundary: the inner hull needs a closed polyhedron",
+                line(v)
+            )))
+            }
+            None => {
+                return Err(Error::Invalid(format!(
+                "vertex {v} (line {}) is non-manifold: the inner hull needs a closed 2-manifold",
+                line(v)
+            )))
+            }
+        };
+        let mut n = normals[v];
+        if fan.faces.len() != 3 {
+            n = n.try_normalize().ok_or_else(|| {
+                Error::Invalid(format!(
+                    "vertex {v} (line {}): normal {n} is zero or not finite",
+                    line(v)
+                ))
+            })?;
+            let face_normals: Vec<DVec3> = fan
+                .faces
+                .iter()
+                .map(|&f| pieces.normal[f as usize])
+                .collect();
+            if above::clearance(n, &face_normals) < above::ABOVE_MARGIN {
+                let fixed = if options.fix_normals {
+                    above::make_above(n, &face_normals)
+                } else {
+                    None
+                };
+                let Some(fixed) = fixed else {
+                    return Err(Error::Invalid(format!(
+                        "vertex {v} (line {}): {} (Appendix C)",
+                        line(v),
+                        if options.fix_normals {
+                            "no normal direction is above all its faces; the corner would need re-meshing"
+                        } else {
+                            "the normal is not above all its faces and fix_normals is off"
+                        }
+                    )));
+                };
+                n = fixed;
+                report.adjusted_normals.push((v as u32, n));
+            }
+        }
+        ring.clear();
+        ring.extend(fan.ring.iter().map(|&w| mesh.positions[w as usize]));
+        let c = corner::Corner {
+            vertex: v as u32,
+            v: mesh.positions[v],
+            n,
+            ring: &ring,
+            faces: &fan.faces,
+        };
+        if !corner::build_corner(&mut hull, &c, options, &mut report.cases) {
+            report.unseparable.push(v as u32);
+        }
+    }
+    Ok((hull, report))
 }

@@ -1,0 +1,176 @@
+//! Algorithm 1, steps (3)–(5): the triangles of T and the face tetrahedra built for one vertex V
+//! of the (convex-faced) polyhedron.
+//!
+//! Reconstruction of the missing figures 4.3–4.5, as implemented:
+//! - step (3), trihedral V: T gets the triangle of the three face centroids C_1C_2C_3 (in the
+//!   counter-clockwise order of the faces round V), apex V. The tangent plane of every C_i is its
+//!   face plane, which contains V, so the tetrahedron is tangent-containing.
+//! - step (4), otherwise: t_i = n_V·(C_i − V). V is separable when all t_i have one sign; then
+//!   V̄ = V + t* n_V with |t*| = min |t_i| and the pseudo-centroid C_0 = αV + (1−α)V̄ (normal
+//!   n_V); unseparable V gives C_0 = V. T gets the fan C_0C_iC_{i+1}, one triangle per edge
+//!   e = VV' between faces f_i and f_{i+1}.
+//! - step (5), per edge e: X is where e meets C_0's tangent plane π (clamped to [V, V + 0.4e]);
+//!   T_0 the midpoint of X and M (the midpoint of e), so T_0 lies on e strictly on V's side of
+//!   M; T_1 the projection of M onto π along n_V. With s_i = n_V·(C_i − C_0):
+//!   (i) s_1 s_2 ≥ 0 and T_0 across π from C_1, C_2: apex T_0;
+//!   (ii) s_1 s_2 ≥ 0, T_0 on their side, T_0 and T_1 on one side of the triangle: apex T_1;
+//!   (iii) as (ii) but on different sides: the L-U pair T_0, T_1;
+//!   (iv) s_1 s_2 < 0 (only at unseparable V): T_0 and T_1 are moved along ±n_V off π (T_0
+//!   up for a ridge, down for a valley, by 5% of |e|) and form an L-U pair; should both still
+//!   be on one side of the triangle, T_1 is pushed across it along the triangle's normal.
+//!   Which side of the triangle (outer or inner) each apex is on follows from its position.
+
+use super::InnerOptions;
+use crate::hull::simplicial::{PointOrigin, SimplicialHull};
+use glam::DVec3;
+
+/// How each triangle's face tetrahedra were chosen (Algorithm 1 steps (3), (5)(i)–(iv)).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CaseCounts {
+    /// Step (3): trihedral vertices.
+    pub trihedral: usize,
+    /// Step (5)(i): apex T_0 on the edge.
+    pub case_i: usize,
+    /// Step (5)(ii): apex T_1 on the tangent plane of C_0.
+    pub case_ii: usize,
+    /// Step (5)(iii): L-U pair T_0, T_1.
+    pub case_iii: usize,
+    /// Step (5)(iv): L-U pair with moved T_0, T_1.
+    pub case_iv: usize,
+}
+
+/// One vertex's data for steps (3)–(5).
+pub struct Corner<'a> {
+    /// The input vertex index.
+    pub vertex: u32,
+    /// Its position.
+    pub v: DVec3,
+    /// Its unit ("above face") normal.
+    pub n: DVec3,
+    /// Its neighbours in counter-clockwise order seen from outside; the edge to `ring[i + 1]`
+    /// lies between `faces[i]` and `faces[i + 1]` (cyclically).
+    pub ring: &'a [DVec3],
+    /// The faces round it (indices of T points: their centroids / corner guards).
+    pub faces: &'a [u32],
+}
+
+/// Orientation of q against the triangle (a, b, c): > 0 on its outer (counter-clockwise normal)
+/// side.
+fn orient(a: DVec3, b: DVec3, c: DVec3, q: DVec3) -> f64 {
+    (b - a).cross(c - a).dot(q - a)
+}
+
+/// Pushes `apex` as the face tetrahedron of the last triangle on the side it lies on.
+fn set_apex(slot: &mut [Option<DVec3>; 2], tri: [DVec3; 3], apex: DVec3) {
+    let side = usize::from(orient(tri[0], tri[1], tri[2], apex) <= 0.0);
+    slot[side] = Some(apex);
+}
+
+/// Runs steps (3)–(5) for `c`, appending to `hull` (whose first points are the face centroids
+/// and guards with their normals). Returns whether the vertex was separable (step (4)).
+pub fn build_corner(
+    hull: &mut SimplicialHull,
+    c: &Corner,
+    options: &InnerOptions,
+    counts: &mut CaseCounts,
+) -> bool {
+    let k = c.faces.len();
+    let pts: Vec<DVec3> = c.faces.iter().map(|&f| hull.points[f as usize]).collect();
+    let nrm: Vec<DVec3> = c.faces.iter().map(|&f| hull.normals[f as usize]).collect();
+    if k == 3 {
+        let tri = [c.faces[0], c.faces[1], c.faces[2]];
+        let mut slot = [None, None];
+        set_apex(&mut slot, [pts[0], pts[1], pts[2]], c.v);
+        hull.triangles.push(tri);
+        hull.apexes.push(slot);
+        hull.element.push(c.vertex);
+        counts.trihedral += 1;
+        return true;
+    }
+    let n = c.n;
+    let t: Vec<f64> = pts.iter().map(|&x| n.dot(x - c.v)).collect();
+    let separable = t.iter().all(|&x| x > 0.0) || t.iter().all(|&x| x < 0.0);
+    let c0 = if separable {
+        let t_star = t
+            .iter()
+            .copied()
+            .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+            .expect("k > 3 faces");
+        c.v + (1.0 - options.alpha) * t_star * n
+    } else {
+        c.v
+    };
+    let i0 = hull.points.len() as u32;
+    hull.points.push(c0);
+    hull.normals.push(n);
+    hull.origins
+        .push(PointOrigin::PseudoCentroid { vertex: c.vertex });
+    for i in 0..k {
+        let (g1, g2) = (c.faces[i], c.faces[(i + 1) % k]);
+        let (c1, c2) = (pts[i], pts[(i + 1) % k]);
+        let w = c.ring[(i + 1) % k];
+        let d = w - c.v;
+        let m = c.v + 0.5 * d;
+        // Where e meets π (u along e), clamped so T_0 stays strictly before M.
+        let nd = n.dot(d);
+        let u = if nd.abs() > 1e-12 * d.length() {
+            (n.dot(c0 - c.v) / nd).clamp(0.0, 0.4)
+        } else {
+            0.4
+        };
+        let mut t0 = c.v + 0.5 * (u + 0.5) * d;
+        let mut t1 = m - n.dot(m - c0) * n;
+        let (s1, s2) = (n.dot(c1 - c0), n.dot(c2 - c0));
+        let tri = [c0, c1, c2];
+        let mut slot = [None, None];
+        if s1 * s2 >= 0.0 {
+            let s = if s1 != 0.0 { s1 } else { s2 };
+            let st0 = n.dot(t0 - c0);
+            if st0 * s <= 0.0 {
+                set_apex(&mut slot, tri, t0);
+                counts.case_i += 1;
+            } else {
+                let o0 = orient(c0, c1, c2, t0);
+                let o1 = orient(c0, c1, c2, t1);
+                if o0 * o1 >= 0.0 {
+                    set_apex(&mut slot, tri, t1);
+                    counts.case_ii += 1;
+                } else {
+                    set_apex(&mut slot, tri, t0);
+                    set_apex(&mut slot, tri, t1);
+                    counts.case_iii += 1;
+                }
+            }
+        } else {
+            // Case (iv): e is a ridge when f_{i+1}'s centroid lies below f_i's plane.
+            let n1 = nrm[i];
+            let ridge = n1.dot(c2 - c1) <= 0.0;
+            let up = if ridge { n } else { -n };
+            let shift = 0.05 * d.length();
+            let h0 = up.dot(t0 - c0);
+            if h0 < shift {
+                t0 += (shift - h0) * up;
+            }
+            t1 -= shift * up;
+            let o0 = orient(c0, c1, c2, t0);
+            let mut o1 = orient(c0, c1, c2, t1);
+            if o0 * o1 >= 0.0 {
+                let m = (c1 - c0).cross(c2 - c0);
+                let mn = m.normalize_or_zero();
+                // Push T_1 across the triangle to the far side from T_0, by the same margin.
+                let dist = o1 / m.length();
+                let target = if o0 >= 0.0 { -shift } else { shift };
+                t1 += (target - dist) * mn;
+                o1 = orient(c0, c1, c2, t1);
+            }
+            debug_assert!(o0 * o1 <= 0.0 || o0 == 0.0);
+            set_apex(&mut slot, tri, t0);
+            set_apex(&mut slot, tri, t1);
+            counts.case_iv += 1;
+        }
+        hull.triangles.push([i0, g1, g2]);
+        hull.apexes.push(slot);
+        hull.element.push(c.vertex);
+    }
+    separable
+}

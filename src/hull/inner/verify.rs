@@ -1,0 +1,497 @@
+//! Checks that a [`SimplicialHull`] is smoothable: Definition 3.6 with Lemmas 4.1–4.3, plus the
+//! global conditions a closed surface needs. Works on any hull (inner, fixtures, hand-made).
+//!
+//! Checked, each violation naming the triangle (and its input element) or point:
+//! - shape: per-triangle arrays of equal length, indices in range, finite points, unit normals,
+//!   at least one apex per triangle;
+//! - T is a closed, consistently oriented 2-manifold (every edge in two triangles, running
+//!   opposite ways; every point's link one cycle); [`euler_characteristic`] gives its genus;
+//! - Lemma 4.1: every edge of T is convex (Definition 3.1 with T's normals);
+//! - Lemma 4.2: every face tetrahedron (or one of an L-U pair) is tangent-containing at each of
+//!   its three triangle vertices (Definition 3.5: the tangent plane there does not leave the
+//!   other three tetrahedron vertices strictly on one side);
+//! - L-U pairs have one apex on each side, and single apexes lie on their recorded side;
+//! - no degenerate face or edge tetrahedron;
+//! - Lemma 4.3 and Def. 3.6 (5)(i): no two tetrahedra of S_f ∪ S_e overlap (separating-axis
+//!   test; touching along shared faces, edges or vertices is allowed);
+//! - every edge of T has edge tetrahedra on at least one side (else the hull is not contiguous
+//!   there and no C1 surface can cross the edge).
+
+use crate::hull::simplicial::{Side, SimplicialHull};
+use crate::mesh::convexity::{edge_convexity_1994, Convexity};
+use glam::DVec3;
+use std::collections::HashMap;
+
+/// Relative volume 6V / L³ (L the longest edge) below which a tetrahedron counts as degenerate:
+/// barycentric coordinates in it would keep fewer than 8 of f64's 16 significant digits, below
+/// what the schemes' continuity checks resolve. (A regular tetrahedron has 0.118.)
+pub const DEGENERATE_VOLUME: f64 = 1e-8;
+
+/// Overlap depth, relative to the smaller tetrahedron's longest edge, above which two
+/// tetrahedra intersect. Shared faces, edges and vertices touch with depth 0 up to rounding of
+/// the coordinates (≈1e-15); a real overlap is a visible fraction of a tetrahedron.
+pub const OVERLAP_DEPTH: f64 = 1e-7;
+
+/// Tangent-containment tolerance relative to the tetrahedron's longest edge. The tangent plane
+/// at a centroid or corner guard is its polygon's plane, and the construction puts apexes on
+/// polygon edges (steps (3), (5)(i)); input polygons are accepted up to
+/// [`crate::mesh::PLANARITY_TOL`] of non-planarity, so such apexes may lie that far off it.
+pub const PLANE_TOL: f64 = crate::mesh::PLANARITY_TOL;
+
+/// What is wrong.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ViolationKind {
+    /// Inconsistent arrays, bad indices, non-finite or non-unit data, a triangle with no apex.
+    Malformed,
+    /// T is not a closed 2-manifold (edge in ≠ 2 triangles, a point's link not one cycle).
+    NotManifold,
+    /// Two triangles run the same way along their shared edge.
+    Orientation,
+    /// An edge of T is nonconvex (Definition 3.1; Lemma 4.1).
+    EdgeNonconvex,
+    /// A face tetrahedron (or L-U pair) is not tangent-containing (Definition 3.5; Lemma 4.2).
+    NotTangentContaining,
+    /// An apex lies on the wrong side of its triangle, or an L-U pair is one-sided.
+    WrongSide,
+    /// A face or edge tetrahedron has (nearly) zero volume.
+    Degenerate,
+    /// Two tetrahedra of the hull overlap (Lemma 4.3; Definition 3.6 (5)(i)).
+    Intersecting,
+    /// An edge of T has no edge tetrahedra on either side.
+    NoEdgeTetrahedra,
+}
+
+/// One violated condition, with a message naming the triangle, element or point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HullViolation {
+    /// Which condition.
+    pub kind: ViolationKind,
+    /// The triangle of T concerned, if one.
+    pub triangle: Option<u32>,
+    /// Human-readable detail.
+    pub message: String,
+}
+
+/// V − E + F of T over the points its triangles use (2 − 2g for a closed orientable surface of
+/// genus g). `None` when T is not a manifold.
+#[must_use]
+pub fn euler_characteristic(hull: &SimplicialHull) -> Option<i64> {
+    let edges = hull.edges().ok()?;
+    let mut used = vec![false; hull.points.len()];
+    for t in &hull.triangles {
+        for &i in t {
+            *used.get_mut(i as usize)? = true;
+        }
+    }
+    let v = used.iter().filter(|&&u| u).count() as i64;
+    Some(v - edges.len() as i64 + hull.triangles.len() as i64)
+}
+
+/// Checks `hull` (see the module documentation). Empty when it is a smoothable hull.
+#[must_use]
+pub fn verify(hull: &SimplicialHull) -> Vec<HullViolation> {
+    let nt = hull.triangles.len();
+    let np = hull.points.len();
+    let mut out = Sink(Vec::new());
+    if hull.apexes.len() != nt
+        || hull.element.len() != nt
+        || hull.normals.len() != np
+        || hull.origins.len() != np
+    {
+        out.push(
+            ViolationKind::Malformed,
+            None,
+            format!(
+                "array lengths differ: {np} points, {} normals, {} origins, {nt} triangles, {} apex slots, {} elements",
+                hull.normals.len(),
+                hull.origins.len(),
+                hull.apexes.len(),
+                hull.element.len()
+            ),
+        );
+        return out.0;
+    }
+    let name = |t: usize| format!("triangle {t} (element {})", hull.element[t]);
+    let mut malformed = false;
+    for (i, (p, n)) in hull.points.iter().zip(&hull.normals).enumerate() {
+        // Unit normals: |n| − 1 within 1e-9 allows any normalised f64 vector.
+        if !p.is_finite() || !n.is_finite() || (n.length() - 1.0).abs() > 1e-9 {
+            out.push(
+                ViolationKind::Malformed,
+                None,
+                format!("point {i}: {p} with normal {n} (need finite point, unit normal)"),
+            );
+            malformed = true;
+        }
+    }
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        if tri.iter().any(|&i| i as usize >= np)
+            || tri[0] == tri[1]
+            || tri[1] == tri[2]
+            || tri[0] == tri[2]
+        {
+            out.push(
+                ViolationKind::Malformed,
+                Some(t),
+                format!("{}: bad indices {tri:?}", name(t)),
+            );
+            malformed = true;
+        } else if hull.apexes[t].iter().all(Option::is_none) {
+            out.push(
+                ViolationKind::Malformed,
+                Some(t),
+                format!("{}: no face tetrahedron", name(t)),
+            );
+        } else if hull.apexes[t].iter().flatten().any(|q| !q.is_finite()) {
+            out.push(
+                ViolationKind::Malformed,
+                Some(t),
+                format!("{}: non-finite apex", name(t)),
+            );
+            malformed = true;
+        }
+    }
+    if malformed {
+        return out.0;
+    }
+    let pt = |i: u32| hull.points[i as usize];
+
+    // Manifold and orientation.
+    let edges = match hull.edges() {
+        Ok(e) => e,
+        Err(m) => {
+            out.push(ViolationKind::NotManifold, None, m);
+            return out.0;
+        }
+    };
+    for e in &edges {
+        let [a, b] = e.v;
+        if e.faces[1] == u32::MAX {
+            out.push(
+                ViolationKind::NotManifold,
+                Some(e.faces[0] as usize),
+                format!(
+                    "edge ({a}, {b}) of {} is a boundary of T",
+                    name(e.faces[0] as usize)
+                ),
+            );
+            continue;
+        }
+        let t1 = hull.triangles[e.faces[1] as usize];
+        let same_way = (0..3).any(|k| t1[k] == a && t1[(k + 1) % 3] == b);
+        if same_way {
+            out.push(
+                ViolationKind::Orientation,
+                Some(e.faces[1] as usize),
+                format!(
+                    "{} and {} run the same way along edge ({a}, {b})",
+                    name(e.faces[0] as usize),
+                    name(e.faces[1] as usize)
+                ),
+            );
+        }
+        // Lemma 4.1.
+        let (pa, pb) = (pt(a), pt(b));
+        let (na, nb) = (hull.normals[a as usize], hull.normals[b as usize]);
+        if edge_convexity_1994(pa, na, pb, nb) == Convexity::Nonconvex {
+            out.push(
+                ViolationKind::EdgeNonconvex,
+                Some(e.faces[0] as usize),
+                format!(
+                    "edge ({a}, {b}) between {} and {} is nonconvex: (p_b − p_a)·n_a = {:.3e}, (p_a − p_b)·n_b = {:.3e}",
+                    name(e.faces[0] as usize),
+                    name(e.faces[1] as usize),
+                    (pb - pa).dot(na),
+                    (pa - pb).dot(nb)
+                ),
+            );
+        }
+        let joined = Side::BOTH.iter().any(|&s| {
+            hull.apexes[e.faces[0] as usize][s as usize].is_some()
+                && hull.apexes[e.faces[1] as usize][s as usize].is_some()
+        });
+        if !joined {
+            out.push(
+                ViolationKind::NoEdgeTetrahedra,
+                Some(e.faces[0] as usize),
+                format!(
+                    "edge ({a}, {b}): {} and {} have face tetrahedra on opposite sides only",
+                    name(e.faces[0] as usize),
+                    name(e.faces[1] as usize)
+                ),
+            );
+        }
+    }
+    // Links: at every point the triangles form one cycle.
+    let mut link: HashMap<u32, Vec<(u32, u32)>> = HashMap::new();
+    for tri in &hull.triangles {
+        for k in 0..3 {
+            link.entry(tri[k])
+                .or_default()
+                .push((tri[(k + 1) % 3], tri[(k + 2) % 3]));
+        }
+    }
+    let mut keys: Vec<u32> = link.keys().copied().collect();
+    keys.sort_unstable();
+    for p in keys {
+        let l = &link[&p];
+        let next: HashMap<u32, u32> = l.iter().copied().collect();
+        let mut cur = l[0].0;
+        let mut steps = 0;
+        while let Some(&n) = next.get(&cur) {
+            cur = n;
+            steps += 1;
+            if cur == l[0].0 || steps > l.len() {
+                break;
+            }
+        }
+        if next.len() != l.len() || steps != l.len() || cur != l[0].0 {
+            out.push(
+                ViolationKind::NotManifold,
+                None,
+                format!("point {p}: its {} triangles do not form one fan", l.len()),
+            );
+        }
+    }
+
+    // Per triangle: sidedness, tangent containment (Lemma 4.2), degeneracy.
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        let base = tri.map(pt);
+        let slots = hull.apexes[t];
+        let tets: Vec<(Side, [DVec3; 4])> = Side::BOTH
+            .iter()
+            .filter_map(|&s| slots[s as usize].map(|q| (s, [base[0], base[1], base[2], q])))
+            .collect();
+        for &(side, tet) in &tets {
+            let l = longest_edge(&tet);
+            let o = (base[1] - base[0])
+                .cross(base[2] - base[0])
+                .dot(tet[3] - base[0]);
+            let rel = o / (l * l * l);
+            if rel.abs() < DEGENERATE_VOLUME {
+                out.push(
+                    ViolationKind::Degenerate,
+                    Some(t),
+                    format!(
+                        "{}: {side:?} face tetrahedron has relative volume {rel:.2e}",
+                        name(t)
+                    ),
+                );
+            } else if (rel > 0.0) != (side == Side::Outer) {
+                out.push(
+                    ViolationKind::WrongSide,
+                    Some(t),
+                    format!("{}: the {side:?} apex lies on the other side", name(t)),
+                );
+            }
+        }
+        for k in 0..3 {
+            let (pk, nk) = (base[k], hull.normals[tri[k] as usize]);
+            let contained = tets.iter().any(|(_, tet)| {
+                let tol = PLANE_TOL * longest_edge(tet);
+                let vals: Vec<f64> = tet
+                    .iter()
+                    .filter(|&&x| x != pk)
+                    .map(|&x| nk.dot(x - pk))
+                    .collect();
+                let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                lo <= tol && hi >= -tol
+            });
+            if !contained {
+                out.push(
+                    ViolationKind::NotTangentContaining,
+                    Some(t),
+                    format!(
+                        "{}: the tangent plane at point {} misses its face tetrahedra",
+                        name(t),
+                        tri[k]
+                    ),
+                );
+            }
+        }
+    }
+
+    // Edge tetrahedra: degeneracy; then all pairs for overlaps.
+    let edge_tets = match hull.edge_tets() {
+        Ok(e) => e,
+        Err(m) => {
+            out.push(ViolationKind::NotManifold, None, m);
+            return out.0;
+        }
+    };
+    let mut all: Vec<([DVec3; 4], String)> = Vec::new();
+    for (t, slots) in hull.apexes.iter().enumerate() {
+        for s in Side::BOTH {
+            if slots[s as usize].is_some() {
+                let tet = hull.face_tet(t, s).expect("apex present");
+                all.push((tet, format!("{s:?} face tetrahedron of {}", name(t))));
+            }
+        }
+    }
+    for et in &edge_tets {
+        let l = longest_edge(&et.tet);
+        let rel = tet_volume6(&et.tet) / (l * l * l);
+        let label = format!(
+            "{:?} edge tetrahedron at edge ({}, {}) beside {}",
+            et.side,
+            edges[et.edge as usize].v[0],
+            edges[et.edge as usize].v[1],
+            name(et.face as usize)
+        );
+        if rel.abs() < DEGENERATE_VOLUME {
+            out.push(
+                ViolationKind::Degenerate,
+                Some(et.face as usize),
+                format!("{label}: relative volume {rel:.2e}"),
+            );
+        }
+        all.push((et.tet, label));
+    }
+    for (i, j, depth) in overlapping_pairs(&all.iter().map(|(t, _)| *t).collect::<Vec<_>>()) {
+        out.push(
+            ViolationKind::Intersecting,
+            None,
+            format!("{} overlaps {} (depth {depth:.2e})", all[i].1, all[j].1),
+        );
+    }
+    out.0
+}
+
+/// Collects violations.
+struct Sink(Vec<HullViolation>);
+
+impl Sink {
+    fn push(&mut self, kind: ViolationKind, triangle: Option<usize>, message: String) {
+        self.0.push(HullViolation {
+            kind,
+            triangle: triangle.map(|t| t as u32),
+            message,
+        });
+    }
+}
+
+/// Longest edge of a tetrahedron.
+fn longest_edge(t: &[DVec3; 4]) -> f64 {
+    let mut l: f64 = 0.0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            l = l.max((t[i] - t[j]).length());
+        }
+    }
+    l
+}
+
+/// Six times the signed volume.
+fn tet_volume6(t: &[DVec3; 4]) -> f64 {
+    (t[1] - t[0]).cross(t[2] - t[0]).dot(t[3] - t[0])
+}
+
+/// Pairs of tetrahedra whose interiors overlap by more than [`OVERLAP_DEPTH`], with the depth
+/// (relative to the smaller one's longest edge). Sweep over x-sorted bounding boxes, then the
+/// separating-axis test.
+#[must_use]
+pub fn overlapping_pairs(tets: &[[DVec3; 4]]) -> Vec<(usize, usize, f64)> {
+    let boxes: Vec<(DVec3, DVec3)> = tets
+        .iter()
+        .map(|t| {
+            let lo = t.iter().fold(DVec3::splat(f64::INFINITY), |a, &b| a.min(b));
+            let hi = t
+                .iter()
+                .fold(DVec3::splat(f64::NEG_INFINITY), |a, &b| a.max(b));
+            (lo, hi)
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..tets.len()).collect();
+    order.sort_by(|&a, &b| boxes[a].0.x.total_cmp(&boxes[b].0.x));
+    let mut out = Vec::new();
+    for (k, &i) in order.iter().enumerate() {
+        for &j in &order[k + 1..] {
+            if boxes[j].0.x > boxes[i].1.x {
+                break;
+            }
+            let (a, b) = (boxes[i], boxes[j]);
+            if a.0.y > b.1.y || b.0.y > a.1.y || a.0.z > b.1.z || b.0.z > a.1.z {
+                continue;
+            }
+            let scale = longest_edge(&tets[i]).min(longest_edge(&tets[j]));
+            let depth = sat_depth(&tets[i], &tets[j]) / scale;
+            if depth > OVERLAP_DEPTH {
+                out.push((i.min(j), i.max(j), depth));
+            }
+        }
+    }
+    out.sort_by_key(|a| (a.0, a.1));
+    out
+}
+
+/// The smallest overlap of the two tetrahedra's projections over all candidate separating axes
+/// (face normals of both, cross products of their edges): ≤ 0 when a plane separates them.
+#[must_use]
+pub fn sat_depth(a: &[DVec3; 4], b: &[DVec3; 4]) -> f64 {
+    let faces = |t: &[DVec3; 4]| {
+        [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]
+            .map(|[i, j, k]| (t[j] - t[i]).cross(t[k] - t[i]))
+    };
+    let edges =
+        |t: &[DVec3; 4]| [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(i, j)| t[j] - t[i]);
+    let mut depth = f64::INFINITY;
+    let mut test = |axis: DVec3| {
+        let Some(ax) = axis.try_normalize() else {
+            return;
+        };
+        let (mut a0, mut a1, mut b0, mut b1) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for p in a {
+            let x = ax.dot(*p);
+            a0 = a0.min(x);
+            a1 = a1.max(x);
+        }
+        for p in b {
+            let x = ax.dot(*p);
+            b0 = b0.min(x);
+            b1 = b1.max(x);
+        }
+        depth = depth.min(a1.min(b1) - a0.max(b0));
+    };
+    for n in faces(a).into_iter().chain(faces(b)) {
+        test(n);
+    }
+    let (ea, eb) = (edges(a), edges(b));
+    for x in ea {
+        for y in eb {
+            let c = x.cross(y);
+            // Nearly parallel edges give no new axis (their plane is covered by face normals).
+            if c.length_squared() > 1e-20 * x.length_squared() * y.length_squared() {
+                test(c);
+            }
+        }
+    }
+    depth
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_tet(o: DVec3) -> [DVec3; 4] {
+        [o, o + DVec3::X, o + DVec3::Y, o + DVec3::Z]
+    }
+
+    /// Separated, face-sharing and overlapping tetrahedra against known answers.
+    #[test]
+    fn sat_depth_known_configurations() {
+        let a = unit_tet(DVec3::ZERO);
+        // Far apart: negative (gap of 1 along x at least).
+        assert!(sat_depth(&a, &unit_tet(DVec3::new(2.0, 0.0, 0.0))) < -0.5);
+        // Mirror image through the face x + y + z = 1 shares that face: depth 0.
+        let m = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::splat(2.0 / 3.0)];
+        assert!(sat_depth(&a, &m).abs() < 1e-15);
+        // Shifted by a quarter along x overlaps (interior point (0.3, 0.1, 0.1) is in both).
+        assert!(sat_depth(&a, &unit_tet(DVec3::new(0.25, 0.0, 0.0))) > 0.05);
+    }
+}
