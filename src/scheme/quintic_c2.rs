@@ -36,7 +36,8 @@ impl Default for QuinticOptions {
 }
 
 impl QuinticOptions {
-    /// Reads the `[scheme]` table: `type` and the optional `curvature` (a number ≥ 0).
+    /// Reads the `[scheme]` table: `type`, the optional `curvature` (a number ≥ 0) and the inner
+    /// hull's keys ([`crate::hull::inner::InnerOptions::KEYS`], read by the hull).
     ///
     /// # Errors
     /// Unknown keys and bad values, naming the key and `scene`.
@@ -45,6 +46,7 @@ impl QuinticOptions {
         for (k, v) in table {
             match k.as_str() {
                 "type" => {}
+                k if crate::hull::inner::InnerOptions::KEYS.contains(&k) => {}
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
                     match x {
@@ -56,7 +58,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }

@@ -344,14 +344,30 @@ pub struct SolveStats {
     pub largest_group: usize,
     /// Largest |residual| of any equation after all stages, relative to the largest weight.
     pub max_residual: f64,
+    /// Points of T whose star needed its edge middles or Hessian relaxed (not in general
+    /// position).
+    pub relaxed_points: usize,
+}
+
+/// A group whose equations could not be met in one pass.
+struct Failure {
+    stage: u8,
+    points: Vec<u32>,
+    message: String,
 }
 
 impl System {
     /// Solves every slot: jets, then the stages, each group closest to its target
     /// (`target(slot's tetrahedron, multi-index)`).
     ///
+    /// Where a vertex star's system is singular and inconsistent (T not in general position
+    /// around that point, e.g. coplanar triangles), the solve is repeated with the number 3/4
+    /// weights of the edges at that point solved together with the star, and if that is not
+    /// enough, with the point's Hessian (number 2 weights) chosen by the system too (closest to
+    /// the estimated one).
+    ///
     /// # Errors
-    /// A group whose equations cannot be met (singular configuration), naming where.
+    /// A group whose equations cannot be met even so, naming where.
     pub fn solve(
         &self,
         tets: &[HullTet],
@@ -359,14 +375,66 @@ impl System {
         nt: u32,
         target: &dyn Fn(usize, [u8; 4]) -> f64,
     ) -> Result<(Vec<f64>, SolveStats)> {
+        let mut level: HashMap<u32, u8> = HashMap::new();
+        for _pass in 0..6 {
+            let (value, mut stats, failures) = self.solve_pass(tets, jets, nt, target, &level);
+            if failures.is_empty() {
+                stats.relaxed_points = level.len();
+                return Ok((value, stats));
+            }
+            let mut bumped = false;
+            for f in &failures {
+                match f.stage {
+                    1 => {
+                        for p in &f.points {
+                            let l = level.entry(*p).or_insert(0);
+                            if *l == 0 {
+                                *l = 1;
+                                bumped = true;
+                            }
+                        }
+                    }
+                    2 | 3 => {
+                        for p in &f.points {
+                            let l = level.entry(*p).or_insert(0);
+                            if *l < 2 {
+                                *l += 1;
+                                bumped = true;
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            if !bumped {
+                return Err(Error::Invalid(failures[0].message.clone()));
+            }
+        }
+        Err(Error::Invalid(
+            "quintic-c2: the vertex-star systems did not become consistent".into(),
+        ))
+    }
+
+    #[allow(clippy::too_many_lines)]
+    fn solve_pass(
+        &self,
+        tets: &[HullTet],
+        jets: &[Jet],
+        nt: u32,
+        target: &dyn Fn(usize, [u8; 4]) -> f64,
+        level: &HashMap<u32, u8>,
+    ) -> (Vec<f64>, SolveStats, Vec<Failure>) {
         let ns = self.keys.len();
         let np = self.np;
         let first_mid = np + 2 * nt;
+        let lv = |p: u32| level.get(&p).copied().unwrap_or(0);
         let mut stage_of = vec![0u8; ns];
         let mut value = vec![0.0; ns];
         let mut known = vec![false; ns];
+        let mut failures = Vec::new();
+        let mut relaxed_jet = vec![false; ns];
         for s in 0..ns {
-            let (mut st, _) = stage(self.keys[s], np);
+            let (mut st, pts) = stage(self.keys[s], np);
             let parts = unkey(self.keys[s]);
             let has_mid = parts.iter().any(|p| p.0 >= first_mid);
             let hull_sum: u32 = parts
@@ -377,9 +445,16 @@ impl System {
             if st == 5 && !has_mid && hull_sum != 2 {
                 st = 3;
             }
-            // Stages 3.. are renumbered 4.. after the vertex stars (see module docs): stage 3 in
-            // this function is step 4 there.
-            stage_of[s] = st;
+            // Pass stages: 1 middles, 2 relaxed stars, 3 stars, 4 far face weights, 5 face
+            // middles, 6 the rest of the edge tetrahedra.
+            if st >= 2 {
+                st += 1;
+            }
+            // Relaxed points: their stars, their edge middles (level 1) and Hessian weights
+            // (level 2) are solved together, before the other stars.
+            if (st == 1 || st == 3) && pts.iter().any(|&p| lv(p) >= 1) {
+                st = 2;
+            }
             if st == 0 {
                 let (t, l) = self.home[s];
                 let tet = &tets[t as usize];
@@ -394,11 +469,17 @@ impl System {
                     }
                 }
                 value[s] = jet.blossom5(&args);
-                known[s] = true;
+                if l[k] == 3 && lv(tet.gid[k]) >= 2 {
+                    st = 2;
+                    relaxed_jet[s] = true;
+                } else {
+                    known[s] = true;
+                }
             }
+            stage_of[s] = st;
         }
         // Each equation is solved at the stage of its last unknown.
-        let mut by_stage: Vec<Vec<usize>> = vec![Vec::new(); 6];
+        let mut by_stage: Vec<Vec<usize>> = vec![Vec::new(); 7];
         for (e, eq) in self.equations.iter().enumerate() {
             let st = eq
                 .terms
@@ -413,7 +494,7 @@ impl System {
             equations: self.equations.len(),
             ..SolveStats::default()
         };
-        for st in 1..=5u8 {
+        for st in 1..=6u8 {
             // Union-find over this stage's unknowns, joined by this stage's equations.
             let mut parent: HashMap<u32, u32> = HashMap::new();
             fn find(p: &mut HashMap<u32, u32>, x: u32) -> u32 {
@@ -472,11 +553,40 @@ impl System {
             glist.sort_unstable_by_key(|g| g.0[0]);
             for (unk, eqs) in glist {
                 stats.largest_group = stats.largest_group.max(unk.len());
-                if unk.len() > 4000 {
-                    return Err(Error::Invalid(format!(
-                        "quintic-c2: {} weights are coupled at stage {st} (expected local systems); the hull is not smoothable as built",
-                        unk.len()
-                    )));
+                let where_ = || {
+                    let mut pts: Vec<u32> = unk
+                        .iter()
+                        .flat_map(|&s| stage(self.keys[s as usize], np).1)
+                        .collect();
+                    pts.sort_unstable();
+                    pts.dedup();
+                    if st == 2 || st == 3 {
+                        // The stars' centres: points at multiplicity 2 in some slot.
+                        let mut c: Vec<u32> = unk
+                            .iter()
+                            .flat_map(|&s| {
+                                unkey(self.keys[s as usize])
+                                    .into_iter()
+                                    .filter(|p| p.0 < np && p.1 >= 2)
+                                    .map(|p| p.0)
+                            })
+                            .collect();
+                        c.sort_unstable();
+                        c.dedup();
+                        pts = c;
+                    }
+                    pts
+                };
+                if unk.len() > 2500 {
+                    failures.push(Failure {
+                        stage: 9,
+                        points: Vec::new(),
+                        message: format!(
+                            "quintic-c2: {} weights are coupled at stage {st} (expected local systems); the hull is not smoothable as built",
+                            unk.len()
+                        ),
+                    });
+                    continue;
                 }
                 let col: HashMap<u32, usize> =
                     unk.iter().enumerate().map(|(i, s)| (*s, i)).collect();
@@ -495,7 +605,12 @@ impl System {
                     .iter()
                     .map(|&s| {
                         let (t, l) = self.home[s as usize];
-                        target(t as usize, l)
+                        if relaxed_jet[s as usize] {
+                            // A relaxed Hessian weight: its estimate.
+                            value[s as usize]
+                        } else {
+                            target(t as usize, l)
+                        }
                     })
                     .collect();
                 let scale = c
@@ -503,26 +618,32 @@ impl System {
                     .chain(tgt.iter())
                     .fold(1e-300_f64, |acc, x| acc.max(x.abs()));
                 let sol = dense::solve_near(&a, m, n, &c, &tgt, 1e-11);
-                if sol.residual.is_nan()
+                let bad = sol.residual.is_nan()
                     || sol.residual > 1e-9 * scale
-                    || sol.x.iter().any(|x| !x.is_finite())
-                {
-                    let (_, pts) = stage(self.keys[unk[0] as usize], np);
+                    || sol.x.iter().any(|x| !x.is_finite());
+                if bad {
+                    let pts = where_();
                     let what = match st {
                         1 => format!("the middle of hull edge {pts:?}"),
-                        2 => format!("the star of hull point {pts:?}"),
+                        2 => format!("the star of hull point(s) {pts:?}"),
                         3 => {
                             format!("the far weights of the face tetrahedra at hull points {pts:?}")
                         }
-                        _ => format!("the edge tetrahedra of hull edge {pts:?}"),
+                        _ => format!("the edge tetrahedra at hull points {pts:?}"),
                     };
-                    return Err(Error::Invalid(format!(
-                        "quintic-c2: the C1/C2 system of {what} is singular ({m} equations, {n} unknowns, rank {}, residual {:.3e}): points of T are not in general position",
-                        sol.rank, sol.residual
-                    )));
+                    failures.push(Failure {
+                        stage: st,
+                        points: pts,
+                        message: format!(
+                            "quintic-c2: the C1/C2 system of {what} is singular ({m} equations, {n} unknowns, rank {}, residual {:.3e}): points of T are not in general position",
+                            sol.rank, sol.residual
+                        ),
+                    });
                 }
                 for (j, &s) in unk.iter().enumerate() {
-                    value[s as usize] = sol.x[j];
+                    if sol.x[j].is_finite() {
+                        value[s as usize] = sol.x[j];
+                    }
                     known[s as usize] = true;
                 }
             }
@@ -540,7 +661,7 @@ impl System {
             })
             .fold(0.0, f64::max)
             / wmax;
-        Ok((value, stats))
+        (value, stats, failures)
     }
 
     /// The 56 weights of tetrahedron `t` from the slot values.
