@@ -10,7 +10,9 @@
 //!  "patches":[{"tet":[[x,y,z]×4],"degree":n,"weights":[… C(n+3,3) numbers …],
 //!              "rational":[{"index":[k1,k2,k3,k4],"terms":[[w,[m1,m2,m3,m4]],…]}],   (omitted when none)
 //!              "sheet":{"rule":"shooting","base":[…],"top":[…]},                      (omitted when "any")
-//!              "role":"face|edge|…","element":id}]}
+//!              "role":"face|edge|…","element":id,
+//!              "jvertex":j,                                                           (omitted when none)
+//!              "jedge":[a,b]}]}                                                       (omitted when none)
 //! ```
 //!
 //! meaning F(α) = Σ w_λ·n!/(λ1!λ2!λ3!λ4!)·α^λ + Σ_r (Σ_m w_m α^μm)/(Σ_m α^μm)·B^n_κr(α),
@@ -64,6 +66,17 @@ pub struct Patch {
     pub role: Role,
     /// Index of the mesh element (face, edge or vertex) the tetrahedron belongs to.
     pub element: u32,
+    /// 1994 schemes: the j-vertex (tetrahedron-local index) of a triangular j-patch
+    /// (Definition 2.1): every segment from it to a point of the opposite face meets the
+    /// surface at most once (a root at the j-vertex itself, when it lies on the surface, not
+    /// counted). `None` when the scheme promises no such vertex.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jvertex: Option<u8>,
+    /// 1994 schemes: an edge (two tetrahedron-local indices) such that every segment from a
+    /// point of it to a point of the opposite edge meets the surface at most once (the
+    /// edge-tetrahedron form of Theorem 2.1; roots at the segment's ends not counted).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jedge: Option<[u8; 2]>,
 }
 
 /// The rational term (Σ_m w_m α^μm)/(Σ_m α^μm) · B^n_κ(α) added to a patch.

@@ -210,6 +210,19 @@ pub fn validate_patch(p: &Patch) -> std::result::Result<(), String> {
             det.abs() / 6.0
         ));
     }
+    if p.jvertex.is_some_and(|j| j > 3) {
+        return Err(format!(
+            "jvertex {:?} is not a tetrahedron vertex (0..=3)",
+            p.jvertex
+        ));
+    }
+    if let Some([a, b]) = p.jedge {
+        if a > 3 || b > 3 || a == b {
+            return Err(format!(
+                "jedge [{a}, {b}] is not an edge of the tetrahedron"
+            ));
+        }
+    }
     for (r, term) in p.rational.iter().enumerate() {
         let ksum: usize = term.index.iter().map(|&k| usize::from(k)).sum();
         if ksum != n {
@@ -375,6 +388,8 @@ mod tests {
             sheet: SheetRule::Any,
             role: Role::Other,
             element: 0,
+            jvertex: None,
+            jedge: None,
         }
     }
 

@@ -162,6 +162,8 @@ pub fn quadric_complex(
                         sheet: SheetRule::Any,
                         role: Role::Other,
                         element,
+                        jvertex: None,
+                        jedge: None,
                     });
                 }
                 element += 1;

@@ -392,6 +392,8 @@ fn rational_patch() -> impl Strategy<Value = Patch> {
                 sheet: SheetRule::Any,
                 role: Role::Other,
                 element: 0,
+                jvertex: None,
+                jedge: None,
             }
         })
 }
@@ -498,6 +500,8 @@ fn unit_tet_patch(rational: Vec<RationalTerm>) -> Patch {
         sheet: SheetRule::Any,
         role: Role::Other,
         element: 0,
+        jvertex: None,
+        jedge: None,
     }
 }
 
@@ -555,6 +559,8 @@ fn quadric_fixture_is_reproduced() {
             sheet: SheetRule::Any,
             role: Role::Other,
             element: 0,
+            jvertex: None,
+            jedge: None,
         };
         for x in [
             DVec3::ZERO,
@@ -607,6 +613,8 @@ proptest! {
             sheet: SheetRule::Any,
             role: Role::Other,
             element: 0,
+            jvertex: None,
+            jedge: None,
         };
         let mut out = [0.0; 16];
         let len = p.segment_poly(x0, x1, &mut out);

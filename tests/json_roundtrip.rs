@@ -62,6 +62,8 @@ fn awkward_complex() -> PatchComplex {
         },
         role: Role::Face,
         element: 7,
+        jvertex: None,
+        jedge: None,
     });
     c
 }

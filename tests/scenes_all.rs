@@ -1,4 +1,4 @@
-//! Every scene shipped in `scenes/` and `scenes/paper2001/` loads, builds its patch complex and
+//! Every scene shipped in `scenes/`, `scenes/paper2001/` and `scenes/paper1994/` loads, builds its patch complex and
 //! passes `apatch check` with the default tolerances (the product's promise for what we ship:
 //! a scene that does not build belongs in `scenes/pending/`).
 
@@ -22,6 +22,7 @@ fn shipped_scenes_build_and_pass_check() {
     let all: Vec<_> = scenes("scenes")
         .into_iter()
         .chain(scenes("scenes/paper2001"))
+        .chain(scenes("scenes/paper1994"))
         .collect();
     // At least the four real models that build today and the paper's figures.
     assert!(all.len() >= 10, "{all:?}");

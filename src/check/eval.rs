@@ -388,6 +388,8 @@ mod tests {
             sheet: SheetRule::Any,
             role: Role::Other,
             element: 0,
+            jvertex: None,
+            jedge: None,
         }
     }
 

@@ -33,6 +33,7 @@
 //! patch's largest weight S: a root of the shooting polynomial φ(t) is simple when
 //! |φ′(t)| > tolerance · S.
 
+pub mod distance;
 pub mod eval;
 mod faces;
 mod interp;
@@ -237,6 +238,19 @@ pub struct SheetStats {
     /// An example of such a patch.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub multi_sheet_at: Option<Location>,
+    /// Patches with a promised j-vertex or j-edge ([`crate::complex::Patch::jvertex`],
+    /// [`crate::complex::Patch::jedge`]) that can vanish.
+    pub j_patches: usize,
+    /// Lines sampled through them: from the j-vertex to lattice points of the opposite face,
+    /// or between lattice points of the j-edge and of the opposite edge.
+    pub j_lines: usize,
+    /// Of those, lines meeting F = 0 more than once away from their ends (a failure).
+    pub j_multi_lines: usize,
+    /// Patches with such a line.
+    pub j_multi_patches: usize,
+    /// An example (the line's first root).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub j_multi_at: Option<Location>,
 }
 
 /// Everything [`check`] measured, with the options used.
@@ -315,6 +329,9 @@ impl CheckReport {
         }
         if o.single_sheet && self.sheets.multi_sheet_patches > 0 {
             f.push("multiple sheets");
+        }
+        if self.sheets.j_multi_lines > 0 {
+            f.push("multiple sheets along j-lines");
         }
         f
     }
@@ -535,6 +552,8 @@ mod tests {
             sheet,
             role: Role::Face,
             element: 0,
+            jvertex: None,
+            jedge: None,
         }
     }
 

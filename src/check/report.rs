@@ -160,6 +160,19 @@ impl fmt::Display for CheckReport {
                 &s.multi_sheet_at.clone().or(s.multi_root_at.clone())
             )
         )?;
+        if s.j_patches > 0 {
+            writeln!(
+                f,
+                "j-sheets         {} of {} patches with a j-vertex/j-edge crossed twice ({} of {} \
+                 lines)  {}{}",
+                s.j_multi_patches,
+                s.j_patches,
+                s.j_multi_lines,
+                s.j_lines,
+                verdict(s.j_multi_lines == 0),
+                fmt_location_as("e.g.", &s.j_multi_at)
+            )?;
+        }
         let failures = self.failures();
         if failures.is_empty() {
             writeln!(f, "PASSED")

@@ -49,6 +49,11 @@ fn merge(a: SheetStats, b: SheetStats) -> SheetStats {
         multi_root_at: a.multi_root_at.or(b.multi_root_at),
         multi_sheet_patches: a.multi_sheet_patches + b.multi_sheet_patches,
         multi_sheet_at: a.multi_sheet_at.or(b.multi_sheet_at),
+        j_patches: a.j_patches + b.j_patches,
+        j_lines: a.j_lines + b.j_lines,
+        j_multi_lines: a.j_multi_lines + b.j_multi_lines,
+        j_multi_patches: a.j_multi_patches + b.j_multi_patches,
+        j_multi_at: a.j_multi_at.or(b.j_multi_at),
     }
 }
 
@@ -95,6 +100,7 @@ fn patch_sheets(e: &PatchEval<'_>, opts: &CheckOptions, mut stats: SheetStats) -
         return stats;
     }
     let n = opts.line_samples.max(4);
+    j_lines(e, opts, n, &mut stats);
     match &e.patch.sheet {
         SheetRule::Shooting { base, top } => {
             stats.shooting_patches += 1;
@@ -151,6 +157,100 @@ fn patch_sheets(e: &PatchEval<'_>, opts: &CheckOptions, mut stats: SheetStats) -
         SheetRule::Any => {}
     }
     stats
+}
+
+/// The 1994 single-sheet promise: lines from the j-vertex through the opposite face, or
+/// between the j-edge and the opposite edge, meet F = 0 at most once away from their ends.
+fn j_lines(e: &PatchEval<'_>, opts: &CheckOptions, n: usize, stats: &mut SheetStats) {
+    let p = e.patch;
+    let (from, to): (Vec<[f64; 4]>, Vec<[f64; 4]>) = match (p.jvertex, p.jedge) {
+        (Some(j), _) if j < 4 => {
+            let face: Vec<u8> = (0..4u8).filter(|&k| k != j).collect();
+            let mut a = [0.0; 4];
+            a[usize::from(j)] = 1.0;
+            (vec![a], simplex_lattice(&face, opts.sheet_resolution))
+        }
+        (_, Some([a, b])) if a < 4 && b < 4 && a != b => {
+            let other: Vec<u8> = (0..4u8).filter(|&k| k != a && k != b).collect();
+            (
+                simplex_lattice(&[a, b], opts.sheet_resolution),
+                simplex_lattice(&other, opts.sheet_resolution),
+            )
+        }
+        _ => return,
+    };
+    stats.j_patches += 1;
+    let mut multi = false;
+    for a in &from {
+        for b in &to {
+            stats.j_lines += 1;
+            if let Some(t) = interior_roots_beyond_one(e, a, b, n) {
+                stats.j_multi_lines += 1;
+                if stats.j_multi_at.is_none() {
+                    stats.j_multi_at = Some(Location::new(&[e], point(e, lerp(a, b, t)), None));
+                }
+                multi = true;
+            }
+        }
+    }
+    stats.j_multi_patches += usize::from(multi);
+}
+
+/// `Some(first root)` when F on the segment from `a` to `b` has more than one root in (0, 1)
+/// once roots at the ends are divided out: Descartes' rule on the Bernstein coefficients
+/// decides ≤ 1 root; otherwise the deflated polynomial is sampled at `n` + 1 points.
+fn interior_roots_beyond_one(
+    e: &PatchEval<'_>,
+    a: &[f64; 4],
+    b: &[f64; 4],
+    n: usize,
+) -> Option<f64> {
+    let (mut c, mut len, _) = segment(e, a, b);
+    let scale = c[..len].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    // An end coefficient this small relative to the rest is a root at the end (the j-vertex on
+    // the surface, a zero-convex edge): 1e-12 is far above the round-off of the weights (1e-16
+    // relative) and far below any weight the schemes set on purpose.
+    let tiny = 1e-12 * scale;
+    while len > 1 && c[0].abs() <= tiny {
+        len = uni::deflate_at_zero(&mut c, len);
+    }
+    while len > 1 && c[len - 1].abs() <= tiny {
+        // (1 − t)·B^(m−1)_k = ((m − k)/m)·B^m_k.
+        let m = (len - 1) as f64;
+        for (k, x) in c[..len - 1].iter_mut().enumerate() {
+            *x *= m / (m - k as f64);
+        }
+        len -= 1;
+    }
+    let mut changes = 0;
+    let mut prev: Option<bool> = None;
+    for &x in &c[..len] {
+        if x.abs() > tiny {
+            changes += usize::from(prev.is_some_and(|q| q != (x > 0.0)));
+            prev = Some(x > 0.0);
+        }
+    }
+    if changes <= 1 {
+        return None;
+    }
+    let mut prev: Option<bool> = None;
+    let mut count = 0;
+    let mut first = 0.0;
+    for k in 0..=n {
+        let t = k as f64 / n as f64;
+        let f = uni::eval(&c[..len], t);
+        if f == 0.0 || f.is_nan() {
+            continue;
+        }
+        if prev.is_some_and(|p| p != (f > 0.0)) {
+            if count == 0 {
+                first = t;
+            }
+            count += 1;
+        }
+        prev = Some(f > 0.0);
+    }
+    (count > 1).then_some(first)
 }
 
 /// Bernstein coefficients of F·(rational denominators) along the segment from `a` to `b`

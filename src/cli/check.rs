@@ -85,6 +85,34 @@ pub fn load_complex(path: &Path) -> anyhow::Result<PatchComplex> {
     }
 }
 
+/// For a scene of a 1994 scheme (`cubic-c1`, `quintic-c2`; the surface approximates the
+/// polyhedron), the distance of the surface to the scene's polyhedron.
+fn polyhedron_distance(
+    input: &Path,
+    complex: &PatchComplex,
+) -> anyhow::Result<Option<check::distance::DistanceStats>> {
+    if !input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+        || !matches!(complex.scheme.as_str(), "cubic-c1" | "quintic-c2")
+    {
+        return Ok(None);
+    }
+    let scene = apatch::scene::load(input)?;
+    let apatch::scene::Model::Mesh { file, .. } = &scene.model else {
+        return Ok(None);
+    };
+    let (m, _) = apatch::mesh::load(file)?;
+    let tri = apatch::mesh::triangulate(&m);
+    let faces: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    Ok(Some(check::distance::distance_to_polyhedron(
+        complex,
+        &tri.positions,
+        &faces,
+        6,
+    )))
+}
+
 /// Runs `apatch check`.
 pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     let complex = load_complex(&args.input)?;
@@ -99,6 +127,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         ..CheckOptions::default()
     };
     let report = check::check(&complex, &opts);
+    let distance = polyhedron_distance(&args.input, &complex)?;
     if args.json {
         // The verdict first, then every measure.
         let mut out = serde_json::Map::new();
@@ -107,9 +136,19 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let serde_json::Value::Object(fields) = serde_json::to_value(&report)? {
             out.extend(fields);
         }
+        if let Some(d) = &distance {
+            out.insert("distance".into(), serde_json::to_value(d)?);
+        }
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         print!("{report}");
+        if let Some(d) = &distance {
+            println!(
+                "distance         max {:.4e}, mean {:.4e} of the bounding-box diagonal {:.4} \
+                 ({} surface samples to the polyhedron)  info",
+                d.max, d.mean, d.diagonal, d.samples
+            );
+        }
     }
     Ok(if report.passed() {
         ExitCode::SUCCESS

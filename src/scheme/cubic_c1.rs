@@ -1,10 +1,500 @@
-//! C1 cubic A-patches on the inner simplicial hull (Bajaj, Chen, Xu 1994, §6).
+//! C¹ cubic A-patches on the inner simplicial hull (Bajaj, Chen, Xu 1994, §6–7).
+//!
+//! Input: a smoothable simplicial hull ([`SimplicialHull`], from [`crate::hull::inner`] or a
+//! test hull). Output: a [`PatchComplex`] (scheme `cubic-c1`) with one cubic per face
+//! tetrahedron (`Role::Face`, tetrahedron [v0 v1 v2 q], element = the hull triangle's input
+//! element, j-vertex 3 = the apex) and per edge tetrahedron (`Role::Edge`, [p_i p_j q s],
+//! element = the hull edge, single sheeted between its opposite edges [p_i p_j] and [q s]).
+//! The surface passes through every point of T with normal n, and approximates the polyhedron
+//! (corners are cut) rather than interpolating its vertices. How each weight is fixed, and by
+//! which equation, is tabled in [`weights`].
+//!
+//! Scene usage (the `[scheme]` table):
+//! ```toml
+//! [scheme]
+//! type = "cubic-c1"
+//! alpha = 0.5            # pseudo-centroid C0 = αV + (1−α)V̄ of non-trihedral vertices (§7.1)
+//! level = 0.5            # where the surface crosses centroid → apex in face tetrahedra (§7.1)
+//! center = 1.0           # number 2 weights: this × the quadratic-precision value
+//! levels = { "7" = 0.9 } # per input element (vertex) overrides of `level` (§7 free weights)
+//! ```
 
-use crate::complex::PatchComplex;
+pub mod flat;
+pub mod weights;
+
+use crate::complex::{Patch, PatchComplex, Role};
+use crate::error::{Error, Result};
+use crate::hull::inner::InnerOptions;
+use crate::hull::simplicial::{Side, SimplicialHull};
 use crate::mesh::Mesh;
-use anyhow::bail;
+use anyhow::{anyhow, Context};
 use glam::DVec3;
+use std::collections::HashMap;
 use std::path::Path;
+use weights::{bary_in, e3, gradient_weight, ix, level_height, level_mean, EdgeBlossom};
+
+/// Largest group of coupled flat-edge equations solved (a dense m×m elimination).
+pub const MAX_FLAT_GROUP: usize = 1500;
+
+/// Shape control of the cubic scheme (§7.1 and the free weights of §6).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CubicOptions {
+    /// Default parameter in (0, 1) at which F vanishes on the segment from a face
+    /// tetrahedron's base centroid to its apex: small values cut the corners deeply (the
+    /// surface near T), values near 1 reach toward the apex (the polyhedron's corner for
+    /// trihedral vertices).
+    pub level: f64,
+    /// Per input element (the hull triangle's `element`) overrides of `level`.
+    pub levels: HashMap<u32, f64>,
+    /// Scale of the number 2 weights relative to the quadratic-precision choice (1 = a
+    /// quadratic is reproduced on T's triangles; 0 = flatter, > 1 = rounder).
+    pub center: f64,
+    /// |∇F| at the points of T (the weights scale with it; the surface does not).
+    pub gradient_scale: f64,
+}
+
+impl Default for CubicOptions {
+    fn default() -> Self {
+        CubicOptions {
+            level: 0.5,
+            levels: HashMap::new(),
+            center: 1.0,
+            gradient_scale: 1.0,
+        }
+    }
+}
+
+/// What [`build`] made, besides the complex.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CubicBuild {
+    /// The patches.
+    pub complex: PatchComplex,
+    /// Edges of T where the adjacent triangles are coplanar (the paper's singular case): the
+    /// number 2 weights of the triangles there are adjusted ([`flat`]).
+    pub flat_edges: usize,
+    /// Flat-edge equations in groups too large to solve (larger than [`MAX_FLAT_GROUP`]); C¹
+    /// may fail there.
+    pub flat_unsolved: usize,
+    /// Number 4 / 6 weights raised above the `level` rule for the sign conditions.
+    pub raised: usize,
+    /// Edge tetrahedra whose midpoint s is not on the apex side of the face tetrahedron's base
+    /// (the sign conditions cannot be enforced there; `check` measures the sheets).
+    pub unsigned: usize,
+}
+
+/// Weights of the face tetrahedron of one (triangle, side).
+struct FaceWeights {
+    w: [f64; 20],
+}
+
+/// Builds the cubic C¹ complex on `hull`.
+///
+/// # Errors
+/// A hull edge shared by more than three triangles, non-finite data, or degenerate tetrahedra
+/// (each named).
+pub fn build(hull: &SimplicialHull, options: &CubicOptions) -> Result<PatchComplex> {
+    build_full(hull, options).map(|b| b.complex)
+}
+
+/// [`build`] with its counters.
+///
+/// # Errors
+/// As [`build`].
+pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<CubicBuild> {
+    validate(hull, options)?;
+    let c = options.gradient_scale;
+    let p = &hull.points;
+    let g: Vec<DVec3> = hull.normals.iter().map(|n| c * *n).collect();
+    let edges = hull.edges().map_err(Error::Invalid)?;
+    let edge_tets = hull.edge_tets().map_err(Error::Invalid)?;
+    let nt = hull.triangles.len();
+    let mut out = CubicBuild {
+        complex: PatchComplex::new("cubic-c1"),
+        flat_edges: 0,
+        flat_unsolved: 0,
+        raised: 0,
+        unsigned: 0,
+    };
+
+    // Number 2: a_1110 per triangle (shared by both sides of an L-U pair), quadratic precision.
+    let mut center: Vec<f64> = hull
+        .triangles
+        .iter()
+        .map(|tri| {
+            let mut s = 0.0;
+            for k in 0..3 {
+                for l in 0..3 {
+                    if k != l {
+                        let (a, b) = (tri[k] as usize, tri[l] as usize);
+                        s += gradient_weight(p[a], g[a], p[b]);
+                    }
+                }
+            }
+            options.center * s / 4.0
+        })
+        .collect();
+
+    // Number 2 where T is flat at an edge: the least change making the blossoms exist.
+    let mut flat_eqs = Vec::new();
+    for e in &edges {
+        let [t0, t1] = e.faces;
+        if t1 == u32::MAX {
+            continue;
+        }
+        let [i, j] = e.v.map(|v| v as usize);
+        let third = |t: u32| {
+            hull.triangles[t as usize]
+                .iter()
+                .map(|&v| v as usize)
+                .find(|&v| v != i && v != j)
+                .unwrap_or(i)
+        };
+        if let Some((a, b)) = flat::flat_coords(p[i], p[j], p[third(t0)], p[third(t1)]) {
+            let ai = gradient_weight(p[i], g[i], p[j]);
+            let aj = gradient_weight(p[j], g[j], p[i]);
+            flat_eqs.push(flat::FlatEquation {
+                from: t0 as usize,
+                to: t1 as usize,
+                b,
+                rhs: (1.0 - a - b) * ai + a * aj,
+            });
+        }
+    }
+    out.flat_edges = flat_eqs.len();
+    out.flat_unsolved = flat::adjust(&mut center, &flat_eqs, MAX_FLAT_GROUP);
+
+    // Number 3: the edge blossoms.
+    let mut blossom: HashMap<(u32, u32), EdgeBlossom> = HashMap::new();
+    for e in &edges {
+        let [i, j] = e.v;
+        let (pi, pj) = (p[i as usize], p[j as usize]);
+        let mut known = vec![(pj, gradient_weight(pj, g[j as usize], pi))];
+        for &t in &e.faces {
+            if t != u32::MAX {
+                let tri = hull.triangles[t as usize];
+                let m = tri.iter().copied().find(|&v| v != i && v != j).unwrap_or(i);
+                known.push((p[m as usize], center[t as usize]));
+            }
+        }
+        let prior = (g[i as usize] + g[j as usize]) / 6.0;
+        let b = EdgeBlossom::fit(pi, gradient_weight(pi, g[i as usize], pj), &known, prior);
+        blossom.insert((i.min(j), i.max(j)), b);
+    }
+    let edge_blossom = |a: u32, b: u32| blossom[&(a.min(b), a.max(b))];
+
+    // Face tetrahedra weights up to level 1, and the level rule for numbers 4 and 6.
+    let mut faces: Vec<[Option<FaceWeights>; 2]> = (0..nt).map(|_| [None, None]).collect();
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        for side in Side::BOTH {
+            let Some(tet) = hull.face_tet(t, side) else {
+                continue;
+            };
+            let sigma = sign(side);
+            let q = tet[3];
+            let mut w = [0.0; 20];
+            for k in 0..3 {
+                let gk = g[tri[k] as usize];
+                for l in 0..4 {
+                    if l != k {
+                        w[ix(e3(k, k, l))] = gradient_weight(tet[k], gk, tet[l]);
+                    }
+                }
+            }
+            w[ix([1, 1, 1, 0])] = center[t];
+            for (k, l) in [(0, 1), (1, 2), (0, 2)] {
+                w[ix(e3(k, l, 3))] = edge_blossom(tri[k], tri[l]).at(q);
+            }
+            let level = options
+                .levels
+                .get(&hull.element[t])
+                .copied()
+                .unwrap_or(options.level);
+            let h = level_height(level_mean(&w, 0), level_mean(&w, 1), level);
+            let base = (tet[0] + tet[1] + tet[2]) / 3.0;
+            let h_min = 1e-3 * c * (q - base).length();
+            let h = sigma * (sigma * h).max(h_min);
+            for k in 0..3 {
+                w[ix(e3(k, 3, 3))] = h;
+            }
+            w[ix([0, 0, 0, 3])] = h;
+            faces[t][side as usize] = Some(FaceWeights { w });
+        }
+    }
+
+    // Sign conditions through the edge tetrahedra: raise number 4 (for w_1011, w_0111 ≥ 0)
+    // and then number 6 (for w_0021 ≥ 0); signs mirrored on the inner side.
+    let local = |t: usize, v: u32| {
+        hull.triangles[t]
+            .iter()
+            .position(|&x| x == v)
+            .expect("edge point in its triangle")
+    };
+    let betas: Vec<[f64; 4]> = edge_tets
+        .iter()
+        .map(|et| {
+            let tet = hull.face_tet(et.face as usize, et.side).expect("face tet");
+            bary_in(tet, et.tet[3]).ok_or_else(|| {
+                Error::Invalid(format!(
+                    "face tetrahedron of hull triangle {} is degenerate",
+                    et.face
+                ))
+            })
+        })
+        .collect::<Result<_>>()?;
+    for pass in 0..2 {
+        for (et, beta) in edge_tets.iter().zip(&betas) {
+            let t = et.face as usize;
+            let sigma = sign(et.side);
+            let e = edges[et.edge as usize];
+            let (li, lj) = (local(t, e.v[0]), local(t, e.v[1]));
+            let lm = 3 - li - lj;
+            let fw = faces[t][et.side as usize].as_mut().expect("face weights");
+            let w = &mut fw.w;
+            if beta[3] <= 0.0 {
+                if pass == 0 {
+                    out.unsigned += 1;
+                }
+                continue;
+            }
+            if pass == 0 {
+                for (k, o) in [(li, lj), (lj, li)] {
+                    // (2.8): w_(e_k+e_q+e_s) = β_k a_2e_k+e_q + β_o a_(k,o,q) + β_m a_(k,m,q)
+                    //                          + β_q a_e_k+2e_q.
+                    let rest = beta[k] * w[ix(e3(k, k, 3))]
+                        + beta[o] * w[ix(e3(k, o, 3))]
+                        + beta[lm] * w[ix(e3(k, lm, 3))];
+                    let need = -sigma * rest / beta[3];
+                    let cur = &mut w[ix(e3(k, 3, 3))];
+                    if sigma * *cur < need {
+                        *cur = sigma * need;
+                        out.raised += 1;
+                    }
+                }
+            } else {
+                // (2.8): w_0021 = Σ_k β_k a_e_k+2e_q + β_q F(q).
+                let rest: f64 = (0..3).map(|k| beta[k] * w[ix(e3(k, 3, 3))]).sum();
+                let need = -sigma * rest / beta[3];
+                let cur = &mut w[ix([0, 0, 0, 3])];
+                if sigma * *cur < need {
+                    *cur = sigma * need;
+                    out.raised += 1;
+                }
+            }
+        }
+    }
+
+    // Face patches.
+    for (t, sides) in faces.iter().enumerate() {
+        for side in Side::BOTH {
+            if let Some(fw) = &sides[side as usize] {
+                let tet = hull.face_tet(t, side).expect("face tet");
+                out.complex
+                    .patches
+                    .push(patch(tet, &fw.w, Role::Face, hull.element[t]));
+            }
+        }
+    }
+
+    // Edge tetrahedra, in pairs (edge_tets lists both of a pair together).
+    let mut own: Vec<[f64; 20]> = Vec::with_capacity(edge_tets.len());
+    for (et, beta) in edge_tets.iter().zip(&betas) {
+        let t = et.face as usize;
+        let e = edges[et.edge as usize];
+        let (i, j) = (e.v[0], e.v[1]);
+        let (li, lj) = (local(t, i), local(t, j));
+        let lm = 3 - li - lj;
+        let a = &faces[t][et.side as usize].as_ref().expect("face weights").w;
+        let [pi, pj, q, s] = et.tet;
+        let (gi, gj) = (g[i as usize], g[j as usize]);
+        let blossom = edge_blossom(i, j);
+        let mut w = [0.0; 20];
+        // Number 1 (2.5).
+        w[ix([2, 1, 0, 0])] = gradient_weight(pi, gi, pj);
+        w[ix([1, 2, 0, 0])] = gradient_weight(pj, gj, pi);
+        w[ix([2, 0, 1, 0])] = gradient_weight(pi, gi, q);
+        w[ix([0, 2, 1, 0])] = gradient_weight(pj, gj, q);
+        w[ix([2, 0, 0, 1])] = gradient_weight(pi, gi, s);
+        w[ix([0, 2, 0, 1])] = gradient_weight(pj, gj, s);
+        // Number 3: the edge blossom (C⁰ with the face tetrahedron, (2.10) with the partner).
+        w[ix([1, 1, 1, 0])] = blossom.at(q);
+        w[ix([1, 1, 0, 1])] = blossom.at(s);
+        // C⁰ with the face tetrahedron: its level-2 and apex weights.
+        w[ix([1, 0, 2, 0])] = a[ix(e3(li, 3, 3))];
+        w[ix([0, 1, 2, 0])] = a[ix(e3(lj, 3, 3))];
+        w[ix([0, 0, 3, 0])] = a[ix([0, 0, 0, 3])];
+        // Number 5 (2.8).
+        for (k, o, mu) in [(li, lj, [1, 0, 1, 1]), (lj, li, [0, 1, 1, 1])] {
+            w[ix(mu)] = beta[k] * a[ix(e3(k, k, 3))]
+                + beta[o] * a[ix(e3(k, o, 3))]
+                + beta[lm] * a[ix(e3(k, lm, 3))]
+                + beta[3] * a[ix(e3(k, 3, 3))];
+        }
+        // Number 7 (2.8).
+        w[ix([0, 0, 2, 1])] = (0..3).map(|k| beta[k] * a[ix(e3(k, 3, 3))]).sum::<f64>()
+            + beta[3] * a[ix([0, 0, 0, 3])];
+        // Free: w_0012 = w_0021.
+        w[ix([0, 0, 1, 2])] = w[ix([0, 0, 2, 1])];
+        own.push(w);
+    }
+    // (2.10) across [p_i p_j s]: averages over the pair (edge_tets holds pairs consecutively).
+    let mut k = 0;
+    while k < own.len() {
+        let paired = k + 1 < own.len()
+            && edge_tets[k + 1].edge == edge_tets[k].edge
+            && edge_tets[k + 1].side == edge_tets[k].side;
+        let (a, b) = if paired { (k, k + 1) } else { (k, k) };
+        for (mu, from) in [
+            ([1, 0, 0, 2], [1, 0, 1, 1]),
+            ([0, 1, 0, 2], [0, 1, 1, 1]),
+            ([0, 0, 0, 3], [0, 0, 1, 2]),
+        ] {
+            let avg = 0.5 * (own[a][ix(from)] + own[b][ix(from)]);
+            own[a][ix(mu)] = avg;
+            own[b][ix(mu)] = avg;
+        }
+        k += if paired { 2 } else { 1 };
+    }
+    for (et, w) in edge_tets.iter().zip(&own) {
+        out.complex
+            .patches
+            .push(patch(et.tet, w, Role::Edge, et.edge));
+    }
+
+    out.complex.vertices = p.iter().map(|x| x.to_array()).collect();
+    out.complex.normals = hull.normals.iter().map(|x| x.to_array()).collect();
+    for (n, patch) in out.complex.patches.iter().enumerate() {
+        crate::complex_io::validate_patch(patch).map_err(|m| {
+            Error::Invalid(format!("cubic-c1 patch {n} ({}): {m}", patch.role.name()))
+        })?;
+    }
+    Ok(out)
+}
+
+fn sign(side: Side) -> f64 {
+    match side {
+        Side::Outer => 1.0,
+        Side::Inner => -1.0,
+    }
+}
+
+fn patch(tet: [DVec3; 4], w: &[f64; 20], role: Role, element: u32) -> Patch {
+    Patch {
+        tet: tet.map(|v| v.to_array()),
+        degree: 3,
+        weights: w.to_vec(),
+        rational: Vec::new(),
+        sheet: crate::complex::SheetRule::Any,
+        role,
+        element,
+        // Face tetrahedra: a j-patch for the apex; edge tetrahedra: single sheeted between
+        // [p_i p_j] and [q s] (see `weights`).
+        jvertex: (role == Role::Face).then_some(3),
+        jedge: (role == Role::Edge).then_some([0, 1]),
+    }
+}
+
+fn validate(hull: &SimplicialHull, options: &CubicOptions) -> Result<()> {
+    let bad_level = |l: f64| !(l > 0.0 && l < 1.0);
+    if bad_level(options.level) {
+        return Err(Error::Invalid(format!(
+            "cubic-c1: level {} is not in (0, 1)",
+            options.level
+        )));
+    }
+    if let Some((e, l)) = options.levels.iter().find(|(_, &l)| bad_level(l)) {
+        return Err(Error::Invalid(format!(
+            "cubic-c1: levels.{e} = {l} is not in (0, 1)"
+        )));
+    }
+    if !(options.center.is_finite() && options.gradient_scale > 0.0) {
+        return Err(Error::Invalid(
+            "cubic-c1: center must be finite and gradient_scale positive".into(),
+        ));
+    }
+    if hull.normals.len() != hull.points.len()
+        || hull.apexes.len() != hull.triangles.len()
+        || hull.element.len() != hull.triangles.len()
+    {
+        return Err(Error::Invalid("cubic-c1: inconsistent hull arrays".into()));
+    }
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        if tri.iter().any(|&v| v as usize >= hull.points.len()) {
+            return Err(Error::Invalid(format!(
+                "cubic-c1: hull triangle {t} has a point index out of range"
+            )));
+        }
+        if hull.apexes[t].iter().all(Option::is_none) {
+            return Err(Error::Invalid(format!(
+                "cubic-c1: hull triangle {t} has no face tetrahedron"
+            )));
+        }
+    }
+    if let Some(k) = (0..hull.points.len())
+        .find(|&k| !(hull.points[k].is_finite() && hull.normals[k].is_finite()))
+    {
+        return Err(Error::Invalid(format!(
+            "cubic-c1: hull point {k} or its normal is not finite"
+        )));
+    }
+    Ok(())
+}
+
+/// Reads the scheme options from a scene's `[scheme]` table: the hull's keys
+/// ([`InnerOptions::KEYS`]) by [`InnerOptions::from_toml`], and this scheme's `level`, `center`,
+/// `gradient_scale`, `levels`. Without `level`, the hull's `trihedral_level` (in [0, 1]) is used,
+/// kept 0.02 away from the bottom and the top (a level of exactly 0 or 1 puts the zero on a
+/// boundary of the tetrahedron).
+///
+/// # Errors
+/// Unknown keys and bad values, naming the scene file and the key.
+pub fn options_from_toml(
+    table: &toml::Table,
+    scene: &Path,
+) -> anyhow::Result<(CubicOptions, InnerOptions)> {
+    let inner = InnerOptions::from_toml(table, scene)?;
+    let mut o = CubicOptions {
+        level: inner.trihedral_level.clamp(0.02, 0.98),
+        ..CubicOptions::default()
+    };
+    let bad = |m: String| anyhow!("{}: {m}", scene.display());
+    let num = |k: &str, v: &toml::Value| {
+        v.as_float()
+            .or_else(|| v.as_integer().map(|i| i as f64))
+            .ok_or_else(|| {
+                bad(format!(
+                    "`scheme.{k}`: expected a number, found {}",
+                    v.type_str()
+                ))
+            })
+    };
+    for (k, v) in table {
+        match k.as_str() {
+            "type" => {}
+            k if InnerOptions::KEYS.contains(&k) => {}
+            "level" => o.level = num(k, v)?,
+            "center" => o.center = num(k, v)?,
+            "gradient_scale" => o.gradient_scale = num(k, v)?,
+            "levels" => {
+                let t = v.as_table().ok_or_else(|| {
+                    bad("`scheme.levels` must be a table { \"element\" = level }".into())
+                })?;
+                for (e, l) in t {
+                    let id: u32 = e.parse().map_err(|_| {
+                        bad(format!("`scheme.levels`: key `{e}` is not an element id"))
+                    })?;
+                    o.levels.insert(id, num(&format!("levels.{e}"), l)?);
+                }
+            }
+            _ => {
+                return Err(bad(format!(
+                    "unknown key `scheme.{k}` (cubic-c1 has alpha, trihedral_level, fix_normals, \
+                     level, center, gradient_scale, levels)"
+                )))
+            }
+        }
+    }
+    Ok((o, inner))
+}
 
 /// Builds the `cubic-c1` patch complex of `mesh` with unit vertex normals `normals`; `scheme` is
 /// the scene's `[scheme]` table (its keys are this scheme's options), `scene` the scene file
@@ -18,9 +508,8 @@ pub fn build_from_scene(
     scheme: &toml::Table,
     scene: &Path,
 ) -> anyhow::Result<PatchComplex> {
-    let _ = (mesh, normals, scheme);
-    bail!(
-        "{}: scheme `cubic-c1` is not implemented yet",
-        scene.display()
-    )
+    let (options, inner) = options_from_toml(scheme, scene)?;
+    let hull = crate::hull::inner::build(mesh, normals, &inner)
+        .with_context(|| format!("{}", scene.display()))?;
+    build(&hull, &options).with_context(|| format!("{}", scene.display()))
 }

@@ -846,6 +846,8 @@ fn assemble(
                 sheet: SheetRule::Any,
                 role: Role::Planar,
                 element: t as u32,
+                jvertex: None,
+                jedge: None,
             });
             continue;
         }
@@ -876,6 +878,8 @@ fn assemble(
                     sheet: face_sheet.clone(),
                     role: Role::Face,
                     element: t as u32,
+                    jvertex: None,
+                    jedge: None,
                 });
             }
         }
@@ -915,6 +919,8 @@ fn assemble(
             },
             role: Role::Edge,
             element: et.edge,
+            jvertex: None,
+            jedge: None,
         });
     }
     let mut edges_by_class = [0; 4];

@@ -498,6 +498,8 @@ mod tests {
             sheet: SheetRule::Any,
             role: Role::Other,
             element: 0,
+            jvertex: None,
+            jedge: None,
         }
     }
 
