@@ -112,6 +112,11 @@ pub fn build_with_stats(
             sheet: SheetRule::Any,
             role: tet.role,
             element: tet.element,
+            // Face tetrahedra: a j-patch for the apex; edge tetrahedra: single sheeted between
+            // [p_i p_j] and [q s] (the shapes the cubic scheme promises too; `apatch check`
+            // samples both).
+            jvertex: (tet.role == crate::complex::Role::Face).then_some(3),
+            jedge: (tet.role == crate::complex::Role::Edge).then_some([0, 1]),
         });
     }
     Ok((complex, stats))
