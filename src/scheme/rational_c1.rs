@@ -59,6 +59,7 @@
 //! [`RationalBuild::replaced_normals`]); otherwise the build fails naming the triangle.
 
 pub mod bound;
+pub mod certify;
 pub mod eval;
 pub mod quadric;
 pub mod weights;
@@ -410,10 +411,15 @@ fn tri_grid(n: usize) -> Vec<[f64; 3]> {
 /// Lower bound of σ f_0003 for one face side (Step 6, first part), taken ≥ 0.
 fn face_bound(side: &Side, tab: &Tab) -> f64 {
     const D: [f64; 4] = [0.0, 0.0, 1.0 / 3.0, 1.0];
-    let lines = side.pieces.iter().flat_map(|pc| {
-        let r = pc.rat.map_or([0.0; 4], |r| [r[0], r[1], r[2], 0.0]);
-        (0..tab.basis.len()).map(move |i| (tab.eval(i, &pc.w0, &r, side.sigma), D))
-    });
+    // Pieces whose top layers certify b = 0 cannot raise the maximum above its floor 0.
+    let lines = side
+        .pieces
+        .iter()
+        .filter(|pc| !certify::face_top(&pc.w0, &pc.dw, side.sigma))
+        .flat_map(|pc| {
+            let r = pc.rat.map_or([0.0; 4], |r| [r[0], r[1], r[2], 0.0]);
+            (0..tab.basis.len()).map(move |i| (tab.eval(i, &pc.w0, &r, side.sigma), D))
+        });
     bound::max_lemma_bound(lines, 0.0)
 }
 
@@ -424,8 +430,8 @@ struct EdgeTet {
     side: usize,
     piece: [usize; 2],
     frame: EdgeFrame,
-    /// Shooting-cubic coefficients of ∂/∂b along f_A = σ(B_A + b), f_B = σ(B_B + b), per sample.
-    d: Vec<[f64; 4]>,
+    /// Weights and rational weights of ∂/∂b along f_A = σ(B_A + b), f_B = σ(B_B + b).
+    dw: ([f64; N3], [f64; 4]),
 }
 
 /// Builds the rational C¹ complex (see the module docs).
@@ -626,9 +632,12 @@ fn assemble(
                 let pc = convex_piece(&fd, fh.centroid + t_apex * fh.normal);
                 let sigma = if top { 1.0 } else { -1.0 };
                 let scale = pc.w0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                if grid
-                    .iter()
-                    .any(|&a| sigma * face_shooting(&pc.w0, pc.rat.as_ref(), a)[0] > 1e-12 * scale)
+                // The layer-0 certificate settles most faces without sampling (half the
+                // tolerance: the sampled values round by far less than the other half).
+                if !certify::face_base_below(&pc.w0, pc.rat.as_ref(), sigma, 0.5e-12 * scale)
+                    && grid.iter().any(|&a| {
+                        sigma * face_shooting(&pc.w0, pc.rat.as_ref(), a)[0] > 1e-12 * scale
+                    })
                 {
                     class = Convexity::Nonconvex;
                     promoted = true;
@@ -719,15 +728,17 @@ fn assemble(
                 faces: [fa, fb],
                 side: s,
                 piece: [ka, kb],
+                dw: frame.weights(&sa.pieces[ka].dw, &sb.pieces[kb].dw),
                 frame,
-                d: Vec::new(),
             });
         }
     }
     let mut faces = faces;
-    // Edge bounds (Step 6, second part) along f_A = σ(B_A + b), f_B = σ(B_B + b).
+    // Edge bounds (Step 6, second part) along f_A = σ(B_A + b), f_B = σ(B_B + b); only
+    // positive ones are used, so the floor is 0 and the top-layer certificate at b = 0 skips
+    // the sampling where it holds.
     let edge_bounds: Vec<f64> = etets
-        .par_iter_mut()
+        .par_iter()
         .map(|et| {
             let sa = faces[et.faces[0]].sides[et.side]
                 .as_ref()
@@ -736,15 +747,20 @@ fn assemble(
                 .as_ref()
                 .expect("side exists");
             let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
-            let (dw, drat) = et.frame.weights(&pa.dw, &pb.dw);
+            let (dw, drat) = &et.dw;
             let wa = pa.weights(sa.sigma * sa.bound);
             let wb = pb.weights(sb.sigma * sb.bound);
             let (w0, r0) = et.frame.weights(&wa, &wb);
-            et.d = (0..egrid.len())
-                .map(|i| etab.eval(i, &dw, &drat, 1.0))
-                .collect();
-            let lines = (0..egrid.len()).map(|i| (etab.eval(i, &w0, &r0, sa.sigma), et.d[i]));
-            bound::max_lemma_bound(lines, f64::NEG_INFINITY)
+            if certify::edge_top(&w0, &r0, dw, drat, sa.sigma) {
+                return 0.0;
+            }
+            let lines = (0..egrid.len()).map(|i| {
+                (
+                    etab.eval(i, &w0, &r0, sa.sigma),
+                    etab.eval(i, dw, drat, 1.0),
+                )
+            });
+            bound::max_lemma_bound(lines, 0.0)
         })
         .collect();
     for (et, &be) in etets.iter().zip(&edge_bounds) {
@@ -789,11 +805,20 @@ fn assemble(
                 let sb = faces[et.faces[1]].sides[et.side]
                     .as_ref()
                     .expect("side exists");
-                let wa = sa.pieces[et.piece[0]].weights(sa.f);
-                let wb = sb.pieces[et.piece[1]].weights(sb.f);
-                let (w, r) = et.frame.weights(&wa, &wb);
+                let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
                 let margin = sa.margin.max(sb.margin);
-                let lines = (0..egrid.len()).map(|i| (etab.eval(i, &w, &r, sa.sigma), et.d[i]));
+                let (dw, drat) = &et.dw;
+                // Certificate at b = −margin: then the pruned maximum below is its floor.
+                let shift = -sa.sigma * margin;
+                let (wm, rm) = et
+                    .frame
+                    .weights(&pa.weights(sa.f + shift), &pb.weights(sb.f + shift));
+                if certify::edge_top(&wm, &rm, dw, drat, sa.sigma) {
+                    return 0.0;
+                }
+                let (w, r) = et.frame.weights(&pa.weights(sa.f), &pb.weights(sb.f));
+                let lines = (0..egrid.len())
+                    .map(|i| (etab.eval(i, &w, &r, sa.sigma), etab.eval(i, dw, drat, 1.0)));
                 bound::max_lemma_bound(lines, -margin) + margin
             })
             .collect();
@@ -815,7 +840,7 @@ fn assemble(
         }
     }
 
-    // Emit patches.
+    // Emit patches (in parallel; the order is the sequential one: faces, then edges).
     let mut complex = PatchComplex::new("rational-c1");
     complex.continuity = Some(1);
     complex.vertices = positions.iter().map(|p| p.to_array()).collect();
@@ -829,11 +854,19 @@ fn assemble(
     let mut free_values = vec![[f64::NAN; 2]; nf];
     for (t, fo) in faces.iter().enumerate() {
         faces_by_class[class_index(fo.class)] += 1;
+        for (s, side) in fo.sides.iter().enumerate() {
+            if let Some(side) = side {
+                lower_bounds[t][s] = side.bound;
+                free_values[t][s] = side.f;
+            }
+        }
+    }
+    let face_patches = |t: usize, fo: &FaceOut| -> Vec<Patch> {
         if fo.class == Convexity::Zero {
             let fh = &hull.faces[t];
             let tri = triangles[t];
             let apex = fh.centroid + fh.epsilon * fh.normal;
-            complex.patches.push(Patch {
+            return vec![Patch {
                 tet: [
                     positions[tri[0] as usize].to_array(),
                     positions[tri[1] as usize].to_array(),
@@ -848,13 +881,10 @@ fn assemble(
                 element: t as u32,
                 jvertex: None,
                 jedge: None,
-            });
-            continue;
+            }];
         }
-        for (s, side) in fo.sides.iter().enumerate() {
-            let Some(side) = side else { continue };
-            lower_bounds[t][s] = side.bound;
-            free_values[t][s] = side.f;
+        let mut out = Vec::with_capacity(6);
+        for side in fo.sides.iter().flatten() {
             for pc in &side.pieces {
                 let w = pc.weights(side.f);
                 let rational = pc
@@ -870,7 +900,7 @@ fn assemble(
                         }]
                     })
                     .unwrap_or_default();
-                complex.patches.push(Patch {
+                out.push(Patch {
                     tet: pc.pts.map(|p| p.to_array()),
                     degree: 3,
                     weights: w.to_vec(),
@@ -883,8 +913,9 @@ fn assemble(
                 });
             }
         }
-    }
-    for et in &etets {
+        out
+    };
+    let edge_patch = |et: &EdgeTet| -> Patch {
         let sa = faces[et.faces[0]].sides[et.side]
             .as_ref()
             .expect("side exists");
@@ -894,7 +925,7 @@ fn assemble(
         let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
         let (w, r) = et.frame.weights(&pa.weights(sa.f), &pb.weights(sb.f));
         let e = hull.edges[et.edge as usize];
-        complex.patches.push(Patch {
+        Patch {
             tet: [
                 positions[e.v[0] as usize].to_array(),
                 positions[e.v[1] as usize].to_array(),
@@ -921,8 +952,19 @@ fn assemble(
             element: et.edge,
             jvertex: None,
             jedge: None,
-        });
+        }
+    };
+    let per_face: Vec<Vec<Patch>> = faces
+        .par_iter()
+        .enumerate()
+        .map(|(t, fo)| face_patches(t, fo))
+        .collect();
+    let total = per_face.iter().map(Vec::len).sum::<usize>() + etets.len();
+    complex.patches.reserve_exact(total);
+    for v in per_face {
+        complex.patches.extend(v);
     }
+    complex.patches.par_extend(etets.par_iter().map(edge_patch));
     let mut edges_by_class = [0; 4];
     for e in &hull.edges {
         edges_by_class[class_index(e.class)] += 1;

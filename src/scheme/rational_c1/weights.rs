@@ -230,8 +230,16 @@ impl FaceData {
 
     /// A layer-0/1 weight of [p0 p1 p2 apex] by the rules of Steps 1–4.
     fn layer01(&self, l: &[u8; 4], pts: &[DVec3; 4], f1110: f64) -> f64 {
-        let corners: Vec<usize> = (0..3).filter(|&i| l[i] > 0).collect();
-        match (l[3], corners.len()) {
+        // The corners (local 0..=2) present in λ, in order; no allocation (hot path).
+        let mut corners = [0usize; 3];
+        let mut nc = 0;
+        for (i, &li) in l.iter().take(3).enumerate() {
+            if li > 0 {
+                corners[nc] = i;
+                nc += 1;
+            }
+        }
+        match (l[3], nc) {
             // Vertex (Step 1) or corner weights (Step 2).
             (_, 1) => {
                 let a = corners[0];
