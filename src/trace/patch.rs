@@ -477,6 +477,19 @@ impl CompiledPatch {
         jet
     }
 
+    /// F and its world gradient at the point with barycentrics `alpha`: [`Self::derivatives`]
+    /// without assembling the world Hessian (the shading of every mode but curvature); the
+    /// gradient is bit-identical to the one `derivatives` returns.
+    #[must_use]
+    pub fn value_gradient(&self, alpha: &[f64; 4]) -> (f64, DVec3) {
+        let j = self.bary_derivatives(alpha);
+        let mut g = DVec3::ZERO;
+        for i in 0..4 {
+            g += j.g[i] * self.grad[i];
+        }
+        (j.v, g)
+    }
+
     /// F, world gradient and world Hessian at the point with barycentrics `alpha`.
     #[must_use]
     pub fn derivatives(&self, alpha: &[f64; 4]) -> (f64, DVec3, DMat3) {
@@ -634,6 +647,7 @@ mod tests {
             }
             let x = DVec3::new(0.2, 0.3, 0.35);
             let (v, g, h) = c.derivatives(&c.bary(x));
+            assert_eq!(c.value_gradient(&c.bary(x)), (v, g));
             // Rounding only: exact representation of a quadric.
             assert!((v - q.value(x)).abs() < 1e-13);
             assert!(
@@ -680,7 +694,8 @@ mod tests {
             assert!((uni::eval(&co[..=d], s) - f(x) * den(x)).abs() < 1e-13);
         }
         let x = DVec3::new(0.25, 0.3, 0.2);
-        let (_, g, h) = c.derivatives(&c.bary(x));
+        let (v, g, h) = c.derivatives(&c.bary(x));
+        assert_eq!(c.value_gradient(&c.bary(x)), (v, g));
         let e = 1e-5;
         for axis in 0..3 {
             let mut dx = DVec3::ZERO;

@@ -149,7 +149,12 @@ pub struct Surface {
 pub fn surface(geo: &Geometry, hit: &Hit, o: DVec3, d: DVec3, curvature: bool) -> Surface {
     let patch = &geo.patches[hit.patch as usize];
     let p = o + hit.t * d;
-    let (_, g, h) = patch.derivatives(&hit.bary);
+    let (g, h) = if curvature {
+        let (_, g, h) = patch.derivatives(&hit.bary);
+        (g, h)
+    } else {
+        (patch.value_gradient(&hit.bary).1, glam::DMat3::ZERO)
+    };
     let len = g.length();
     let n = if len > 0.0 && len.is_finite() {
         g / len
