@@ -1,5 +1,6 @@
 //! `apatch export patches|mitsuba`.
 
+use anyhow::{anyhow, bail};
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,6 +35,15 @@ pub struct MitsubaArgs {
     /// Grid intervals per patch edge of the tessellation.
     #[arg(long, default_value_t = 8)]
     pub resolution: usize,
+    /// Image width in pixels (default: the scene's; as `apatch render --width`).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels (default: the scene's).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Samples per pixel (default: the scene's).
+    #[arg(long)]
+    pub spp: Option<u32>,
 }
 
 /// Runs `apatch export …`.
@@ -51,9 +61,24 @@ pub fn run(cmd: ExportCommand) -> anyhow::Result<ExitCode> {
                 .and_then(|e| e.to_str())
                 .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
             if !is_toml {
-                anyhow::bail!("{}: expected a scene .toml", a.scene.display());
+                bail!("{}: expected a scene .toml", a.scene.display());
             }
-            let scene = apatch::scene::load(&a.scene)?;
+            let mut scene = apatch::scene::load(&a.scene)?;
+            let s = &mut scene.settings;
+            if a.width.is_some() || a.height.is_some() {
+                let w = a.width.unwrap_or(s.camera.width);
+                let h = a.height.unwrap_or(s.camera.height);
+                s.camera = s
+                    .camera
+                    .resized(w, h)
+                    .map_err(|e| anyhow!("--width/--height: {e}"))?;
+            }
+            if let Some(spp) = a.spp {
+                if spp == 0 {
+                    bail!("--spp: must be ≥ 1");
+                }
+                s.spp = spp;
+            }
             let complex = super::check::load_complex(&a.scene)?;
             let done = apatch::export::mitsuba::export(&scene, &complex, &a.output, a.resolution)?;
             println!(

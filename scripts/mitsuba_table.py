@@ -1,0 +1,204 @@
+#!/usr/bin/env python3
+"""Regenerate the apatch-vs-Mitsuba comparison table (docs/mitsuba_table.md) and the side-by-side
+pictures (renders/mitsuba/<scene>.png) for every scene in scenes/*.toml.
+
+Per scene, in shaded mode at the same size and spp on both sides:
+  1. `apatch export mitsuba` (tessellated surface as PLY, same sensor/film/emitters);
+  2. Mitsuba renders the export (`scripts/mitsuba_render.py`, variant scalar_rgb), timed;
+  3. `apatch render` renders the scene itself, timed;
+  4. `apatch compare` gives PSNR and max error over R,G,B (and alpha), plus the picture.
+
+Usage (from the repository root, after `bash .ci/run` or with MITSUBA_PYTHON set):
+
+    cargo build --release
+    python3 scripts/mitsuba_table.py [--width 400 --height 300] [--spp 256] [scenes/spot.toml ...]
+
+Only the Python standard library is needed here; Mitsuba runs in MITSUBA_PYTHON or the venv
+target/mitsuba-venv. Intermediate files (PLY, EXR) go to target/mitsuba-table/. Exit code 0 on
+success, 2 on errors (one line on stderr).
+"""
+
+import argparse
+import datetime
+import glob
+import json
+import os
+import platform
+import re
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def fail(msg):
+    print("mitsuba_table: error: %s" % msg, file=sys.stderr)
+    sys.exit(2)
+
+
+def run(cmd, **kw):
+    """Runs `cmd`, returning (stdout, stderr, wall seconds); fails with its stderr."""
+    t = time.monotonic()
+    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
+    dt = time.monotonic() - t
+    if r.returncode != 0:
+        fail("%s: exit %d: %s" % (" ".join(cmd), r.returncode, r.stderr.strip()[-2000:]))
+    return r.stdout, r.stderr, dt
+
+
+def find_python(explicit):
+    for p in (explicit, os.environ.get("MITSUBA_PYTHON"),
+              os.path.join(ROOT, "target", "mitsuba-venv", "bin", "python")):
+        if p and os.path.isfile(p):
+            return p
+    fail("no Mitsuba Python: set MITSUBA_PYTHON or run bash .ci/run (creates target/mitsuba-venv)")
+
+
+def mitsuba_version(python):
+    out, _, _ = run([python, "-c", "import mitsuba; print(mitsuba.__version__)"])
+    return out.strip()
+
+
+def cpu_name():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def one_scene(scene, args, python, work):
+    stem = os.path.splitext(os.path.basename(scene))[0]
+    d = os.path.join(work, stem)
+    os.makedirs(d, exist_ok=True)
+    size = ["--width", str(args.width), "--height", str(args.height)] if args.width else []
+    # 1. export
+    out, _, t_export = run([args.apatch, "export", "mitsuba", scene, "-o", d,
+                            "--resolution", str(args.resolution), "--spp", str(args.spp)] + size)
+    m = re.search(r"\((\d+) vertices, (\d+) triangles\)", out)
+    triangles = int(m.group(2)) if m else 0
+    xml = os.path.join(d, stem + ".xml")
+    mts_exr = os.path.join(d, "mitsuba.exr")
+    # 2. Mitsuba (wall time of the whole process: PLY loading, BVH build and rendering)
+    _, _, t_mts = run([python, os.path.join(ROOT, "scripts", "mitsuba_render.py"), xml, mts_exr,
+                       "--quiet", "--variant", args.variant])
+    # 3. apatch (wall time of the whole process: mesh, scheme, BVH, rendering)
+    apatch_exr = os.path.join(d, "apatch.exr")
+    _, err, t_apatch = run([args.apatch, "render", scene, "--mode", "shaded", "--spp",
+                            str(args.spp), "--output", apatch_exr] + size)
+    m = re.search(r"build ([0-9.]+) s, render ([0-9.]+) s", err)
+    t_build, t_render = (float(m.group(1)), float(m.group(2))) if m else (None, None)
+    # 4. compare
+    pic = os.path.join(args.pictures, stem + ".png")
+    out, _, _ = run([args.apatch, "compare", apatch_exr, mts_exr, "--channels", "R,G,B",
+                     "--json", "--side-by-side", pic])
+    rgb = json.loads(out)
+    out, _, _ = run([args.apatch, "compare", apatch_exr, mts_exr, "--channels", "A", "--json"])
+    alpha = json.loads(out)
+    return {
+        "scene": stem,
+        "width": rgb["width"],
+        "height": rgb["height"],
+        "triangles": triangles,
+        "psnr": rgb["all"]["psnr"],
+        "max": rgb["all"]["max_abs"],
+        "rmse": rgb["all"]["rmse"],
+        "ssim": rgb["ssim"],
+        "alpha_psnr": alpha["all"]["psnr"],
+        "t_export": t_export,
+        "t_mitsuba": t_mts,
+        "t_apatch": t_apatch,
+        "t_build": t_build,
+        "t_render": t_render,
+        "picture": os.path.relpath(pic, ROOT),
+    }
+
+
+def fmt_db(x):
+    return "∞" if x is None else "%.1f" % x
+
+
+def table(rows, args, python):
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    lines = [
+        "# apatch vs Mitsuba 3",
+        "",
+        "Generated by `python3 scripts/mitsuba_table.py%s` on %s: shaded mode, %d spp on both sides, "
+        "box filter; Mitsuba %s (`%s`, `direct` integrator) renders the `apatch export mitsuba` "
+        "scene, whose surface is the A-patch tessellation at resolution %d "
+        "(`--resolution`). PSNR and max error over linear R, G, B (peak 1); alpha PSNR over "
+        "coverage. Times are wall clock of the whole process on the same machine "
+        "(%s, %d cores, load average %.1f at the end: shared with other jobs, so absolute "
+        "times are noisy; apatch includes building the A-patches, Mitsuba includes loading the PLY)."
+        % (" " + " ".join(args.argv) if args.argv else "", datetime.date.today().isoformat(),
+           args.spp, mitsuba_version(python), args.variant, args.resolution, cpu_name(),
+           os.cpu_count() or 0, load),
+        "",
+        "| scene | size | exported triangles | PSNR RGB (dB) | max error | alpha PSNR (dB) | SSIM "
+        "| apatch time (s) (build + render) | Mitsuba time (s) | side by side |",
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |",
+    ]
+    for r in rows:
+        split = ("%.1f (%.1f + %.1f)" % (r["t_apatch"], r["t_build"], r["t_render"])
+                 if r["t_build"] is not None else "%.1f" % r["t_apatch"])
+        lines.append(
+            "| %s | %d×%d | %d | %s | %.3f | %s | %.4f | %s | %.1f | [png](../%s) |"
+            % (r["scene"], r["width"], r["height"], r["triangles"], fmt_db(r["psnr"]), r["max"],
+               fmt_db(r["alpha_psnr"]), r["ssim"], split, r["t_mitsuba"], r["picture"]))
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("scenes", nargs="*", help="scene files (default: scenes/*.toml)")
+    ap.add_argument("--width", type=int, help="image width (default: each scene's)")
+    ap.add_argument("--height", type=int, help="image height (default: each scene's)")
+    ap.add_argument("--spp", type=int, default=256, help="samples per pixel on both sides")
+    ap.add_argument("--resolution", type=int, default=8,
+                    help="tessellation intervals per patch edge of the exported mesh")
+    ap.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant")
+    ap.add_argument("--python", help="Python with mitsuba (default: MITSUBA_PYTHON or the venv)")
+    ap.add_argument("--apatch", default=os.path.join(ROOT, "target", "release", "apatch"),
+                    help="apatch binary (default: target/release/apatch)")
+    ap.add_argument("--pictures", default=os.path.join(ROOT, "renders", "mitsuba"),
+                    help="directory of the side-by-side PNGs")
+    ap.add_argument("--table", default=os.path.join(ROOT, "docs", "mitsuba_table.md"),
+                    help="markdown file to write")
+    args = ap.parse_args(argv)
+    args.argv = argv
+    if (args.width is None) != (args.height is None):
+        fail("give both --width and --height, or neither")
+    if args.spp < 1:
+        fail("--spp must be >= 1")
+    if not os.path.isfile(args.apatch):
+        fail("%s: no such file (cargo build --release)" % args.apatch)
+    python = find_python(args.python)
+    scenes = args.scenes or sorted(glob.glob(os.path.join(ROOT, "scenes", "*.toml")))
+    if not scenes:
+        fail("no scenes")
+    work = os.path.join(ROOT, "target", "mitsuba-table")
+    os.makedirs(args.pictures, exist_ok=True)
+    rows = []
+    for s in scenes:
+        r = one_scene(s, args, python, work)
+        print("%s: PSNR %s dB, max %.3f, apatch %.1f s, Mitsuba %.1f s"
+              % (r["scene"], fmt_db(r["psnr"]), r["max"], r["t_apatch"], r["t_mitsuba"]),
+              file=sys.stderr)
+        rows.append(r)
+    text = table(rows, args, python)
+    os.makedirs(os.path.dirname(args.table), exist_ok=True)
+    with open(args.table, "w") as f:
+        f.write(text)
+    with open(os.path.join(work, "rows.json"), "w") as f:
+        json.dump(rows, f, indent=1)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
