@@ -164,7 +164,9 @@ Notes:
   resolution; under a directional light facets that face away from it shadow themselves, the
   "shadow terminator").
   The max error sits on silhouette and shadow-boundary pixels.
-- `emitters` are hidden from camera rays (`hide_emitters`), so both backgrounds are 0 and both
+- `--keep-apatch` reuses the apatch renders (and their times) of the previous run at the same
+  size: apatch's image does not depend on the export resolution.
+- Emitters are hidden from camera rays (`hide_emitters`), so both backgrounds are 0 and both
   alphas are coverage.
 """
 
@@ -205,8 +207,8 @@ def table(rows, args, python):
             "",
             "Size: %d×%d instead of the scenes' own (same view and aspect) to keep the run short on "
             "a shared 2-core machine: apatch's shaded renders ran at 0.1–0.25 M samples/s under "
-            "that load (9–17 min per scene at 800×600×256), Mitsuba's scalar_rgb at about "
-            "0.85 M samples/s. Without `--width/--height` the script uses each scene's size."
+            "that load (9–17 min per scene at 800×600×256), Mitsuba's scalar_rgb at 0.4–0.85 M "
+            "samples/s. Without `--width/--height` the script uses each scene's size."
             % (args.width, args.height),
         ]
     return "\n".join(lines) + "\n" + NOTES
