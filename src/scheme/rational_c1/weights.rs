@@ -466,7 +466,7 @@ impl EdgeFrame {
         }
         // Σ_r β_r w(face multiset + e_r), alternating A and B.
         let blend = |k: usize| -> f64 {
-            let (w, beta) = if k % 2 == 0 {
+            let (w, beta) = if k.is_multiple_of(2) {
                 (wa, &self.beta_a)
             } else {
                 (wb, &self.beta_b)
