@@ -4,6 +4,7 @@
 //! (`RAYON_NUM_THREADS=1` for the one-thread figure). Besides wall time it prints the
 //! process CPU time of the build (from `/proc/self/stat`, Linux only): on a shared, loaded
 //! machine the wall time mostly measures the other processes, CPU time / threads does not.
+//! `APATCH_TORUS=n` builds only the n × n torus (peak memory at several sizes).
 
 #[path = "rational_support.rs"]
 mod support;
@@ -26,10 +27,19 @@ fn cpu_seconds() -> Option<f64> {
 #[test]
 #[ignore = "timing run, not a check"]
 fn build_throughput() {
-    for m in [
-        support::sphere_model("sphere/6", 6),
-        support::torus(1.0, 0.4, 224, 224),
-    ] {
+    // APATCH_TORUS=<n>: only the n × n torus, for peak-memory runs at several sizes
+    // (`/usr/bin/time -v`).
+    let models = match std::env::var("APATCH_TORUS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+    {
+        Some(n) => vec![support::torus(1.0, 0.4, n, n)],
+        None => vec![
+            support::sphere_model("sphere/6", 6),
+            support::torus(1.0, 0.4, 224, 224),
+        ],
+    };
+    for m in models {
         let c0 = cpu_seconds();
         let t = Instant::now();
         let b = build(
