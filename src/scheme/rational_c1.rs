@@ -46,7 +46,9 @@
 //! interpolation (4.10)–(4.12) and Step 4). Step 5 by the least squares (4.13)/(4.14); for a
 //! nonconvex face the Clough–Tocher values (see [`weights::nonconvex_pieces`]). Step 6 lower
 //! bounds with [`bound::lemma_bound`] sampled on grids (accuracy there), taken ≥ 0, plus
-//! `bound_margin`. Steps 7, 9 by the C¹ conditions (2.3). Step 8 and the `free` choices in
+//! `bound_margin`; a face or edge tetrahedron whose top two weight layers prove the bound
+//! ([`certify`], Bernstein coefficients) is not sampled at all, which gives the same result.
+//! Steps 7, 9 by the C¹ conditions (2.3). Step 8 and the `free` choices in
 //! [`Free`]. After the choice, every edge tetrahedron is checked again with the chosen values
 //! and both faces are raised if needed (the paper's bound is taken along f_A − B_A = f_B − B_B
 //! only). Positive (negative) convex faces on which F > 0 (< 0) somewhere are treated as
@@ -409,6 +411,12 @@ fn tri_grid(n: usize) -> Vec<[f64; 3]> {
 }
 
 /// Lower bound of σ f_0003 for one face side (Step 6, first part), taken ≥ 0.
+///
+/// Pieces whose top layers certify b = 0 ([`certify::face_top`]) are skipped; the others are
+/// sampled at the base points of `tab`. The sampled maximum is not a certificate: between
+/// the samples a line can need more (on 7 of 1200 random sides up to ~0.6 % of the longest
+/// edge more, beyond `bound_margin`; see the ignored test
+/// `fast_face_bound_covers_dense_sampling`).
 fn face_bound(side: &Side, tab: &Tab) -> f64 {
     const D: [f64; 4] = [0.0, 0.0, 1.0 / 3.0, 1.0];
     // Pieces whose top layers certify b = 0 cannot raise the maximum above its floor 0.
@@ -982,4 +990,142 @@ fn assemble(
         raised_faces: raised.iter().flatten().filter(|&&r| r).count(),
         replaced_normals: 0,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        }
+        fn vec(&mut self) -> DVec3 {
+            DVec3::new(self.next(), self.next(), self.next())
+        }
+    }
+
+    /// One face side of a random test case, its longest edge and its fast bound.
+    struct Case {
+        side: Side,
+        longest: f64,
+        fast: f64,
+    }
+
+    /// Seeded random faces (corners in the unit cube, normals within ~35° of the face's),
+    /// both sides, as one convex piece and as three nonconvex pieces, with the fast bound.
+    fn random_cases() -> Vec<Case> {
+        let mut rng = Rng(0x0ddb_a11c_afe5_eed5);
+        let tab = Tab::face(&tri_grid(RationalOptions::default().bound_samples));
+        let mut out = Vec::new();
+        for _ in 0..300 {
+            let p = [rng.vec(), rng.vec(), rng.vec()];
+            let Some(nf) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
+                continue;
+            };
+            let n = [0; 3].map(|_| (nf + 0.6 * rng.vec()).normalize());
+            if n.iter().any(|x| x.dot(nf) < 0.2) {
+                continue;
+            }
+            let fd = FaceData::new(p, n);
+            let longest = (0..3)
+                .map(|k| (p[(k + 1) % 3] - p[k]).length())
+                .fold(0.0, f64::max);
+            let c = (p[0] + p[1] + p[2]) / 3.0;
+            for (sigma, t) in [(1.0, 0.3 * longest), (-1.0, -0.3 * longest)] {
+                let apex = c + t * nf;
+                for pieces in [
+                    vec![convex_piece(&fd, apex)],
+                    nonconvex_pieces(&fd, apex).to_vec(),
+                ] {
+                    let side = Side {
+                        sigma,
+                        pieces,
+                        bound: 0.0,
+                        f: 0.0,
+                        margin: 0.0,
+                        edge_extra: 0.0,
+                    };
+                    let fast = face_bound(&side, &tab);
+                    out.push(Case {
+                        side,
+                        longest,
+                        fast,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The plain maximum (floor 0) of [`bound::lemma_bound`] over the lines of `side` from the
+    /// base points `grid`, each line straight from [`face_shooting`] (no tables, no pruning).
+    fn plain_bound(side: &Side, grid: &[[f64; 3]]) -> f64 {
+        const D: [f64; 4] = [0.0, 0.0, 1.0 / 3.0, 1.0];
+        side.pieces
+            .iter()
+            .flat_map(|pc| {
+                grid.iter().map(move |&a| {
+                    let line = face_shooting(&pc.w0, pc.rat.as_ref(), a);
+                    bound::lemma_bound(line.map(|x| side.sigma * x), D)
+                })
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The fast face bound (certificates + pruned sampling) on random faces equals the plain
+    /// maximum of [`bound::lemma_bound`] over the same samples: the certificates and the
+    /// pruning change nothing. Both paths are exercised.
+    #[test]
+    fn fast_face_bound_equals_plain_sampling() {
+        let grid = tri_grid(RationalOptions::default().bound_samples);
+        let (mut certified, mut sampled) = (0, 0);
+        for c in random_cases() {
+            if c.side
+                .pieces
+                .iter()
+                .all(|pc| certify::face_top(&pc.w0, &pc.dw, c.side.sigma))
+            {
+                certified += 1;
+            } else {
+                sampled += 1;
+            }
+            let plain = plain_bound(&c.side, &grid);
+            let scale = c.side.pieces[0]
+                .w0
+                .iter()
+                .fold(1e-300f64, |m, x| m.max(x.abs()));
+            // The tabulated evaluation rounds differently from face_shooting (1e-12 of the
+            // weights' scale, far above f64 rounding of 20-term sums).
+            assert!(
+                (c.fast - plain).abs() <= 1e-12 * scale,
+                "fast {} plain {plain}",
+                c.fast
+            );
+        }
+        assert!(certified > 20 && sampled > 20, "{certified} {sampled}");
+    }
+
+    /// Known gap (extra evidence, not a requirement's proof): the sampled Lemma 2.3 bound is
+    /// not a certificate. On a dense grid (32 intervals per edge) 7 of the 1200 random sides
+    /// need up to ~0.6 % of the longest edge more than the 8-interval samples give, beyond the
+    /// scheme's margin (0.1 %). This test fails until the face bound becomes a certificate.
+    #[test]
+    #[ignore = "known gap: the sampled face bound is below the dense one on a few random faces"]
+    fn fast_face_bound_covers_dense_sampling() {
+        let dense = tri_grid(32);
+        let margin = RationalOptions::default().bound_margin;
+        for c in random_cases() {
+            let d = plain_bound(&c.side, &dense);
+            assert!(
+                d <= c.fast + margin * c.longest,
+                "dense {d} > fast {} + margin",
+                c.fast
+            );
+        }
+    }
 }

@@ -45,7 +45,8 @@ pub fn face_top(w: &[f64; N3], dw: &[f64; N3], sigma: f64) -> bool {
 #[must_use]
 pub fn face_base_below(w: &[f64; N3], rat: Option<&[f64; 3]>, sigma: f64, tol: f64) -> bool {
     let (face, _) = layers();
-    let k1110 = super::weights::ix([1, 1, 1, 0]);
+    static K1110: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    let k1110 = *K1110.get_or_init(|| super::weights::ix([1, 1, 1, 0]));
     (0..N3).all(|k| {
         if face[k] != 0 {
             return true;

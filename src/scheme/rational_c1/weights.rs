@@ -390,6 +390,12 @@ pub struct EdgeFrame {
     pub beta_a: [f64; 4],
     /// Barycentric coordinates of apexA in piece B's tetrahedron.
     pub beta_b: [f64; 4],
+    /// Precomputed gather of [`EdgeFrame::weights`]: per edge weight, the piece (0 = A,
+    /// 1 = B, 2 = computed by (2.3)) and the index in it.
+    copy: [(u8, u8); N3],
+    /// The four weights of piece A (B) blended by β_a (β_b) for f_0021 (f_0012) and the four
+    /// rational weights, in the order of [`EdgeFrame::weights`].
+    c1: [[u8; 4]; 6],
 }
 
 impl EdgeFrame {
@@ -402,11 +408,45 @@ impl EdgeFrame {
             let j = (0..3).find(|&k| pc.pts[k] == pj)?;
             Some([i, j, 3])
         };
+        let (a_loc, b_loc) = (loc(a)?, loc(b)?);
+        let map = |loc: &[usize; 3], c: [u8; 3]| -> [u8; 4] {
+            let mut l = [0u8; 4];
+            for k in 0..3 {
+                l[loc[k]] += c[k];
+            }
+            l
+        };
+        let mut copy = [(2u8, 0u8); N3];
+        for (k, &l) in cubic_indices().iter().enumerate() {
+            if l[3] == 0 {
+                copy[k] = (0, ix(map(&a_loc, [l[0], l[1], l[2]])) as u8);
+            } else if l[2] == 0 {
+                copy[k] = (1, ix(map(&b_loc, [l[0], l[1], l[3]])) as u8);
+            }
+        }
+        // First layer across the face shared with a piece: w(face multiset + e_r), r = 0..3.
+        let c1 = |loc: &[usize; 3], c: [u8; 3]| -> [u8; 4] {
+            let base = map(loc, c);
+            std::array::from_fn(|r| {
+                let mut l = base;
+                l[r] += 1;
+                ix(l) as u8
+            })
+        };
         Some(EdgeFrame {
-            a_loc: loc(a)?,
-            b_loc: loc(b)?,
+            a_loc,
+            b_loc,
             beta_a: bary(&a.pts, b.pts[3])?,
             beta_b: bary(&b.pts, a.pts[3])?,
+            copy,
+            c1: [
+                c1(&a_loc, [0, 0, 2]),
+                c1(&b_loc, [0, 0, 2]),
+                c1(&a_loc, [1, 0, 1]),
+                c1(&b_loc, [1, 0, 1]),
+                c1(&a_loc, [0, 1, 1]),
+                c1(&b_loc, [0, 1, 1]),
+            ],
         })
     }
 
@@ -416,40 +456,33 @@ impl EdgeFrame {
     /// rational ones by (2.3)) and Step 9 (number 7 weights by (2.3)).
     #[must_use]
     pub fn weights(&self, wa: &[f64; N3], wb: &[f64; N3]) -> ([f64; N3], [f64; 4]) {
-        let map = |loc: &[usize; 3], c: [u8; 3]| -> [u8; 4] {
-            let mut l = [0u8; 4];
-            for k in 0..3 {
-                l[loc[k]] += c[k];
-            }
-            l
-        };
-        // First layer across the face shared with a piece: Σ_r β_r w(face multiset + e_r).
-        let c1 = |w: &[f64; N3], loc: &[usize; 3], beta: &[f64; 4], c: [u8; 3]| -> f64 {
-            let base = map(loc, c);
-            (0..4)
-                .map(|r| {
-                    let mut l = base;
-                    l[r] += 1;
-                    beta[r] * w[ix(l)]
-                })
-                .sum()
-        };
         let mut e = [0.0; N3];
-        for (k, &l) in cubic_indices().iter().enumerate() {
-            if l[3] == 0 {
-                e[k] = wa[ix(map(&self.a_loc, [l[0], l[1], l[2]]))];
-            } else if l[2] == 0 {
-                e[k] = wb[ix(map(&self.b_loc, [l[0], l[1], l[3]]))];
+        for (ek, &(src, i)) in e.iter_mut().zip(&self.copy) {
+            match src {
+                0 => *ek = wa[usize::from(i)],
+                1 => *ek = wb[usize::from(i)],
+                _ => {}
             }
         }
-        e[ix([0, 0, 2, 1])] = c1(wa, &self.a_loc, &self.beta_a, [0, 0, 2]);
-        e[ix([0, 0, 1, 2])] = c1(wb, &self.b_loc, &self.beta_b, [0, 0, 2]);
-        let rat = [
-            c1(wa, &self.a_loc, &self.beta_a, [1, 0, 1]),
-            c1(wb, &self.b_loc, &self.beta_b, [1, 0, 1]),
-            c1(wa, &self.a_loc, &self.beta_a, [0, 1, 1]),
-            c1(wb, &self.b_loc, &self.beta_b, [0, 1, 1]),
-        ];
-        (e, rat)
+        // Σ_r β_r w(face multiset + e_r), alternating A and B.
+        let blend = |k: usize| -> f64 {
+            let (w, beta) = if k.is_multiple_of(2) {
+                (wa, &self.beta_a)
+            } else {
+                (wb, &self.beta_b)
+            };
+            (0..4)
+                .map(|r| beta[r] * w[usize::from(self.c1[k][r])])
+                .sum()
+        };
+        e[edge_ix().0] = blend(0);
+        e[edge_ix().1] = blend(1);
+        (e, [blend(2), blend(3), blend(4), blend(5)])
     }
+}
+
+/// Indices of f_0021 and f_0012 (computed once).
+fn edge_ix() -> (usize, usize) {
+    static I: OnceLock<(usize, usize)> = OnceLock::new();
+    *I.get_or_init(|| (ix([0, 0, 2, 1]), ix([0, 0, 1, 2])))
 }
