@@ -55,7 +55,8 @@ pub fn most_above(faces: &[DVec3]) -> DVec3 {
 
 /// A normal above all `faces` (unit normals) with clearance ≥ [`ABOVE_MARGIN`]: `given` itself
 /// when it qualifies, else `given` rotated towards [`most_above`] by the smallest step that
-/// qualifies (bisection on the blend). `None` when no direction qualifies.
+/// reaches half of the best clearance (bisection on the blend). `None` when no direction
+/// qualifies.
 #[must_use]
 pub fn make_above(given: DVec3, faces: &[DVec3]) -> Option<DVec3> {
     if clearance(given, faces) >= ABOVE_MARGIN {
@@ -69,7 +70,9 @@ pub fn make_above(given: DVec3, faces: &[DVec3]) -> Option<DVec3> {
     let (mut lo, mut hi) = (0.0, 1.0);
     for _ in 0..50 {
         let mid = 0.5 * (lo + hi);
-        if clearance(blend(mid), faces) >= 2.0 * ABOVE_MARGIN.min(0.5 * clearance(target, faces)) {
+        // Half the best clearance: well inside the feasible cone, so the corner stays
+        // separable and its tetrahedra stay thick.
+        if clearance(blend(mid), faces) >= 0.5 * clearance(target, faces) {
             hi = mid;
         } else {
             lo = mid;

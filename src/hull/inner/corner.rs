@@ -123,14 +123,66 @@ pub fn build_corner(
         let (s1, s2) = (n.dot(c1 - c0), n.dot(c2 - c0));
         let tri = [c0, c1, c2];
         let mut slot = [None, None];
+        // Lemma 4.3: the plane Π through C_1, C_2 and M separates this vertex's tetrahedron
+        // from the one built at V' over the same edge C_1C_2, if every apex lies on V's side
+        // at least as far as the point 0.45e (T_0 does by construction). T_1 is moved there
+        // within π, keeping tangency at C_0.
+        let mut pi_n = (c1 - m).cross(c2 - m).normalize_or_zero();
+        if pi_n.dot(c.v - m) < 0.0 {
+            pi_n = -pi_n;
+        }
+        let g_min = pi_n.dot(c.v + 0.45 * d - m);
+        let along = (n * n.dot(d) - d).normalize_or_zero();
+        let keep_side = |q: DVec3| -> DVec3 {
+            let gq = pi_n.dot(q - m);
+            let rate = pi_n.dot(along);
+            if g_min > 0.0 && gq < g_min && rate > 1e-9 {
+                q + (g_min - gq) / rate * along
+            } else {
+                q
+            }
+        };
+        t1 = keep_side(t1);
         if s1 * s2 >= 0.0 {
             let s = if s1 != 0.0 { s1 } else { s2 };
             let st0 = n.dot(t0 - c0);
+            // The side the polyhedron's corner lies on: outer when the centroids are below
+            // C_0's tangent plane (a convex corner), inner otherwise.
+            let up = if s <= 0.0 { n } else { -n };
+            let mm = (c1 - c0).cross(c2 - c0);
+            let want = if s <= 0.0 { 1.0 } else { -1.0 };
+            let margin = 0.05 * d.length() * mm.length();
+            // Moves q parallel to π (so its height over C_0's tangent plane, and with it the
+            // tangency at C_0, is kept) until it is on the corner's side of the triangle.
+            let w = (want * mm - want * mm.dot(up) * up).normalize_or_zero();
+            let rate = want * mm.dot(w);
+            let to_corner_side = |q: DVec3| -> DVec3 {
+                let o = orient(c0, c1, c2, q) * want;
+                if o < margin && rate > 1e-12 * mm.length() {
+                    keep_side(q + (margin - o) / rate * w)
+                } else {
+                    q
+                }
+            };
             if st0 * s <= 0.0 {
+                if separable {
+                    t0 = to_corner_side(t0);
+                }
+                if !separable {
+                    // C_0 = V lies in both face planes, as does T_0: lift T_0 off them (away
+                    // from the triangle) so the edge tetrahedra over VC_i are not flat.
+                    let mm = (c1 - c0).cross(c2 - c0);
+                    let side = orient(c0, c1, c2, t0).signum();
+                    t0 += 0.05 * d.length() * side * mm.normalize_or_zero();
+                }
                 set_apex(&mut slot, tri, t0);
                 counts.case_i += 1;
             } else {
                 let o0 = orient(c0, c1, c2, t0);
+                // T_1 must lie on the corner's side of the triangle unless T_0 already does.
+                if o0 * want <= 0.0 {
+                    t1 = to_corner_side(t1);
+                }
                 let o1 = orient(c0, c1, c2, t1);
                 if o0 * o1 >= 0.0 {
                     set_apex(&mut slot, tri, t1);
@@ -151,7 +203,7 @@ pub fn build_corner(
             if h0 < shift {
                 t0 += (shift - h0) * up;
             }
-            t1 -= shift * up;
+            t1 = keep_side(t1 - shift * up);
             let o0 = orient(c0, c1, c2, t0);
             let mut o1 = orient(c0, c1, c2, t1);
             if o0 * o1 >= 0.0 {
