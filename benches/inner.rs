@@ -27,7 +27,9 @@ fn quad_torus(nu: usize, nv: usize) -> Mesh {
             faces.push(vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
         }
     }
-    mesh::from_polygons(positions, faces).expect("valid torus").0
+    mesh::from_polygons(positions, faces)
+        .expect("valid torus")
+        .0
 }
 
 fn bench(c: &mut Criterion) {
