@@ -156,3 +156,19 @@ fn explore_torus() {
         b.flat_edges, b.flat_unsolved, b.unsigned, b.raised
     );
 }
+
+/// The j-vertex / j-edge fields survive the patch JSON (written only when present), and a
+/// bad j-vertex is rejected on read.
+#[test]
+fn jvertex_json_roundtrip() {
+    let (m, _) = apatch::mesh::load(Path::new("scenes/models/cube.obj")).unwrap();
+    let c = build_full(&trihedral_hull(&m), &CubicOptions::default())
+        .unwrap()
+        .complex;
+    let text = apatch::complex_io::to_json_string(&c).unwrap();
+    assert!(text.contains("\"jvertex\":3") && text.contains("\"jedge\":[0,1]"));
+    let back = apatch::complex_io::from_json_str(&text, Path::new("x.json")).unwrap();
+    assert_eq!(back, c);
+    let bad = text.replacen("\"jvertex\":3", "\"jvertex\":7", 1);
+    assert!(apatch::complex_io::from_json_str(&bad, Path::new("x.json")).is_err());
+}
