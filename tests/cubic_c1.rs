@@ -123,3 +123,52 @@ fn explore_models() {
             hull.triangles.len(), b.flat_edges, b.raised, b.unsigned, r.gradient_jump.worst, r.gradient_jump.at, r.sheets.j_multi_at);
     }
 }
+
+/// Exploration: build counters on a generated quad torus (`TORUS=m`).
+#[test]
+#[ignore = "exploration"]
+fn explore_torus() {
+    use apatch::hull::inner::{self, InnerOptions};
+    let m: usize = std::env::var("TORUS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(40);
+    let mut v = Vec::new();
+    for i in 0..m {
+        let u = i as f64 / m as f64 * std::f64::consts::TAU;
+        for j in 0..m {
+            let w = j as f64 / m as f64 * std::f64::consts::TAU;
+            let r = 1.0 + 0.4 * w.cos();
+            v.push(glam::DVec3::new(r * u.cos(), r * u.sin(), 0.4 * w.sin()));
+        }
+    }
+    let id = |i: usize, j: usize| ((i % m) * m + (j % m)) as u32;
+    let f: Vec<Vec<u32>> = (0..m * m)
+        .map(|k| (k / m, k % m))
+        .map(|(i, j)| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        .collect();
+    let mesh = apatch::mesh::Mesh::new(v, f);
+    let vn = apatch::mesh::vertex_normals(&mesh, apatch::mesh::NormalMethod::Angle).unwrap();
+    let hull = inner::build(&mesh, &vn, &InnerOptions::default()).unwrap();
+    let b = build_full(&hull, &CubicOptions::default()).unwrap();
+    eprintln!(
+        "torus {m}: flat {} unsolved {} unsigned {} raised {}",
+        b.flat_edges, b.flat_unsolved, b.unsigned, b.raised
+    );
+}
+
+/// The j-vertex / j-edge fields survive the patch JSON (written only when present), and a
+/// bad j-vertex is rejected on read.
+#[test]
+fn jvertex_json_roundtrip() {
+    let (m, _) = apatch::mesh::load(Path::new("scenes/models/cube.obj")).unwrap();
+    let c = build_full(&trihedral_hull(&m), &CubicOptions::default())
+        .unwrap()
+        .complex;
+    let text = apatch::complex_io::to_json_string(&c).unwrap();
+    assert!(text.contains("\"jvertex\":3") && text.contains("\"jedge\":[0,1]"));
+    let back = apatch::complex_io::from_json_str(&text, Path::new("x.json")).unwrap();
+    assert_eq!(back, c);
+    let bad = text.replacen("\"jvertex\":3", "\"jvertex\":7", 1);
+    assert!(apatch::complex_io::from_json_str(&bad, Path::new("x.json")).is_err());
+}
