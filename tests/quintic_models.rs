@@ -14,8 +14,17 @@ fn run(name: &str) -> Result<String, String> {
         mesh::vertex_normals(&m, NormalMethod::default_for(&m)).map_err(|e| e.to_string())?;
     let hull = inner::build(&m, &normals, &InnerOptions::default()).map_err(|e| e.to_string())?;
     let t = std::time::Instant::now();
-    let (c, stats) =
-        build_with_stats(&hull, &QuinticOptions::default()).map_err(|e| e.to_string())?;
+    let (c, stats) = build_with_stats(
+        &hull,
+        &QuinticOptions {
+            lift: std::env::var("LIFT")
+                .ok()
+                .and_then(|x| x.parse().ok())
+                .unwrap_or(apatch::scheme::quintic_c2::LIFT),
+            ..QuinticOptions::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
     let secs = t.elapsed().as_secs_f64();
     let r = check(&c, &CheckOptions::default());
     Ok(format!(
@@ -72,7 +81,17 @@ fn inner_hull_models_are_c2() {
         let (m, _) = mesh::load(&path).unwrap();
         let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
         let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
-        let (c, stats) = build_with_stats(&hull, &QuinticOptions::default()).unwrap();
+        let (c, stats) = build_with_stats(
+            &hull,
+            &QuinticOptions {
+                lift: std::env::var("LIFT")
+                    .ok()
+                    .and_then(|x| x.parse().ok())
+                    .unwrap_or(apatch::scheme::quintic_c2::LIFT),
+                ..QuinticOptions::default()
+            },
+        )
+        .unwrap();
         // Relative residual of the solved equations: rounding of short sums.
         assert!(stats.max_residual < 1e-12, "{name}: {stats:?}");
         let r = check(&c, &CheckOptions::default());
@@ -82,16 +101,17 @@ fn inner_hull_models_are_c2() {
             r.gradient_jump
         );
         assert!(r.hessian_jump.worst <= 1e-7, "{name}: {:?}", r.hessian_jump);
-        // Known limitation: on l_prism, corner_poly and the torus a few patches (2, 2 and 48)
-        // are crossed twice along some j-lines (free weights chosen by closeness to the Taylor
-        // targets, not yet by Theorem 2.1); every other measure must pass.
+        // Known limitation: on l_prism and corner_poly 2 patches each (at the relaxed, coplanar
+        // stars) are crossed twice along some j-lines (free weights chosen by closeness to the
+        // lifted Taylor targets, not by Theorem 2.1's sign conditions); every other measure
+        // must pass, and everything on the other models.
         let f: Vec<&str> = r
             .failures()
             .into_iter()
             .filter(|f| *f != "multiple sheets along j-lines")
             .collect();
         assert!(f.is_empty(), "{name}: {f:?}");
-        if name.contains("hedron") {
+        if !name.contains("prism") && !name.contains("corner") {
             assert!(r.passed(), "{name}: {:?}", r.failures());
         }
     }

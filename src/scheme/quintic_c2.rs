@@ -27,13 +27,22 @@ pub struct QuinticOptions {
     /// normals of T's neighbouring points (curvature continuous and close to the normals'),
     /// 0 = zero Hessian (flatter patches).
     pub curvature: f64,
+    /// Lift of the free weights toward the vertices off T (apexes, edge midpoints), in units of
+    /// their height above T: 0 = the plain blend of the Taylor polynomials.
+    pub lift: f64,
 }
 
 impl Default for QuinticOptions {
     fn default() -> Self {
-        QuinticOptions { curvature: 1.0 }
+        QuinticOptions {
+            curvature: 1.0,
+            lift: LIFT,
+        }
     }
 }
+
+/// Default [`QuinticOptions::lift`].
+pub const LIFT: f64 = 3.0;
 
 impl QuinticOptions {
     /// Reads the `[scheme]` table: `type`, the optional `curvature` (a number ≥ 0) and the inner
@@ -47,6 +56,16 @@ impl QuinticOptions {
             match k.as_str() {
                 "type" => {}
                 k if crate::hull::inner::InnerOptions::KEYS.contains(&k) => {}
+                "lift" => {
+                    let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+                    match x {
+                        Some(x) if x.is_finite() && x >= 0.0 => o.lift = x,
+                        _ => bail!(
+                            "{}: `scheme.lift` must be a number ≥ 0, got {v}",
+                            scene.display()
+                        ),
+                    }
+                }
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
                     match x {
@@ -58,7 +77,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }
@@ -93,7 +112,7 @@ pub fn build_with_stats(
     let jets = jets::estimate(hull, options.curvature);
     let (tets, _pos) = system::tetrahedra(hull)?;
     let sys = system::assemble(&tets, np)?;
-    let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np);
+    let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
     let (value, stats) = sys.solve(&tets, &jets, nt, &target)?;
     let mut complex = PatchComplex::new("quintic-c2");
     complex.continuity = Some(2);
@@ -125,7 +144,7 @@ pub fn build_with_stats(
 /// The target of the weight at multi-index `l` of `tet`: the blend of the Taylor polynomials
 /// of the tetrahedron's points of T, each weighted by its multiplicity + ½, evaluated as the
 /// degree-5 blossom at the weight's domain point.
-fn target_weight(tet: &system::HullTet, l: [u8; 4], jets: &[jets::Jet], np: u32) -> f64 {
+fn target_weight(tet: &system::HullTet, l: [u8; 4], jets: &[jets::Jet], np: u32, lift: f64) -> f64 {
     let mut args = [DVec3::ZERO; 5];
     let mut c = 0;
     for (i, &m) in l.iter().enumerate() {
@@ -143,7 +162,25 @@ fn target_weight(tet: &system::HullTet, l: [u8; 4], jets: &[jets::Jet], np: u32)
             wsum += w;
         }
     }
-    sum / wsum
+    let blend = sum / wsum;
+    if lift == 0.0 {
+        return blend;
+    }
+    // Lift: the weights toward the tetrahedron's vertices off T move further to the side they
+    // lie on (height above T along the mean normal, quadratic in the share of the domain
+    // point off T), which keeps lines toward the apex and the midpoint from turning back.
+    let hull_k: Vec<usize> = (0..4).filter(|&k| tet.gid[k] < np).collect();
+    let c = hull_k.iter().map(|&k| tet.pts[k]).sum::<DVec3>() / hull_k.len() as f64;
+    let n = hull_k
+        .iter()
+        .map(|&k| jets[tet.gid[k] as usize].g)
+        .sum::<DVec3>()
+        .normalize_or_zero();
+    let extra: f64 = (0..4)
+        .filter(|&k| tet.gid[k] >= np)
+        .map(|k| (f64::from(l[k]) / 5.0).powi(2) * n.dot(tet.pts[k] - c))
+        .sum();
+    blend + lift * extra
 }
 
 fn validate(hull: &SimplicialHull) -> Result<()> {
