@@ -309,3 +309,24 @@ fn scene_with_scheme_is_built_and_checked() {
     assert!(v["faces"]["shared"].as_u64().unwrap() > 0);
     assert!(v["interpolation"]["value"]["samples"].as_u64().unwrap() > 0);
 }
+
+/// A 1994-scheme scene: `check --json` reports the inner hull's validity (Def. 3.6 and
+/// Lemmas 4.1–4.3 via `hull::inner::verify`) and the surface's distance to the polyhedron, which
+/// for a corner-cutting surface is positive and below the size of the model.
+#[test]
+fn inner_hull_scene_reports_hull_and_distance() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper1994/octahedron.toml");
+    let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["hull"]["valid"], true, "{v}");
+    assert_eq!(v["passed"], true);
+    let max = v["distance"]["max"].as_f64().unwrap();
+    assert!(max > 0.0 && max < 0.5, "{max}");
+    let o = apatch(&["check", scene.to_str().unwrap()]);
+    assert!(
+        stdout(&o).contains("hull             valid"),
+        "{}",
+        stdout(&o)
+    );
+}

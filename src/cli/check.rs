@@ -113,6 +113,46 @@ fn polyhedron_distance(
     )))
 }
 
+/// For a scene of a 1994 scheme, the inner simplicial hull it was built on, checked against
+/// Definition 3.6 and Lemmas 4.1–4.3 (`hull::inner::verify`): the violations, empty when valid.
+fn hull_violations(
+    input: &Path,
+    complex: &PatchComplex,
+) -> anyhow::Result<Option<Vec<apatch::hull::inner::HullViolation>>> {
+    if !input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+        || !matches!(complex.scheme.as_str(), "cubic-c1" | "quintic-c2")
+    {
+        return Ok(None);
+    }
+    let scene = apatch::scene::load(input)?;
+    let apatch::scene::Model::Mesh {
+        file,
+        normals,
+        scheme,
+    } = &scene.model
+    else {
+        return Ok(None);
+    };
+    let method: apatch::mesh::NormalMethod = normals
+        .parse()
+        .map_err(|e: String| anyhow::anyhow!("{}: `model.normals`: {e}", input.display()))?;
+    let (m, _) = apatch::mesh::load(file)?;
+    let vn = apatch::mesh::vertex_normals(&m, method)?;
+    let options = apatch::hull::inner::InnerOptions::from_toml(scheme, input)?;
+    let hull = apatch::hull::inner::build(&m, &vn, &options)?;
+    Ok(Some(apatch::hull::inner::verify(&hull)))
+}
+
+/// One line per hull violation: the condition, the triangle of T, the detail.
+fn violation_line(v: &apatch::hull::inner::HullViolation) -> String {
+    match v.triangle {
+        Some(t) => format!("{:?} at hull triangle {t}: {}", v.kind, v.message),
+        None => format!("{:?}: {}", v.kind, v.message),
+    }
+}
+
 /// Runs `apatch check`.
 pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     let complex = load_complex(&args.input)?;
@@ -128,16 +168,26 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     };
     let report = check::check(&complex, &opts);
     let distance = polyhedron_distance(&args.input, &complex)?;
+    let hull = hull_violations(&args.input, &complex)?;
+    let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);
+    let passed = report.passed() && hull_valid;
     if args.json {
         // The verdict first, then every measure.
         let mut out = serde_json::Map::new();
-        out.insert("passed".into(), report.passed().into());
+        out.insert("passed".into(), passed.into());
         out.insert("failures".into(), report.failures().into());
         if let serde_json::Value::Object(fields) = serde_json::to_value(&report)? {
             out.extend(fields);
         }
         if let Some(d) = &distance {
             out.insert("distance".into(), serde_json::to_value(d)?);
+        }
+        if let Some(v) = &hull {
+            let list: Vec<String> = v.iter().map(violation_line).collect();
+            out.insert(
+                "hull".into(),
+                serde_json::json!({ "valid": v.is_empty(), "violations": list }),
+            );
         }
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
@@ -149,8 +199,25 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 d.max, d.mean, d.diagonal, d.samples
             );
         }
+        if let Some(v) = &hull {
+            if v.is_empty() {
+                println!(
+                    "hull             valid: Def. 3.6 / Lemmas 4.1-4.3 hold (edge-convex T, \
+                     tangent-containing and non-intersecting face tetrahedra)  ok"
+                );
+            } else {
+                println!(
+                    "hull             {} violations of Def. 3.6 / Lemmas 4.1-4.3  FAIL",
+                    v.len()
+                );
+                for x in v.iter().take(10) {
+                    println!("  {}", violation_line(x));
+                }
+                println!("FAILED: the simplicial hull is not smoothable");
+            }
+        }
     }
-    Ok(if report.passed() {
+    Ok(if passed {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
