@@ -228,33 +228,7 @@ pub fn build_from_scene(
     scene: &Path,
 ) -> anyhow::Result<PatchComplex> {
     let opts = QuinticOptions::from_toml(scheme, scene)?;
-    let hull = match crate::hull::inner::build(
-        mesh,
-        normals,
-        &crate::hull::inner::InnerOptions::default(),
-    ) {
-        Ok(h) => h,
-        Err(e) => {
-            if trihedral(mesh) {
-                crate::fixtures::trihedral_hull(mesh)
-            } else {
-                return Err(e.into());
-            }
-        }
-    };
+    let inner = crate::hull::inner::InnerOptions::from_toml(scheme, scene)?;
+    let hull = crate::hull::inner::build(mesh, normals, &inner)?;
     Ok(build(&hull, &opts)?)
-}
-
-/// Every vertex of `mesh` lies on exactly three faces and every face is non-degenerate.
-fn trihedral(mesh: &Mesh) -> bool {
-    let mut count = vec![0usize; mesh.positions.len()];
-    for f in &mesh.faces {
-        if f.len() < 3 {
-            return false;
-        }
-        for &v in f {
-            count[v as usize] += 1;
-        }
-    }
-    count.iter().all(|&c| c == 3)
 }
