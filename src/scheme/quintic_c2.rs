@@ -216,8 +216,8 @@ fn validate(hull: &SimplicialHull) -> Result<()> {
 /// the scene's `[scheme]` table (its keys are this scheme's options), `scene` the scene file
 /// named in errors.
 ///
-/// The hull is `hull::inner::build`; while that is unavailable, convex polyhedra whose vertices
-/// are all trihedral use the step-(3) hull of Algorithm 1 ([`crate::fixtures::trihedral_hull`]).
+/// The hull is `hull::inner::build` with the inner-hull keys of the same table
+/// ([`crate::hull::inner::InnerOptions::from_toml`]), as for `cubic-c1`.
 ///
 /// # Errors
 /// Unknown or bad options, and meshes the scheme cannot build, naming the file and element.
