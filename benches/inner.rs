@@ -43,8 +43,16 @@ fn bench(c: &mut Criterion) {
         b.iter(|| inner::build(black_box(&m), black_box(&normals), &opts).unwrap())
     });
     let hull = inner::build(&m, &normals, &opts).unwrap();
+    let violations = inner::verify(&hull);
+    eprintln!(
+        "{} faces, {} hull triangles, {} violations; first: {:?}",
+        m.faces.len(),
+        hull.triangles.len(),
+        violations.len(),
+        violations.first()
+    );
     g.bench_function("verify", |b| {
-        b.iter(|| assert!(inner::verify(black_box(&hull)).is_empty()))
+        b.iter(|| inner::verify(black_box(&hull)).len())
     });
     g.finish();
 }

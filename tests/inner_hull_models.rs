@@ -1,5 +1,6 @@
-//! The inner hull (1994) on every model in `scenes/models/`: builds (or gives a clear error) and
-//! `verify` accepts it.
+//! The inner hull (1994) on the polygon and real models of `scenes/models/`: what holds today
+//! (builds, closed T of the right genus, corner guards), and an ignored survey printing every
+//! model's `verify` result (`cargo test --test inner_hull_models -- --ignored --nocapture`).
 
 use apatch::hull::inner::{self, verify::euler_characteristic, InnerOptions};
 use apatch::mesh::{self, NormalMethod};
@@ -35,7 +36,7 @@ fn run(name: &str) -> Result<(usize, Vec<String>), String> {
 }
 
 #[test]
-#[ignore = "exploration"]
+#[ignore = "survey for humans: prints violations per model, asserts nothing"]
 fn explore_all() {
     for e in std::fs::read_dir("scenes/models").unwrap() {
         let name = e.unwrap().file_name().into_string().unwrap();
@@ -64,33 +65,97 @@ fn explore_all() {
     }
 }
 
+/// Non-convex polygon models (Algorithm 2 via convex pieces) and the real models: each builds, its
+/// T is a closed oriented manifold of the input's genus, the non-convex polygons are split into
+/// corner guards lying in their polygons' planes, and every corner guard net edge is zero convex.
+/// (Overlaps between tetrahedra are still reported on these: see ARCHITECTURE.md.)
 #[test]
-#[ignore = "exploration"]
-fn debug_one() {
-    let name = std::env::var("MODEL").unwrap();
-    let tri: usize = std::env::var("TRI").unwrap().parse().unwrap();
-    let path = Path::new("scenes/models").join(&name);
-    let (m, _) = mesh::load(&path).unwrap();
-    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
-    let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
-    let t = hull.triangles[tri];
-    let e = hull.element[tri] as usize;
-    eprintln!("vertex {e} at {} n {}", m.positions[e], normals[e]);
-    for &i in &t {
-        eprintln!(
-            "  point {i} {:?} at {} n {}",
-            hull.origins[i as usize], hull.points[i as usize], hull.normals[i as usize]
-        );
-    }
-    eprintln!("  apexes {:?}", hull.apexes[tri]);
-    for &i in &t {
-        let (p, n) = (hull.points[i as usize], hull.normals[i as usize]);
-        let others: Vec<f64> = t
-            .iter()
-            .map(|&j| hull.points[j as usize])
-            .chain(hull.apexes[tri].iter().flatten().copied())
-            .map(|x| n.dot(x - p))
+fn nonconvex_and_real_models_give_closed_hulls() {
+    use apatch::hull::inner::ViolationKind::*;
+    use apatch::hull::simplicial::PointOrigin;
+    for (name, nonconvex) in [
+        ("l_prism.obj", true),
+        ("hallway_corner.obj", false),
+        ("star_prism.obj", true),
+        ("corner_poly.obj", true),
+        ("letter_P_poly.obj", false),
+        ("double_torus_poly.obj", true),
+        ("mpi_poly.obj", true),
+        ("spot.obj", false),
+        ("bunny_npm_lowres.obj", false),
+        ("fandisk.obj", false),
+    ] {
+        let path = Path::new("scenes/models").join(name);
+        let (m, _) = mesh::load(&path).unwrap();
+        let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+        let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(!rep.split_faces.is_empty(), nonconvex, "{name}");
+        let topo = mesh::Topology::new(m.positions.len(), &m.faces);
+        let chi = m.positions.len() as i64 - topo.edges.len() as i64 + m.faces.len() as i64;
+        assert_eq!(euler_characteristic(&hull), Some(chi), "{name}: genus");
+        // Closed and consistently oriented: every edge of T in two triangles, running opposite
+        // ways (checked directly; `verify` with its overlap search is too slow for the big
+        // triangle models in a test).
+        for e in hull.edges().unwrap() {
+            assert_ne!(e.faces[1], u32::MAX, "{name}: boundary");
+            let t1 = hull.triangles[e.faces[1] as usize];
+            assert!(
+                (0..3).any(|k| t1[k] == e.v[1] && t1[(k + 1) % 3] == e.v[0]),
+                "{name}: orientation"
+            );
+        }
+        if hull.triangles.len() > 1000 {
+            continue;
+        }
+        let bad: Vec<_> = inner::verify(&hull)
+            .into_iter()
+            .filter(|v| matches!(v.kind, Malformed | NotManifold | Orientation | WrongSide))
             .collect();
-        eprintln!("  at {i}: {others:?}");
+        assert!(bad.is_empty(), "{name}: {:?}", &bad[..bad.len().min(3)]);
+        for (i, o) in hull.origins.iter().enumerate() {
+            if let PointOrigin::CornerGuard { face } = *o {
+                let f = &m.faces[face as usize];
+                let n = mesh::geometry::area_vector(&m.positions, f).normalize();
+                let c = f
+                    .iter()
+                    .map(|&v| m.positions[v as usize])
+                    .sum::<glam::DVec3>()
+                    / f.len() as f64;
+                // In the plane up to rounding of unit-size coordinates.
+                assert!(n.dot(hull.points[i] - c).abs() < 1e-12, "{name}: guard {i}");
+            }
+        }
+        let edges = hull.edges().unwrap();
+        for e in edges {
+            let [a, b] = e.v.map(|x| x as usize);
+            if let (PointOrigin::CornerGuard { face: fa }, PointOrigin::CornerGuard { face: fb }) =
+                (hull.origins[a], hull.origins[b])
+            {
+                if fa == fb {
+                    let d = hull.points[b] - hull.points[a];
+                    // Zero convex: both normals are the polygon's, the edge lies in its plane.
+                    assert!(
+                        hull.normals[a].dot(d).abs() < 1e-12 * (1.0 + d.length()),
+                        "{name}"
+                    );
+                }
+            }
+        }
     }
+}
+
+/// Models the hull cannot take give one clear error: the spot control cage has a vertex whose
+/// faces wrap round more than a hemisphere (Appendix C re-meshing would be needed).
+#[test]
+fn spot_control_cage_needs_appendix_c() {
+    let (m, _) = mesh::load(Path::new("scenes/models/spot_control_cage.obj")).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let e = inner::build(&m, &normals, &InnerOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("vertex") && e.contains("line") && e.contains("Appendix C"),
+        "{e}"
+    );
 }

@@ -125,14 +125,16 @@ pub fn build_corner(
         let mut slot = [None, None];
         // Lemma 4.3: the plane Π through C_1, C_2 and M separates this vertex's tetrahedron
         // from the one built at V' over the same edge C_1C_2, if every apex lies on V's side
-        // at least as far as the point 0.45e (T_0 does by construction). T_1 is moved there
-        // within π, keeping tangency at C_0.
+        // at least as far as the point 0.45e (T_0 does by construction). Apexes are moved
+        // there along −e.
         let mut pi_n = (c1 - m).cross(c2 - m).normalize_or_zero();
         if pi_n.dot(c.v - m) < 0.0 {
             pi_n = -pi_n;
         }
         let g_min = pi_n.dot(c.v + 0.45 * d - m);
-        let along = (n * n.dot(d) - d).normalize_or_zero();
+        // Along −e: keeps the distances to both face planes (e lies in them), so tangency at
+        // C_1 and C_2 is unchanged.
+        let along = -d.normalize_or_zero();
         let keep_side = |q: DVec3| -> DVec3 {
             let gq = pi_n.dot(q - m);
             let rate = pi_n.dot(along);
@@ -152,9 +154,15 @@ pub fn build_corner(
             let mm = (c1 - c0).cross(c2 - c0);
             let want = if s <= 0.0 { 1.0 } else { -1.0 };
             let margin = 0.05 * d.length() * mm.length();
-            // Moves q parallel to π (so its height over C_0's tangent plane, and with it the
-            // tangency at C_0, is kept) until it is on the corner's side of the triangle.
-            let w = (want * mm - want * mm.dot(up) * up).normalize_or_zero();
+            // Moves q until it is on the corner's side of the triangle: along `up` when that
+            // gets there (n_V is above every face, so q rises over C_0's tangent plane and both
+            // face planes and stays tangent-containing), else parallel to π (keeping the
+            // tangency at C_0).
+            let w = if want * mm.dot(up) > 0.2 * mm.length() {
+                up
+            } else {
+                (want * mm - want * mm.dot(up) * up).normalize_or_zero()
+            };
             let rate = want * mm.dot(w);
             let to_corner_side = |q: DVec3| -> DVec3 {
                 let o = orient(c0, c1, c2, q) * want;
