@@ -676,15 +676,24 @@ impl CompiledPatch<'_> {
             }
             let mut left = [0.0; MAX_DEGREE + 1];
             product(out, deg, &den, dden, &mut left);
-            let mut right = [0.0; MAX_DEGREE + 1];
-            product(&sum, dsum, &q, qdeg, &mut right);
             let mut dl = deg + dden;
-            add_poly(&mut left, &mut dl, &right, dsum + qdeg);
+            if qdeg == 0 {
+                // Π of no denominators is 1 (the only group of a face or edge patch).
+                add_poly(&mut left, &mut dl, &sum, dsum);
+            } else {
+                let mut right = [0.0; MAX_DEGREE + 1];
+                product(&sum, dsum, &q, qdeg, &mut right);
+                add_poly(&mut left, &mut dl, &right, dsum + qdeg);
+            }
             *out = left;
             deg = dl;
-            let mut nq = [0.0; MAX_DEGREE + 1];
-            product(&q, qdeg, &den, dden, &mut nq);
-            q = nq;
+            if qdeg == 0 {
+                q = den;
+            } else {
+                let mut nq = [0.0; MAX_DEGREE + 1];
+                product(&q, qdeg, &den, dden, &mut nq);
+                q = nq;
+            }
             qdeg += dden;
         }
         deg
