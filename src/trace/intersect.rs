@@ -9,7 +9,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::bvh::{Bounds, Bvh};
-use super::patch::{CompiledPatch, Sheet, MAX_DEGREE};
+use super::patch::{CompiledPatch, PatchStore, Sheet, MAX_DEGREE};
 use crate::bb::uni;
 use crate::complex::{PatchComplex, Role};
 use glam::DVec3;
@@ -28,7 +28,7 @@ pub struct Hit {
 /// A patch complex compiled for ray queries: compiled patches and a BVH over their tetrahedra.
 pub struct Geometry {
     /// The compiled patches, in the complex's order.
-    pub patches: Vec<CompiledPatch>,
+    pub patches: PatchStore,
     /// Hull role per patch (for patch shading).
     pub roles: Vec<Role>,
     /// Mesh element per patch.
@@ -53,10 +53,10 @@ impl Geometry {
     /// # Errors
     /// A message naming the first patch that cannot be compiled.
     pub fn new(complex: &PatchComplex) -> Result<Self, String> {
-        let mut patches = Vec::with_capacity(complex.patches.len());
+        let mut patches = PatchStore::with_capacity(complex.patches.len());
         let mut boxes = Vec::with_capacity(complex.patches.len());
         for (i, p) in complex.patches.iter().enumerate() {
-            patches.push(CompiledPatch::new(p, i)?);
+            patches.push(p, i)?;
             let v = p.tet_points();
             let min = v[0].min(v[1]).min(v[2]).min(v[3]);
             let max = v[0].max(v[1]).max(v[2]).max(v[3]);
@@ -101,10 +101,7 @@ impl Geometry {
     /// Bytes used by compiled patches and the BVH.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
-        self.patches
-            .iter()
-            .map(CompiledPatch::memory_bytes)
-            .sum::<usize>()
+        self.patches.memory_bytes()
             + self.roles.len() * std::mem::size_of::<Role>()
             + self.elements.len() * 4
             + self.bvh.memory_bytes()
@@ -156,8 +153,8 @@ impl Geometry {
         tmin: f64,
         tmax: f64,
     ) -> Option<(f64, [f64; 4])> {
-        let p = &self.patches[i];
-        if p.no_zero {
+        let p = self.patches.get(i);
+        if p.no_zero() {
             return None;
         }
         let (t0, t1, a0, rate) = p.clip(o, d)?;
@@ -182,12 +179,12 @@ impl Geometry {
         let s_hi = ((hi_t - t0) / len).min(1.0);
         let mut s_lo = ((lo_t - t0) / len).max(0.0);
         for _ in 0..16 {
-            let s = uni::first_root_in_tol(&c[..=n], s_lo, s_hi, p.zero_tol)?;
+            let s = uni::first_root_in_tol(&c[..=n], s_lo, s_hi, p.zero_tol())?;
             let mut alpha = [0.0; 4];
             for k in 0..4 {
                 alpha[k] = (1.0 - s) * a[k] + s * b[k];
             }
-            if Self::sheet_accepts(p, &alpha) {
+            if Self::sheet_accepts(&p, &alpha) {
                 return Some((t0 + s * len, alpha));
             }
             // Continue just after the rejected root.
@@ -201,8 +198,8 @@ impl Geometry {
 
     /// The sheet rule of `p` at the root with barycentrics `alpha`: true when the root is on
     /// the surface.
-    pub fn sheet_accepts(p: &CompiledPatch, alpha: &[f64; 4]) -> bool {
-        let Sheet::Shooting { base, top } = p.sheet else {
+    pub fn sheet_accepts(p: &CompiledPatch<'_>, alpha: &[f64; 4]) -> bool {
+        let Sheet::Shooting { base, top } = p.sheet() else {
             return true;
         };
         let mut q = [0.0; 4];
@@ -229,12 +226,12 @@ impl Geometry {
         }
         let mut c = [0.0; MAX_DEGREE + 1];
         let mut n = p.segment(&q, &u, &mut c);
-        for _ in 0..p.base_order.min(n) {
+        for _ in 0..p.base_order().min(n) {
             // G(t) = t·H(t): the base point's root of a vanishing denominator is not F's.
             n = uni::deflate_at_zero(&mut c, n + 1) - 1;
         }
         // (4.5)–(4.7): F at the base point must not have the top weight's strict sign.
-        if c[0] * p.top_weight > 0.0 {
+        if c[0] * p.top_weight() > 0.0 {
             return false;
         }
         uni::first_root_in(&c[..=n], 0.0, t - SHEET_TOL).is_none()

@@ -1,13 +1,19 @@
-//! The tracer's compiled form of one [`Patch`]: barycentric map, weights and rational terms
-//! arranged for the hot loop. Restriction of F to a segment (univariate Bernstein coefficients,
-//! rational denominators cleared) and value/gradient/Hessian at a point.
+//! The tracer's compiled form of the patches: barycentric maps, weights and rational terms
+//! packed into shared arrays for the hot loop. Restriction of F to a segment (univariate
+//! Bernstein coefficients, rational denominators cleared) and value/gradient/Hessian at a point.
+//!
+//! Memory: one [`PatchHeader`] per patch (barycentric map, tolerances, small-integer degrees
+//! and sheet masks, an offset into the shared f64 array), the patch's BB weights followed by
+//! its rational numerator weights in one shared `Vec<f64>`, and the integer structure of the
+//! rational terms (κ, monomials μ) interned once per distinct shape ([`RationalForm`]): every
+//! face patch of the 2001 scheme shares one form, every edge patch another.
 
 // Index loops over the four barycentric components read better than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
-use crate::bb::rational::{multinomial, term_jet};
+use crate::bb::rational::{monomial_jet, multinomial, MIN_DENOMINATOR};
 use crate::bb::{index_of, multi_indices, num_coeffs, poly, uni};
-use crate::complex::{Patch, RationalTerm, SheetRule};
+use crate::complex::{Patch, SheetRule};
 use glam::{DMat3, DVec3};
 
 /// Relative size of an empty ray interval [t0, t1] (t0 > t1) still treated as a touching point.
@@ -40,71 +46,123 @@ pub enum Sheet {
     },
 }
 
-/// One rational term: κ, its multinomial factor n!/κ!, and the numerator terms (w_m, μ_m).
-type KappaTerm = ([u8; 4], f64, Vec<(f64, [u8; 4])>);
+/// One rational term's integer structure: κ, its multinomial factor n!/κ!, and the numerator
+/// monomials μ_m (the weights w_m live in the shared f64 array).
+#[derive(Clone, Debug, PartialEq)]
+struct FormTerm {
+    kappa: [u8; 4],
+    mult: f64,
+    numer: Vec<[u8; 4]>,
+}
 
 /// Rational terms sharing one denominator Σ_m α^μm.
-#[derive(Clone, Debug)]
-struct RationalGroup {
+#[derive(Clone, Debug, PartialEq)]
+struct FormGroup {
     denominator: Vec<[u8; 4]>,
-    /// (κ with its multinomial factor n!/κ!, numerator terms (w_m, μ_m)).
-    terms: Vec<KappaTerm>,
+    terms: Vec<FormTerm>,
 }
 
-/// A patch compiled for tracing.
-#[derive(Clone, Debug)]
-pub struct CompiledPatch {
+/// The integer structure of a patch's rational terms, grouped by denominator; the numerator
+/// weights follow the polynomial weights in the shared array in group, term, monomial order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RationalForm {
+    groups: Vec<FormGroup>,
+}
+
+impl RationalForm {
+    /// Approximate bytes of the form.
+    fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self
+                .groups
+                .iter()
+                .map(|g| {
+                    std::mem::size_of::<FormGroup>()
+                        + g.denominator.len() * 4
+                        + g.terms
+                            .iter()
+                            .map(|t| std::mem::size_of::<FormTerm>() + t.numer.len() * 4)
+                            .sum::<usize>()
+                })
+                .sum::<usize>()
+    }
+
+    /// How many numerator weights the form reads.
+    fn numer_len(&self) -> usize {
+        self.groups
+            .iter()
+            .flat_map(|g| &g.terms)
+            .map(|t| t.numer.len())
+            .sum()
+    }
+}
+
+/// Sentinel [`PatchHeader::form`] of a polynomial patch.
+const NO_FORM: u16 = u16::MAX;
+
+/// The per-patch record: barycentric map, tolerances and small integers (120 bytes).
+#[derive(Clone, Copy, Debug)]
+pub struct PatchHeader {
     /// First tetrahedron vertex (origin of the barycentric map).
-    pub v0: DVec3,
-    /// ∇αi in world coordinates.
-    pub grad: [DVec3; 4],
-    /// Polynomial degree n.
-    pub degree: usize,
-    weights: Vec<f64>,
-    /// BB weights (degree `segment_degree`) of the cleared polynomial G = F·Π D_g when the
-    /// patch has rational terms (empty otherwise: G = F): restricting G to a segment is one
-    /// blossom chain instead of a product of univariate pieces per term.
-    cleared: Vec<f64>,
-    #[cfg(test)]
-    groups: Vec<RationalGroup>,
-    /// The rational terms as given (for derivatives at a hit).
-    rational: Vec<RationalTerm>,
-    /// The sheet rule.
-    pub sheet: Sheet,
-    /// Degree of the segment polynomial once denominators are cleared.
-    pub segment_degree: usize,
-    /// The weight at the first top vertex of a shooting rule (0 for `Any`): F at a shooting
-    /// line's base point must not have its strict sign.
-    pub top_weight: f64,
-    /// How many factors of t the cleared polynomial on a shooting line carries at its base
-    /// point (denominators that vanish on the base simplex, e.g. α3 + α4 for edge patches):
-    /// those roots at t = 0 are not zeros of F and are divided out.
-    pub base_order: usize,
-    /// True when every weight (rational blends included) has the same strict sign: by the
-    /// convex hull property F has no zero in the tetrahedron and rays skip the patch.
-    pub no_zero: bool,
+    v0: DVec3,
+    /// ∇α1, ∇α2, ∇α3 in world coordinates (∇α0 = −their sum).
+    grad: [DVec3; 3],
     /// Values of the cleared segment polynomial below this count as zero at a segment's ends:
     /// rounding of F near its zeros, from the patch's largest weight.
-    pub zero_tol: f64,
+    zero_tol: f64,
+    /// Offset of the patch's weights in the shared array.
+    offset: u32,
+    /// Index of the rational form, or [`NO_FORM`].
+    form: u16,
+    degree: u8,
+    segment_degree: u8,
+    base_order: u8,
+    /// Sheet masks (both 0 for [`Sheet::Any`]).
+    base: u8,
+    top: u8,
+    no_zero: bool,
 }
 
-#[cfg(test)]
+/// Every patch of a complex compiled for tracing, in shared arrays.
+#[derive(Clone, Debug, Default)]
+pub struct PatchStore {
+    headers: Vec<PatchHeader>,
+    data: Vec<f64>,
+    forms: Vec<RationalForm>,
+}
+
+/// A borrowed view of one compiled patch.
+#[derive(Clone, Copy, Debug)]
+pub struct CompiledPatch<'a> {
+    h: &'a PatchHeader,
+    weights: &'a [f64],
+    numer: &'a [f64],
+    form: Option<&'a RationalForm>,
+}
+
 /// Bernstein coefficients (degree |μ|) of α(s)^μ with α(s) = (1−s)a + s·b.
+#[inline]
 fn monomial_segment(mu: [u8; 4], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
     out[0] = 1.0;
     let mut len = 1;
-    let mut tmp = [0.0; MAX_DEGREE + 1];
     for i in 0..4 {
         for _ in 0..mu[i] {
-            len = uni::multiply_into(&out[..len], &[a[i], b[i]], &mut tmp);
-            out[..len].copy_from_slice(&tmp[..len]);
+            // Multiply by (1−s)a_i + s·b_i in place, from the top coefficient down.
+            let k = len;
+            out[k] = 0.0;
+            for j in (0..=k).rev() {
+                let up = if j > 0 { out[j - 1] * b[i] } else { 0.0 };
+                let stay = if j < k { out[j] * a[i] } else { 0.0 };
+                out[j] = (stay * (k - j) as f64 + up * j as f64) / k as f64;
+            }
+            len += 1;
         }
     }
     len - 1
 }
 
-#[cfg(test)]
 /// Sum into `acc` (degree `*deg`) the polynomial `p` of degree `d`, elevating as needed.
+#[inline]
 fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
     let mut q = *p;
     let mut dq = d;
@@ -119,7 +177,6 @@ fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
     }
 }
 
-#[cfg(test)]
 /// `out[..=m+n]` = the product of `p[..=m]` and `q[..=n]`.
 #[inline]
 fn product(p: &Coeffs, m: usize, q: &Coeffs, n: usize, out: &mut Coeffs) {
@@ -171,30 +228,33 @@ fn bb_monomial(mu: [u8; 4]) -> (usize, Vec<f64>) {
 }
 
 /// BB weights of the cleared polynomial G = P·Π_g D_g + Σ_g (Σ_r N_r·B_κr)·Π_{g'≠g} D_g' of a
-/// patch with polynomial part `weights` (degree `n`) and rational `groups`, following the
-/// degrees of the univariate construction (so its degree is the patch's `segment_degree`).
-fn clear_denominators(n: usize, weights: &[f64], groups: &[RationalGroup]) -> Vec<f64> {
+/// patch with polynomial part `weights` (degree `n`), rational `form` and numerator weights
+/// `numer`, following the degrees of the univariate construction (so its degree is the
+/// patch's segment degree). Used at compile time for the sign-definite test.
+fn clear_denominators(n: usize, weights: &[f64], form: &RationalForm, numer: &[f64]) -> Vec<f64> {
     let (mut deg, mut out) = (n, weights.to_vec());
     let (mut qdeg, mut q) = (0usize, vec![1.0]);
-    for g in groups {
+    let mut w = numer.iter();
+    for g in &form.groups {
         let (mut dden, mut den) = (0usize, vec![0.0]);
         for mu in &g.denominator {
             let (d, m) = bb_monomial(*mu);
             (dden, den) = bb_add(dden, den, d, m);
         }
         let (mut dsum, mut sum) = (0usize, vec![0.0]);
-        for (kappa, _, numer) in &g.terms {
+        for t in &g.terms {
             let (mut dnum, mut num) = (0usize, vec![0.0]);
-            for (w, mu) in numer {
+            for mu in &t.numer {
+                let wm = *w.next().expect("numerator weight");
                 let (d, mut m) = bb_monomial(*mu);
                 for x in &mut m {
-                    *x *= w;
+                    *x *= wm;
                 }
                 (dnum, num) = bb_add(dnum, num, d, m);
             }
             // B^n_κ: weight 1 at κ.
             let mut bern = vec![0.0; num_coeffs(n)];
-            bern[index_of(*kappa)] = 1.0;
+            bern[index_of(t.kappa)] = 1.0;
             let prod = bb_product(dnum, &num, n, &bern);
             (dsum, sum) = bb_add(dsum, sum, dnum + n, prod);
         }
@@ -207,13 +267,65 @@ fn clear_denominators(n: usize, weights: &[f64], groups: &[RationalGroup]) -> Ve
     out
 }
 
-impl CompiledPatch {
-    /// Compiles `patch`; `index` names it in errors.
+impl PatchStore {
+    /// An empty store with room for `n` patches.
+    #[must_use]
+    pub fn with_capacity(n: usize) -> Self {
+        PatchStore {
+            headers: Vec::with_capacity(n),
+            data: Vec::with_capacity(n * 20),
+            forms: Vec::new(),
+        }
+    }
+
+    /// Number of patches.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.headers.len()
+    }
+
+    /// True when the store holds no patch.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.headers.is_empty()
+    }
+
+    /// The compiled patch `i`.
+    #[must_use]
+    #[inline]
+    pub fn get(&self, i: usize) -> CompiledPatch<'_> {
+        let h = &self.headers[i];
+        let start = h.offset as usize;
+        let nw = num_coeffs(usize::from(h.degree));
+        let form = self.forms.get(usize::from(h.form));
+        let nn = form.map_or(0, RationalForm::numer_len);
+        CompiledPatch {
+            h,
+            weights: &self.data[start..start + nw],
+            numer: &self.data[start + nw..start + nw + nn],
+            form,
+        }
+    }
+
+    /// Bytes of the headers, the shared weights and the forms.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        self.headers.len() * std::mem::size_of::<PatchHeader>()
+            + self.data.len() * 8
+            + self
+                .forms
+                .iter()
+                .map(RationalForm::memory_bytes)
+                .sum::<usize>()
+    }
+
+    /// Compiles `patch` and appends it; `index` names it in errors.
     ///
     /// # Errors
-    /// A degenerate tetrahedron, a degree outside 1..=7, a wrong weight count, or rational terms
-    /// whose cleared segment degree exceeds [`MAX_DEGREE`].
-    pub fn new(patch: &Patch, index: usize) -> Result<Self, String> {
+    /// A degenerate tetrahedron, a degree outside 1..=7, a wrong weight count, rational terms
+    /// whose cleared segment degree exceeds [`MAX_DEGREE`], or more than 65535 distinct
+    /// rational forms.
+    pub fn push(&mut self, patch: &Patch, index: usize) -> Result<(), String> {
         let n = usize::from(patch.degree);
         if !(1..=MAX_PATCH_DEGREE).contains(&n) {
             return Err(format!("patch {index}: degree {n} is outside 1..=7"));
@@ -239,12 +351,10 @@ impl CompiledPatch {
             return Err(format!("patch {index}: degenerate tetrahedron"));
         }
         let inv = m.inverse().transpose();
-        let g1 = inv.x_axis;
-        let g2 = inv.y_axis;
-        let g3 = inv.z_axis;
-        let grad = [-(g1 + g2 + g3), g1, g2, g3];
+        let grad = [inv.x_axis, inv.y_axis, inv.z_axis];
 
-        let mut groups: Vec<RationalGroup> = Vec::new();
+        let mut groups: Vec<FormGroup> = Vec::new();
+        let mut group_weights: Vec<Vec<Vec<f64>>> = Vec::new();
         for (r, term) in patch.rational.iter().enumerate() {
             let kdeg: u8 = term.index.iter().sum();
             if usize::from(kdeg) != n {
@@ -257,13 +367,24 @@ impl CompiledPatch {
             }
             let mut denom: Vec<[u8; 4]> = term.terms.iter().map(|t| t.1).collect();
             denom.sort_unstable();
-            let kappa = (term.index, multinomial(term.index), term.terms.clone());
-            match groups.iter_mut().find(|g| g.denominator == denom) {
-                Some(g) => g.terms.push(kappa),
-                None => groups.push(RationalGroup {
-                    denominator: denom,
-                    terms: vec![kappa],
-                }),
+            let ft = FormTerm {
+                kappa: term.index,
+                mult: multinomial(term.index),
+                numer: term.terms.iter().map(|t| t.1).collect(),
+            };
+            let ws: Vec<f64> = term.terms.iter().map(|t| t.0).collect();
+            match groups.iter().position(|g| g.denominator == denom) {
+                Some(k) => {
+                    groups[k].terms.push(ft);
+                    group_weights[k].push(ws);
+                }
+                None => {
+                    groups.push(FormGroup {
+                        denominator: denom,
+                        terms: vec![ft],
+                    });
+                    group_weights.push(vec![ws]);
+                }
             }
         }
         let mu_deg = |l: &[u8; 4]| l.iter().map(|&x| usize::from(x)).sum::<usize>();
@@ -275,7 +396,7 @@ impl CompiledPatch {
             let dsum = g
                 .terms
                 .iter()
-                .map(|t| t.2.iter().map(|m| mu_deg(&m.1)).max().unwrap_or(0) + n)
+                .map(|t| t.numer.iter().map(mu_deg).max().unwrap_or(0) + n)
                 .max()
                 .unwrap_or(0);
             segment_degree = (segment_degree + dden).max(dsum + qdeg);
@@ -286,8 +407,8 @@ impl CompiledPatch {
                 "patch {index}: rational terms raise the segment degree to {segment_degree} (> {MAX_DEGREE})"
             ));
         }
-        let sheet = match &patch.sheet {
-            SheetRule::Any => Sheet::Any,
+        let (base, top) = match &patch.sheet {
+            SheetRule::Any => (0, 0),
             SheetRule::Shooting { base, top } => {
                 let mask = |s: &[u8]| -> Result<u8, String> {
                     let mut m = 0u8;
@@ -305,21 +426,13 @@ impl CompiledPatch {
                         "patch {index}: sheet base and top must be disjoint and non-empty"
                     ));
                 }
-                Sheet::Shooting { base: b, top: t }
+                (b, t)
             }
         };
-        let top_weight = match sheet {
-            Sheet::Any => 0.0,
-            Sheet::Shooting { top, .. } => {
-                let k = top.trailing_zeros() as usize;
-                let mut l = [0u8; 4];
-                l[k] = n as u8;
-                patch.weights[index_of(l)]
-            }
-        };
-        let base_order = match sheet {
-            Sheet::Any => 0,
-            Sheet::Shooting { top, .. } => groups
+        let base_order: usize = if top == 0 {
+            0
+        } else {
+            groups
                 .iter()
                 .map(|g| {
                     g.denominator
@@ -333,7 +446,7 @@ impl CompiledPatch {
                         .min()
                         .unwrap_or(0)
                 })
-                .sum(),
+                .sum()
         };
         let all = patch.weights.iter().copied().chain(
             patch
@@ -344,10 +457,12 @@ impl CompiledPatch {
         let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), w| {
             (l.min(w), h.max(w))
         });
-        let cleared = if groups.is_empty() {
+        let numer: Vec<f64> = group_weights.into_iter().flatten().flatten().collect();
+        let form = RationalForm { groups };
+        let cleared = if form.groups.is_empty() {
             Vec::new()
         } else {
-            clear_denominators(n, &patch.weights, &groups)
+            clear_denominators(n, &patch.weights, &form, &numer)
         };
         debug_assert!(cleared.is_empty() || cleared.len() == num_coeffs(segment_degree));
         // G = F·Π D_g with D_g ≥ 0 in the tetrahedron: weights of G of one strict sign also
@@ -356,32 +471,120 @@ impl CompiledPatch {
             |w: &[f64]| !w.is_empty() && (w.iter().all(|&x| x > 0.0) || w.iter().all(|&x| x < 0.0));
         let no_zero = lo > 0.0 || hi < 0.0 || g_sign(&cleared);
         let zero_tol = 64.0 * f64::EPSILON * lo.abs().max(hi.abs()) * segment_degree as f64;
-        Ok(CompiledPatch {
-            zero_tol,
-            no_zero,
-            base_order,
-            top_weight,
+        let form_id = if form.groups.is_empty() {
+            NO_FORM
+        } else if let Some(k) = self.forms.iter().position(|f| *f == form) {
+            k as u16
+        } else {
+            if self.forms.len() >= usize::from(NO_FORM) {
+                return Err(format!("patch {index}: too many distinct rational forms"));
+            }
+            self.forms.push(form);
+            (self.forms.len() - 1) as u16
+        };
+        let offset = u32::try_from(self.data.len())
+            .map_err(|_| format!("patch {index}: more weights than the tracer can address"))?;
+        self.data.extend_from_slice(&patch.weights);
+        self.data.extend_from_slice(&numer);
+        self.headers.push(PatchHeader {
             v0: v[0],
             grad,
-            degree: n,
-            weights: patch.weights.clone(),
-            cleared,
-            #[cfg(test)]
-            groups,
-            rational: patch.rational.clone(),
-            sheet,
-            segment_degree,
-        })
+            zero_tol,
+            offset,
+            form: form_id,
+            degree: n as u8,
+            segment_degree: segment_degree as u8,
+            base_order: base_order.min(255) as u8,
+            base,
+            top,
+            no_zero,
+        });
+        Ok(())
+    }
+}
+
+impl CompiledPatch<'_> {
+    /// Polynomial degree n.
+    #[must_use]
+    #[inline]
+    pub fn degree(&self) -> usize {
+        usize::from(self.h.degree)
+    }
+
+    /// Degree of the segment polynomial once denominators are cleared.
+    #[must_use]
+    #[inline]
+    pub fn segment_degree(&self) -> usize {
+        usize::from(self.h.segment_degree)
+    }
+
+    /// True when every weight (rational blends included) has the same strict sign: by the
+    /// convex hull property F has no zero in the tetrahedron and rays skip the patch.
+    #[must_use]
+    #[inline]
+    pub fn no_zero(&self) -> bool {
+        self.h.no_zero
+    }
+
+    /// Values of the cleared segment polynomial below this count as zero at a segment's ends.
+    #[must_use]
+    #[inline]
+    pub fn zero_tol(&self) -> f64 {
+        self.h.zero_tol
+    }
+
+    /// How many factors of t the cleared polynomial on a shooting line carries at its base
+    /// point (denominators that vanish on the base simplex, e.g. α3 + α4 for edge patches):
+    /// those roots at t = 0 are not zeros of F and are divided out.
+    #[must_use]
+    #[inline]
+    pub fn base_order(&self) -> usize {
+        usize::from(self.h.base_order)
+    }
+
+    /// The sheet rule.
+    #[must_use]
+    #[inline]
+    pub fn sheet(&self) -> Sheet {
+        if self.h.top == 0 {
+            Sheet::Any
+        } else {
+            Sheet::Shooting {
+                base: self.h.base,
+                top: self.h.top,
+            }
+        }
+    }
+
+    /// The weight at the first top vertex of a shooting rule (0 for `Any`): F at a shooting
+    /// line's base point must not have its strict sign.
+    #[must_use]
+    pub fn top_weight(&self) -> f64 {
+        if self.h.top == 0 {
+            return 0.0;
+        }
+        let k = self.h.top.trailing_zeros() as usize;
+        let mut l = [0u8; 4];
+        l[k] = self.h.degree;
+        self.weights[index_of(l)]
+    }
+
+    /// ∇αi in world coordinates.
+    #[must_use]
+    #[inline]
+    pub fn grad(&self) -> [DVec3; 4] {
+        let [g1, g2, g3] = self.h.grad;
+        [-(g1 + g2 + g3), g1, g2, g3]
     }
 
     /// Barycentric coordinates of `x`.
     #[must_use]
     #[inline]
     pub fn bary(&self, x: DVec3) -> [f64; 4] {
-        let d = x - self.v0;
-        let a1 = self.grad[1].dot(d);
-        let a2 = self.grad[2].dot(d);
-        let a3 = self.grad[3].dot(d);
+        let d = x - self.h.v0;
+        let a1 = self.h.grad[0].dot(d);
+        let a2 = self.h.grad[1].dot(d);
+        let a3 = self.h.grad[2].dot(d);
         [1.0 - a1 - a2 - a3, a1, a2, a3]
     }
 
@@ -393,10 +596,10 @@ impl CompiledPatch {
         let a = self.bary(o);
         let mut t0 = f64::NEG_INFINITY;
         let mut t1 = f64::INFINITY;
-        let mut rate = [0.0; 4];
-        for i in 0..4 {
-            rate[i] = self.grad[i].dot(d);
-        }
+        let r1 = self.h.grad[0].dot(d);
+        let r2 = self.h.grad[1].dot(d);
+        let r3 = self.h.grad[2].dot(d);
+        let rate = [-(r1 + r2 + r3), r1, r2, r3];
         // αi(t) = a_i + t·rate_i ≥ 0.
         for i in 0..4 {
             let r = rate[i];
@@ -424,22 +627,82 @@ impl CompiledPatch {
     }
 
     /// Bernstein coefficients on s ∈ [0, 1] of F((1−s)·a + s·b) (barycentric endpoints), with
-    /// rational denominators cleared (multiplied by their positive values). Returns the degree.
+    /// rational denominators cleared (multiplied by their positive values): the polynomial
+    /// part restricted by blossoms, times the restricted denominators, plus each rational
+    /// term's restricted numerator and Bernstein polynomial. Returns the degree.
     #[inline]
     pub fn segment(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
-        if self.cleared.is_empty() {
-            poly::restrict(self.degree, &self.weights, *a, *b, out);
-            self.degree
-        } else {
-            poly::restrict(self.segment_degree, &self.cleared, *a, *b, out);
-            self.segment_degree
+        let n = self.degree();
+        poly::restrict(n, self.weights, *a, *b, out);
+        let Some(form) = self.form else {
+            return n;
+        };
+        // G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group.
+        let mut w = self.numer.iter();
+        let mut deg = n;
+        let mut q = [0.0; MAX_DEGREE + 1]; // Π of the denominators so far
+        q[0] = 1.0;
+        let mut qdeg = 0;
+        for g in &form.groups {
+            let mut den = [0.0; MAX_DEGREE + 1];
+            let mut dden = 0;
+            for mu in &g.denominator {
+                let mut m = [0.0; MAX_DEGREE + 1];
+                let d = monomial_segment(*mu, a, b, &mut m);
+                add_poly(&mut den, &mut dden, &m, d);
+            }
+            let mut sum = [0.0; MAX_DEGREE + 1];
+            let mut dsum = 0;
+            for t in &g.terms {
+                let mut num = [0.0; MAX_DEGREE + 1];
+                let mut dnum = 0;
+                for mu in &t.numer {
+                    let wm = w.next().copied().unwrap_or(0.0);
+                    let mut m = [0.0; MAX_DEGREE + 1];
+                    let d = monomial_segment(*mu, a, b, &mut m);
+                    for x in &mut m[..=d] {
+                        *x *= wm;
+                    }
+                    add_poly(&mut num, &mut dnum, &m, d);
+                }
+                let mut bern = [0.0; MAX_DEGREE + 1];
+                let dk = monomial_segment(t.kappa, a, b, &mut bern);
+                for x in &mut bern[..=dk] {
+                    *x *= t.mult;
+                }
+                let mut prod = [0.0; MAX_DEGREE + 1];
+                product(&num, dnum, &bern, dk, &mut prod);
+                add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
+            }
+            let mut left = [0.0; MAX_DEGREE + 1];
+            product(out, deg, &den, dden, &mut left);
+            let mut dl = deg + dden;
+            if qdeg == 0 {
+                // Π of no denominators is 1 (the only group of a face or edge patch).
+                add_poly(&mut left, &mut dl, &sum, dsum);
+            } else {
+                let mut right = [0.0; MAX_DEGREE + 1];
+                product(&sum, dsum, &q, qdeg, &mut right);
+                add_poly(&mut left, &mut dl, &right, dsum + qdeg);
+            }
+            *out = left;
+            deg = dl;
+            if qdeg == 0 {
+                q = den;
+            } else {
+                let mut nq = [0.0; MAX_DEGREE + 1];
+                product(&q, qdeg, &den, dden, &mut nq);
+                q = nq;
+            }
+            qdeg += dden;
         }
+        deg
     }
 
     /// F, its gradient and Hessian with respect to the four barycentric variables at `alpha`.
     #[must_use]
     pub fn bary_derivatives(&self, alpha: &[f64; 4]) -> Jet {
-        let n = self.degree;
+        let n = self.degree();
         let mut jet = Jet::default();
         if n == 1 {
             for i in 0..4 {
@@ -448,7 +711,7 @@ impl CompiledPatch {
             }
         } else {
             let mut work = [0.0; MAX_COEFFS];
-            work[..self.weights.len()].copy_from_slice(&self.weights);
+            work[..self.weights.len()].copy_from_slice(self.weights);
             for level in (3..=n).rev() {
                 poly::step_in_place_fast(&mut work, level, *alpha);
             }
@@ -464,13 +727,54 @@ impl CompiledPatch {
                 jet.g[i] = nf * ci;
             }
         }
-        for term in &self.rational {
-            let (v, g, h) = term_jet(term, n, *alpha);
-            jet.v += v;
-            for i in 0..4 {
-                jet.g[i] += g[i];
-                for k in 0..4 {
-                    jet.h[i][k] += h[i][k];
+        let Some(form) = self.form else {
+            return jet;
+        };
+        let mut w = self.numer.iter();
+        for g in &form.groups {
+            // D = Σ α^μ over the group's monomials (shared by its terms).
+            let (mut d, mut gd, mut hd) = (0.0, [0.0; 4], [[0.0; 4]; 4]);
+            for mu in &g.denominator {
+                let (v, gv, hv) = monomial_jet(*mu, *alpha);
+                d += v;
+                for i in 0..4 {
+                    gd[i] += gv[i];
+                    for k in 0..4 {
+                        hd[i][k] += hv[i][k];
+                    }
+                }
+            }
+            for t in &g.terms {
+                let (mut nv, mut gn, mut hn) = (0.0, [0.0; 4], [[0.0; 4]; 4]);
+                for mu in &t.numer {
+                    let wm = w.next().copied().unwrap_or(0.0);
+                    let (v, gv, hv) = monomial_jet(*mu, *alpha);
+                    nv += wm * v;
+                    for i in 0..4 {
+                        gn[i] += wm * gv[i];
+                        for k in 0..4 {
+                            hn[i][k] += wm * hv[i][k];
+                        }
+                    }
+                }
+                if d.abs() < MIN_DENOMINATOR {
+                    // The term is 0 where its denominator vanishes (bb::rational's convention).
+                    continue;
+                }
+                let c = t.mult;
+                let (bv, gb, hb) = monomial_jet(t.kappa, *alpha);
+                let (bv, gb, hb) = (c * bv, gb.map(|x| c * x), hb.map(|r| r.map(|x| c * x)));
+                // q = N/D, ∇q = (∇N − q∇D)/D, Hq = (HN − q HD − ∇q∇Dᵀ − ∇D∇qᵀ)/D.
+                let qv = nv / d;
+                let gq: [f64; 4] = std::array::from_fn(|i| (gn[i] - qv * gd[i]) / d);
+                jet.v += qv * bv;
+                for i in 0..4 {
+                    jet.g[i] += bv * gq[i] + qv * gb[i];
+                    for k in 0..4 {
+                        let hq = (hn[i][k] - qv * hd[i][k] - gq[i] * gd[k] - gd[i] * gq[k]) / d;
+                        // R = q·B: HR = B Hq + ∇q∇Bᵀ + ∇B∇qᵀ + q HB.
+                        jet.h[i][k] += bv * hq + gq[i] * gb[k] + gb[i] * gq[k] + qv * hb[i][k];
+                    }
                 }
             }
         }
@@ -483,9 +787,10 @@ impl CompiledPatch {
     #[must_use]
     pub fn value_gradient(&self, alpha: &[f64; 4]) -> (f64, DVec3) {
         let j = self.bary_derivatives(alpha);
+        let grad = self.grad();
         let mut g = DVec3::ZERO;
         for i in 0..4 {
-            g += j.g[i] * self.grad[i];
+            g += j.g[i] * grad[i];
         }
         (j.v, g)
     }
@@ -494,30 +799,31 @@ impl CompiledPatch {
     #[must_use]
     pub fn derivatives(&self, alpha: &[f64; 4]) -> (f64, DVec3, DMat3) {
         let j = self.bary_derivatives(alpha);
+        let grad = self.grad();
         let mut g = DVec3::ZERO;
         let mut h = DMat3::ZERO;
         for i in 0..4 {
-            g += j.g[i] * self.grad[i];
+            g += j.g[i] * grad[i];
             for k in 0..4 {
-                let gi = self.grad[i] * j.h[i][k];
-                let gk = self.grad[k];
+                let gi = grad[i] * j.h[i][k];
+                let gk = grad[k];
                 h += DMat3::from_cols(gi * gk.x, gi * gk.y, gi * gk.z);
             }
         }
         (j.v, g, h)
     }
 
-    /// Approximate bytes this patch occupies.
-    #[must_use]
-    pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + self.weights.len() * 8
-            + self.cleared.len() * 8
-            + self
-                .rational
-                .iter()
-                .map(|r| std::mem::size_of::<RationalTerm>() + r.terms.len() * 16)
-                .sum::<usize>()
+    #[cfg(test)]
+    /// [`Self::segment`] computed another way: the BB-form cleared polynomial G restricted by
+    /// blossoms (the reference for the univariate products).
+    fn segment_by_bb_form(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
+        let Some(form) = self.form else {
+            poly::restrict(self.degree(), self.weights, *a, *b, out);
+            return self.degree();
+        };
+        let g = clear_denominators(self.degree(), self.weights, form, self.numer);
+        poly::restrict(self.segment_degree(), &g, *a, *b, out);
+        self.segment_degree()
     }
 }
 
@@ -533,73 +839,16 @@ pub struct Jet {
 }
 
 #[cfg(test)]
-impl CompiledPatch {
-    /// [`Self::segment`] computed the slow, independent way: univariate products of every
-    /// term's monomials along the segment (the reference for the BB-form clearing).
-    pub fn segment_by_products(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
-        let n = self.degree;
-        // Polynomial part: c_k = blossom(a^(n−k), b^k).
-        poly::restrict(n, &self.weights, *a, *b, out);
-        if self.groups.is_empty() {
-            return n;
-        }
-        // Rational terms: G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group.
-        let mut deg = n;
-        let mut q = [0.0; MAX_DEGREE + 1]; // Π of the denominators so far
-        q[0] = 1.0;
-        let mut qdeg = 0;
-        for g in &self.groups {
-            let mut den = [0.0; MAX_DEGREE + 1];
-            let mut dden = 0;
-            for mu in &g.denominator {
-                let mut m = [0.0; MAX_DEGREE + 1];
-                let d = monomial_segment(*mu, a, b, &mut m);
-                add_poly(&mut den, &mut dden, &m, d);
-            }
-            let mut sum = [0.0; MAX_DEGREE + 1];
-            let mut dsum = 0;
-            for (kappa, mult, numer) in &g.terms {
-                let mut num = [0.0; MAX_DEGREE + 1];
-                let mut dnum = 0;
-                for (w, mu) in numer {
-                    let mut m = [0.0; MAX_DEGREE + 1];
-                    let d = monomial_segment(*mu, a, b, &mut m);
-                    for x in &mut m[..=d] {
-                        *x *= w;
-                    }
-                    add_poly(&mut num, &mut dnum, &m, d);
-                }
-                let mut bern = [0.0; MAX_DEGREE + 1];
-                let dk = monomial_segment(*kappa, a, b, &mut bern);
-                for x in &mut bern[..=dk] {
-                    *x *= mult;
-                }
-                let mut prod = [0.0; MAX_DEGREE + 1];
-                product(&num, dnum, &bern, dk, &mut prod);
-                add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
-            }
-            let mut left = [0.0; MAX_DEGREE + 1];
-            product(out, deg, &den, dden, &mut left);
-            let mut right = [0.0; MAX_DEGREE + 1];
-            product(&sum, dsum, &q, qdeg, &mut right);
-            let mut dl = deg + dden;
-            add_poly(&mut left, &mut dl, &right, dsum + qdeg);
-            *out = left;
-            deg = dl;
-            let mut nq = [0.0; MAX_DEGREE + 1];
-            product(&q, qdeg, &den, dden, &mut nq);
-            q = nq;
-            qdeg += dden;
-        }
-        deg
-    }
-}
-
-#[cfg(test)]
 mod tests {
     use super::*;
     use crate::complex::{RationalTerm, Role};
     use crate::fixtures::{quadric_weights, Quadric};
+
+    fn compile(p: &Patch) -> PatchStore {
+        let mut s = PatchStore::default();
+        s.push(p, 0).unwrap();
+        s
+    }
 
     fn tet() -> [DVec3; 4] {
         [
@@ -629,7 +878,8 @@ mod tests {
     fn segment_and_derivatives_match_the_quadric() {
         let q = Quadric::ellipsoid(DVec3::new(0.2, 0.3, 0.1), DVec3::new(0.7, 0.5, 0.9));
         for n in 2..=5 {
-            let c = CompiledPatch::new(&patch(&q, n), 0).unwrap();
+            let store = compile(&patch(&q, n));
+            let c = store.get(0);
             let x0 = DVec3::new(0.1, 0.2, 0.1);
             let x1 = DVec3::new(0.3, 0.25, 0.4);
             let (a, b) = (c.bary(x0), c.bary(x1));
@@ -676,7 +926,8 @@ mod tests {
             index: [1, 1, 1, 0],
             terms: vec![(2.0, [2, 0, 0, 0]), (3.0, [0, 2, 0, 0])],
         });
-        let c = CompiledPatch::new(&p, 0).unwrap();
+        let store = compile(&p);
+        let c = store.get(0);
         let f = |x: DVec3| c.derivatives(&c.bary(x)).0;
         let den = |x: DVec3| {
             let a = c.bary(x);
@@ -715,10 +966,10 @@ mod tests {
     }
 
     #[test]
-    fn bb_cleared_form_matches_the_univariate_products() {
+    fn univariate_products_match_the_bb_cleared_form() {
         // Two denominator groups (an edge-patch style α3 + α4 and a face-patch style
-        // α1α2 + α1α3 + α2α3), three terms: the BB-form G restricted to random segments must
-        // equal the term-by-term univariate construction.
+        // α1α2 + α1α3 + α2α3), three terms: the term-by-term univariate construction on random
+        // segments must equal the BB-form G restricted by blossoms.
         let q = Quadric::sphere(DVec3::new(0.3, 0.3, 0.3), 0.4);
         let mut p = patch(&q, 3);
         p.rational.push(RationalTerm {
@@ -737,8 +988,9 @@ mod tests {
                 (1.1, [0, 1, 1, 0]),
             ],
         });
-        let c = CompiledPatch::new(&p, 0).unwrap();
-        assert_eq!(c.segment_degree, 6);
+        let store = compile(&p);
+        let c = store.get(0);
+        assert_eq!(c.segment_degree(), 6);
         let mut seed = 12345u64;
         let mut rnd = || {
             seed = seed
@@ -755,7 +1007,7 @@ mod tests {
             let (a, b) = (pick(), pick());
             let (mut x, mut y) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
             let dx = c.segment(&a, &b, &mut x);
-            let dy = c.segment_by_products(&a, &b, &mut y);
+            let dy = c.segment_by_bb_form(&a, &b, &mut y);
             assert_eq!(dx, dy);
             for k in 0..=dx {
                 // Both are sums of O(1) products of O(1) barycentrics: rounding only.

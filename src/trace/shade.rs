@@ -147,7 +147,7 @@ pub struct Surface {
 /// Normal and curvatures at `hit` on the ray `o + t·d`; curvature only when `curvature`.
 #[must_use]
 pub fn surface(geo: &Geometry, hit: &Hit, o: DVec3, d: DVec3, curvature: bool) -> Surface {
-    let patch = &geo.patches[hit.patch as usize];
+    let patch = geo.patches.get(hit.patch as usize);
     let p = o + hit.t * d;
     let (g, h) = if curvature {
         let (_, g, h) = patch.derivatives(&hit.bary);
