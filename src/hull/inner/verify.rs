@@ -388,7 +388,7 @@ fn tet_volume6(t: &[DVec3; 4]) -> f64 {
 }
 
 /// Pairs of tetrahedra whose interiors overlap by more than [`OVERLAP_DEPTH`], with the depth
-/// (relative to the smaller one's longest edge). Sweep over x-sorted bounding boxes, then the
+/// (relative to the smaller one's longest edge). Grid of bounding boxes, then the
 /// separating-axis test.
 #[must_use]
 pub fn overlapping_pairs(tets: &[[DVec3; 4]]) -> Vec<(usize, usize, f64)> {
@@ -402,22 +402,58 @@ pub fn overlapping_pairs(tets: &[[DVec3; 4]]) -> Vec<(usize, usize, f64)> {
             (lo, hi)
         })
         .collect();
-    let mut order: Vec<usize> = (0..tets.len()).collect();
-    order.sort_by(|&a, &b| boxes[a].0.x.total_cmp(&boxes[b].0.x));
+    if tets.is_empty() {
+        return Vec::new();
+    }
+    // Uniform grid with cells of the mean box size: each pair is tested once, in the cell that
+    // holds the lower corner of the intersection of its boxes.
+    let mean = boxes
+        .iter()
+        .map(|(lo, hi)| (*hi - *lo).max_element())
+        .sum::<f64>()
+        / boxes.len() as f64;
+    let cell = if mean > 0.0 && mean.is_finite() {
+        mean
+    } else {
+        1.0
+    };
+    let key = |p: DVec3| {
+        let k = (p / cell).floor();
+        (k.x as i64, k.y as i64, k.z as i64)
+    };
+    let mut grid: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
+    for (i, (lo, hi)) in boxes.iter().enumerate() {
+        let (a, b) = (key(*lo), key(*hi));
+        for x in a.0..=b.0 {
+            for y in a.1..=b.1 {
+                for z in a.2..=b.2 {
+                    grid.entry((x, y, z)).or_default().push(i);
+                }
+            }
+        }
+    }
     let mut out = Vec::new();
-    for (k, &i) in order.iter().enumerate() {
-        for &j in &order[k + 1..] {
-            if boxes[j].0.x > boxes[i].1.x {
-                break;
-            }
-            let (a, b) = (boxes[i], boxes[j]);
-            if a.0.y > b.1.y || b.0.y > a.1.y || a.0.z > b.1.z || b.0.z > a.1.z {
-                continue;
-            }
-            let scale = longest_edge(&tets[i]).min(longest_edge(&tets[j]));
-            let depth = sat_depth(&tets[i], &tets[j]) / scale;
-            if depth > OVERLAP_DEPTH {
-                out.push((i.min(j), i.max(j), depth));
+    for (&here, list) in &grid {
+        for (k, &i) in list.iter().enumerate() {
+            for &j in &list[k + 1..] {
+                let (a, b) = (boxes[i], boxes[j]);
+                if a.0.x > b.1.x
+                    || b.0.x > a.1.x
+                    || a.0.y > b.1.y
+                    || b.0.y > a.1.y
+                    || a.0.z > b.1.z
+                    || b.0.z > a.1.z
+                {
+                    continue;
+                }
+                if key(a.0.max(b.0)) != here {
+                    continue;
+                }
+                let scale = longest_edge(&tets[i]).min(longest_edge(&tets[j]));
+                let depth = sat_depth(&tets[i], &tets[j]) / scale;
+                if depth > OVERLAP_DEPTH {
+                    out.push((i.min(j), i.max(j), depth));
+                }
             }
         }
     }
