@@ -547,6 +547,40 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
     }
 }
 
+/// The inner simplicial hull (1994) a `cubic-c1` or `quintic-c2` scene is built on, with the
+/// scene's normals and hull options; `None` for other scenes. Lets `check` verify the hull
+/// (Definition 3.6) beside the patches.
+///
+/// # Errors
+/// Unreadable meshes, bad options, and hulls that cannot be built, naming the file.
+pub fn inner_hull(
+    scene: &Scene,
+) -> anyhow::Result<Option<crate::hull::simplicial::SimplicialHull>> {
+    let Model::Mesh {
+        file,
+        normals,
+        scheme,
+    } = &scene.model
+    else {
+        return Ok(None);
+    };
+    if !matches!(
+        scheme.get("type").and_then(|v| v.as_str()),
+        Some("cubic-c1" | "quintic-c2")
+    ) {
+        return Ok(None);
+    }
+    let method: NormalMethod = normals
+        .parse()
+        .map_err(|e: String| anyhow!("{}: `model.normals`: {e}", scene.path.display()))?;
+    let (m, _) = mesh::load(file)?;
+    let vn = mesh::vertex_normals(&m, method)?;
+    let options = crate::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
+    let hull = crate::hull::inner::build(&m, &vn, &options)
+        .with_context(|| format!("{}", file.display()))?;
+    Ok(Some(hull))
+}
+
 /// Reads a patch complex JSON file (as written by `apatch export patches`) with the validating
 /// reader [`crate::complex_io::read_json_file`].
 ///

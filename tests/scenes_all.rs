@@ -36,6 +36,24 @@ fn shipped_scenes_build_and_pass_check() {
                 if !report.passed() {
                     failures.push(format!("{}: {:?}", path.display(), report.failures()));
                 }
+                // 1994 schemes: the inner hull itself must be smoothable (Def. 3.6), as
+                // `apatch check` requires.
+                let hull = scene::load(path).and_then(|s| scene::inner_hull(&s));
+                match hull {
+                    Err(e) => failures.push(format!("{}: hull: {e:#}", path.display())),
+                    Ok(Some(h)) => {
+                        let v = apatch::hull::inner::verify(&h);
+                        if !v.is_empty() {
+                            failures.push(format!(
+                                "{}: {} hull violations, first {:?}",
+                                path.display(),
+                                v.len(),
+                                v[0]
+                            ));
+                        }
+                    }
+                    Ok(None) => {}
+                }
             }
         }
     }

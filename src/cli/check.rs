@@ -127,21 +127,9 @@ fn hull_violations(
         return Ok(None);
     }
     let scene = apatch::scene::load(input)?;
-    let apatch::scene::Model::Mesh {
-        file,
-        normals,
-        scheme,
-    } = &scene.model
-    else {
+    let Some(hull) = apatch::scene::inner_hull(&scene)? else {
         return Ok(None);
     };
-    let method: apatch::mesh::NormalMethod = normals
-        .parse()
-        .map_err(|e: String| anyhow::anyhow!("{}: `model.normals`: {e}", input.display()))?;
-    let (m, _) = apatch::mesh::load(file)?;
-    let vn = apatch::mesh::vertex_normals(&m, method)?;
-    let options = apatch::hull::inner::InnerOptions::from_toml(scheme, input)?;
-    let hull = apatch::hull::inner::build(&m, &vn, &options)?;
     Ok(Some(apatch::hull::inner::verify(&hull)))
 }
 
