@@ -5,34 +5,12 @@
 //! prebuilt hull. Throughput is in input faces per second.
 
 use apatch::hull::inner::{self, InnerOptions};
-use apatch::mesh::{vertex_normals, Mesh, NormalMethod};
+use apatch::mesh::{vertex_normals, NormalMethod};
 use apatch::scheme::cubic_c1::{build, CubicOptions};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use glam::DVec3;
-
-fn quad_torus(m: usize, k: usize) -> Mesh {
-    let (big, small) = (1.0, 0.4);
-    let mut v = Vec::with_capacity(m * k);
-    for i in 0..m {
-        let u = i as f64 / m as f64 * std::f64::consts::TAU;
-        for j in 0..k {
-            let w = j as f64 / k as f64 * std::f64::consts::TAU;
-            let r = big + small * w.cos();
-            v.push(DVec3::new(r * u.cos(), r * u.sin(), small * w.sin()));
-        }
-    }
-    let id = |i: usize, j: usize| ((i % m) * k + (j % k)) as u32;
-    let mut f = Vec::with_capacity(m * k);
-    for i in 0..m {
-        for j in 0..k {
-            f.push(vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    Mesh::new(v, f)
-}
 
 fn bench(c: &mut Criterion) {
-    let mesh = quad_torus(320, 320);
+    let mesh = apatch::fixtures::quad_torus(320, 320);
     let normals = vertex_normals(&mesh, NormalMethod::Angle).expect("normals");
     let hull = inner::build(&mesh, &normals, &InnerOptions::default()).expect("hull");
     let mut g = c.benchmark_group("cubic_build");

@@ -371,3 +371,31 @@ mod hull_tests {
         }
     }
 }
+
+/// A torus of `nu` × `nv` planar quads (isosceles trapezoids between meridians and parallels;
+/// radii 1 and 0.4), loaded through the validating pipeline so it is oriented outward: both
+/// convex and saddle-shaped valence-4 corners, genus 1. A polygon model for the 1994 schemes.
+///
+/// # Panics
+/// Never for `nu, nv ≥ 3` (the mesh is valid by construction).
+#[must_use]
+pub fn quad_torus(nu: usize, nv: usize) -> crate::mesh::Mesh {
+    let mut positions = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        let a = std::f64::consts::TAU * i as f64 / nu as f64;
+        for j in 0..nv {
+            let b = std::f64::consts::TAU * j as f64 / nv as f64;
+            let r = 1.0 + 0.4 * b.cos();
+            positions.push(DVec3::new(r * a.cos(), r * a.sin(), 0.4 * b.sin()));
+        }
+    }
+    let id = |i: usize, j: usize| ((i % nu) * nv + (j % nv)) as u32;
+    let faces: Vec<Vec<u32>> = (0..nu)
+        .flat_map(|i| {
+            (0..nv).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        })
+        .collect();
+    crate::mesh::from_polygons(positions, faces)
+        .expect("a valid torus")
+        .0
+}

@@ -381,23 +381,7 @@ fn open_or_non_manifold_meshes_are_errors() {
 /// the hull verifies and has genus 1.
 #[test]
 fn fine_quad_torus_gives_valid_hull() {
-    let (nu, nv) = (48usize, 32usize);
-    let mut positions = Vec::new();
-    for i in 0..nu {
-        let a = std::f64::consts::TAU * i as f64 / nu as f64;
-        for j in 0..nv {
-            let b = std::f64::consts::TAU * j as f64 / nv as f64;
-            let r = 1.0 + 0.4 * b.cos();
-            positions.push(DVec3::new(r * a.cos(), r * a.sin(), 0.4 * b.sin()));
-        }
-    }
-    let id = |i: usize, j: usize| ((i % nu) * nv + (j % nv)) as u32;
-    let faces: Vec<Vec<u32>> = (0..nu)
-        .flat_map(|i| {
-            (0..nv).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
-        })
-        .collect();
-    let (m, _) = mesh::from_polygons(positions, faces).unwrap();
+    let m = apatch::fixtures::quad_torus(48, 32);
     let (hull, _) = hull_of(&m);
     assert_valid("torus 48x32", &m, &hull);
     assert_eq!(euler_characteristic(&hull), Some(0));

@@ -85,20 +85,26 @@ pub fn load_complex(path: &Path) -> anyhow::Result<PatchComplex> {
     }
 }
 
-/// For a scene of a 1994 scheme (`cubic-c1`, `quintic-c2`; the surface approximates the
-/// polyhedron), the distance of the surface to the scene's polyhedron.
-fn polyhedron_distance(
+/// The scene of `input` when it is a `.toml` scene of a 1994 scheme (`cubic-c1`, `quintic-c2`:
+/// the surface approximates the polyhedron and lives on an inner hull), else `None`.
+fn scene_1994(
     input: &Path,
     complex: &PatchComplex,
-) -> anyhow::Result<Option<check::distance::DistanceStats>> {
-    if !input
+) -> anyhow::Result<Option<apatch::scene::Scene>> {
+    let is_toml = input
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
-        || !matches!(complex.scheme.as_str(), "cubic-c1" | "quintic-c2")
-    {
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if !is_toml || !matches!(complex.scheme.as_str(), "cubic-c1" | "quintic-c2") {
         return Ok(None);
     }
-    let scene = apatch::scene::load(input)?;
+    Ok(Some(apatch::scene::load(input)?))
+}
+
+/// The distance of the surface to the scene's polyhedron (1994 scenes).
+fn polyhedron_distance(
+    scene: &apatch::scene::Scene,
+    complex: &PatchComplex,
+) -> anyhow::Result<Option<check::distance::DistanceStats>> {
     let apatch::scene::Model::Mesh { file, .. } = &scene.model else {
         return Ok(None);
     };
@@ -113,24 +119,12 @@ fn polyhedron_distance(
     )))
 }
 
-/// For a scene of a 1994 scheme, the inner simplicial hull it was built on, checked against
-/// Definition 3.6 and Lemmas 4.1–4.3 (`hull::inner::verify`): the violations, empty when valid.
+/// The inner simplicial hull a 1994 scene is built on, checked against Definition 3.6 and
+/// Lemmas 4.1–4.3 (`hull::inner::verify`): the violations, empty when valid.
 fn hull_violations(
-    input: &Path,
-    complex: &PatchComplex,
+    scene: &apatch::scene::Scene,
 ) -> anyhow::Result<Option<Vec<apatch::hull::inner::HullViolation>>> {
-    if !input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
-        || !matches!(complex.scheme.as_str(), "cubic-c1" | "quintic-c2")
-    {
-        return Ok(None);
-    }
-    let scene = apatch::scene::load(input)?;
-    let Some(hull) = apatch::scene::inner_hull(&scene)? else {
-        return Ok(None);
-    };
-    Ok(Some(apatch::hull::inner::verify(&hull)))
+    Ok(apatch::scene::inner_hull(scene)?.map(|h| apatch::hull::inner::verify(&h)))
 }
 
 /// One line per hull violation: the condition, the triangle of T, the detail.
@@ -155,8 +149,11 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         ..CheckOptions::default()
     };
     let report = check::check(&complex, &opts);
-    let distance = polyhedron_distance(&args.input, &complex)?;
-    let hull = hull_violations(&args.input, &complex)?;
+    let scene = scene_1994(&args.input, &complex)?;
+    let (distance, hull) = match &scene {
+        Some(s) => (polyhedron_distance(s, &complex)?, hull_violations(s)?),
+        None => (None, None),
+    };
     let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);
     let passed = report.passed() && hull_valid;
     if args.json {
