@@ -32,7 +32,8 @@ pub struct DistanceStats {
 }
 
 /// Surface points of every patch with a j-vertex or j-edge: the first root of F in (0, 1)
-/// on lines through `res` lattice steps per edge.
+/// on lines through `res` lattice steps per edge (at least 3, and 4 across a face so it has an
+/// interior point: the lattice of the sheet check).
 #[must_use]
 pub fn surface_samples(complex: &PatchComplex, res: usize) -> Vec<DVec3> {
     let res = res.max(3);
@@ -41,41 +42,7 @@ pub fn surface_samples(complex: &PatchComplex, res: usize) -> Vec<DVec3> {
         .par_iter()
         .flat_map_iter(|p| {
             let v = p.tet_points();
-            let lattice = |verts: &[usize]| -> Vec<[f64; 4]> {
-                let mut out = Vec::new();
-                let mut put = |w: &[usize]| {
-                    let mut a = [0.0; 4];
-                    for (&k, &x) in verts.iter().zip(w) {
-                        a[k] = x as f64 / res as f64;
-                    }
-                    out.push(a);
-                };
-                match verts.len() {
-                    1 => put(&[res]),
-                    2 => (1..res).for_each(|i| put(&[i, res - i])),
-                    _ => {
-                        for i in 1..res {
-                            for j in 1..res - i {
-                                put(&[i, j, res - i - j]);
-                            }
-                        }
-                    }
-                }
-                out
-            };
-            let (from, to) = match (p.jvertex, p.jedge) {
-                (Some(j), _) if j < 4 => {
-                    let j = usize::from(j);
-                    let face: Vec<usize> = (0..4).filter(|&k| k != j).collect();
-                    (lattice(&[j]), lattice(&face))
-                }
-                (_, Some([a, b])) if a < 4 && b < 4 && a != b => {
-                    let (a, b) = (usize::from(a), usize::from(b));
-                    let other: Vec<usize> = (0..4).filter(|&k| k != a && k != b).collect();
-                    (lattice(&[a, b]), lattice(&other))
-                }
-                _ => (Vec::new(), Vec::new()),
-            };
+            let (from, to) = super::sheets::j_line_ends(p, res).unwrap_or_default();
             let mut pts = Vec::new();
             for a in &from {
                 for b in &to {

@@ -13,7 +13,7 @@ use super::eval::PatchEval;
 use super::{CheckOptions, Location, SheetStats};
 use crate::bb::rational::segment_poly;
 use crate::bb::uni;
-use crate::complex::SheetRule;
+use crate::complex::{Patch, SheetRule};
 use rayon::prelude::*;
 
 /// Bisection steps on [0, 1]-subintervals: 2⁻⁶⁰ is below f64 resolution of t.
@@ -159,25 +159,31 @@ fn patch_sheets(e: &PatchEval<'_>, opts: &CheckOptions, mut stats: SheetStats) -
     stats
 }
 
-/// The 1994 single-sheet promise: lines from the j-vertex through the opposite face, or
-/// between the j-edge and the opposite edge, meet F = 0 at most once away from their ends.
-fn j_lines(e: &PatchEval<'_>, opts: &CheckOptions, n: usize, stats: &mut SheetStats) {
-    let p = e.patch;
-    let (from, to): (Vec<[f64; 4]>, Vec<[f64; 4]>) = match (p.jvertex, p.jedge) {
+/// Barycentric lattice points of one simplex of a tetrahedron.
+pub(crate) type Lattice = Vec<[f64; 4]>;
+
+/// The ends of a patch's j-lines as barycentric lattice points, `res` steps per edge: the
+/// j-vertex and the opposite face, or the j-edge and the opposite edge; `None` when the patch
+/// promises neither. Shared by the sheet check and the distance sampling.
+pub(crate) fn j_line_ends(p: &Patch, res: usize) -> Option<(Lattice, Lattice)> {
+    match (p.jvertex, p.jedge) {
         (Some(j), _) if j < 4 => {
             let face: Vec<u8> = (0..4u8).filter(|&k| k != j).collect();
-            let mut a = [0.0; 4];
-            a[usize::from(j)] = 1.0;
-            (vec![a], simplex_lattice(&face, opts.sheet_resolution))
+            Some((simplex_lattice(&[j], res), simplex_lattice(&face, res)))
         }
         (_, Some([a, b])) if a < 4 && b < 4 && a != b => {
             let other: Vec<u8> = (0..4u8).filter(|&k| k != a && k != b).collect();
-            (
-                simplex_lattice(&[a, b], opts.sheet_resolution),
-                simplex_lattice(&other, opts.sheet_resolution),
-            )
+            Some((simplex_lattice(&[a, b], res), simplex_lattice(&other, res)))
         }
-        _ => return,
+        _ => None,
+    }
+}
+
+/// The 1994 single-sheet promise: lines from the j-vertex through the opposite face, or
+/// between the j-edge and the opposite edge, meet F = 0 at most once away from their ends.
+fn j_lines(e: &PatchEval<'_>, opts: &CheckOptions, n: usize, stats: &mut SheetStats) {
+    let Some((from, to)) = j_line_ends(e.patch, opts.sheet_resolution) else {
+        return;
     };
     stats.j_patches += 1;
     let mut multi = false;
