@@ -1,6 +1,6 @@
 //! `apatch export patches|mitsuba`.
 
-use anyhow::{anyhow, bail};
+use anyhow::bail;
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -64,21 +64,7 @@ pub fn run(cmd: ExportCommand) -> anyhow::Result<ExitCode> {
                 bail!("{}: expected a scene .toml", a.scene.display());
             }
             let mut scene = apatch::scene::load(&a.scene)?;
-            let s = &mut scene.settings;
-            if a.width.is_some() || a.height.is_some() {
-                let w = a.width.unwrap_or(s.camera.width);
-                let h = a.height.unwrap_or(s.camera.height);
-                s.camera = s
-                    .camera
-                    .resized(w, h)
-                    .map_err(|e| anyhow!("--width/--height: {e}"))?;
-            }
-            if let Some(spp) = a.spp {
-                if spp == 0 {
-                    bail!("--spp: must be ≥ 1");
-                }
-                s.spp = spp;
-            }
+            super::override_film(&mut scene.settings, a.width, a.height, a.spp)?;
             let complex = super::check::load_complex(&a.scene)?;
             let done = apatch::export::mitsuba::export(&scene, &complex, &a.output, a.resolution)?;
             println!(

@@ -7,3 +7,31 @@ pub mod export;
 pub mod info;
 pub mod render;
 pub mod tessellate;
+
+/// Applies the `--width`, `--height` and `--spp` flags shared by `render` and `export mitsuba`
+/// to a scene's settings (the size through `Camera::resized`).
+///
+/// # Errors
+/// A size the camera rejects, or `--spp 0`.
+pub fn override_film(
+    s: &mut apatch::trace::RenderSettings,
+    width: Option<u32>,
+    height: Option<u32>,
+    spp: Option<u32>,
+) -> anyhow::Result<()> {
+    if width.is_some() || height.is_some() {
+        let w = width.unwrap_or(s.camera.width);
+        let h = height.unwrap_or(s.camera.height);
+        s.camera = s
+            .camera
+            .resized(w, h)
+            .map_err(|e| anyhow::anyhow!("--width/--height: {e}"))?;
+    }
+    if let Some(spp) = spp {
+        if spp == 0 {
+            anyhow::bail!("--spp: must be ≥ 1");
+        }
+        s.spp = spp;
+    }
+    Ok(())
+}

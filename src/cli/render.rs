@@ -43,20 +43,7 @@ static CANCEL: AtomicBool = AtomicBool::new(false);
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let mut scene = scene::load(&args.input)?;
     let s = &mut scene.settings;
-    if args.width.is_some() || args.height.is_some() {
-        let w = args.width.unwrap_or(s.camera.width);
-        let h = args.height.unwrap_or(s.camera.height);
-        s.camera = s
-            .camera
-            .resized(w, h)
-            .map_err(|e| anyhow!("--width/--height: {e}"))?;
-    }
-    if let Some(spp) = args.spp {
-        if spp == 0 {
-            return Err(anyhow!("--spp: must be ≥ 1"));
-        }
-        s.spp = spp;
-    }
+    super::override_film(s, args.width, args.height, args.spp)?;
     if let Some(m) = &args.mode {
         s.mode = m.parse::<Mode>().map_err(|e| anyhow!("--mode: {e}"))?;
     }
