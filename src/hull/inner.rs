@@ -21,6 +21,7 @@
 //! carries it ([`InnerOptions::trihedral_level`]).
 
 pub mod above;
+pub mod coplanar;
 pub mod corner;
 pub mod decompose;
 pub mod verify;
@@ -122,6 +123,8 @@ pub struct InnerReport {
     pub adjusted_normals: Vec<(u32, DVec3)>,
     /// Non-convex input polygons split into convex pieces (corner guards), with the piece count.
     pub split_faces: Vec<(u32, usize)>,
+    /// Non-convex but star-shaped input polygons kept whole, with their single corner guard.
+    pub star_faces: Vec<(u32, DVec3)>,
     /// Non-trihedral vertices that are unseparable from their face centroids (C_0 = V).
     pub unseparable: Vec<u32>,
     /// How the face tetrahedra were chosen.
@@ -167,28 +170,28 @@ pub fn build_with_report(
     }
     let line = |v: usize| mesh.vertex_lines.get(v).copied().unwrap_or(0);
     let mut report = InnerReport::default();
+    let merged = coplanar::merge_coplanar(mesh);
+    let mesh = &merged;
     let pieces = decompose::convex_pieces(mesh)?;
-    report.split_faces.clone_from(&pieces.split);
+    let input_face = |f: u32| mesh.face_parent[f as usize];
+    report.split_faces = pieces
+        .split
+        .iter()
+        .map(|&(f, n)| (input_face(f), n))
+        .collect();
+    report.star_faces = pieces
+        .star
+        .iter()
+        .map(|&(f, g)| (input_face(f), g))
+        .collect();
     let topo = Topology::new(nv, &pieces.faces);
 
     let mut hull = SimplicialHull::default();
-    let mean = |face: &[u32]| {
-        face.iter()
-            .map(|&v| mesh.positions[v as usize])
-            .sum::<DVec3>()
-            / face.len() as f64
-    };
-    for (f, piece) in pieces.faces.iter().enumerate() {
-        let mut c = mean(piece);
-        if pieces.guard[f] {
-            // Corner guards of one polygon lie exactly in its plane (through its vertex mean),
-            // so the guard net's edges are zero convex even when the polygon is slightly bent.
-            let o = mean(&mesh.faces[pieces.parent[f] as usize]);
-            c -= pieces.normal[f].dot(c - o) * pieces.normal[f];
-        }
+    for (f, _) in pieces.faces.iter().enumerate() {
+        let c = pieces.center[f];
         hull.points.push(c);
         hull.normals.push(pieces.normal[f]);
-        let face = pieces.parent[f];
+        let face = mesh.face_parent[pieces.parent[f] as usize];
         hull.origins.push(if pieces.guard[f] {
             PointOrigin::CornerGuard { face }
         } else {
@@ -196,6 +199,7 @@ pub fn build_with_report(
         });
     }
     let mut ring = Vec::new();
+    let mut hallway = Vec::new();
     #[allow(clippy::needless_range_loop)] // v indexes positions, normals, lines and topology
     for v in 0..nv {
         if topo.vertex_corners(v as u32).is_empty() {
@@ -252,16 +256,25 @@ pub fn build_with_report(
         }
         ring.clear();
         ring.extend(fan.ring.iter().map(|&w| mesh.positions[w as usize]));
+        let reflex = (0..fan.faces.len()).find(|&i| {
+            let a = ring[i] - mesh.positions[v];
+            let b = ring[(i + 1) % ring.len()] - mesh.positions[v];
+            // Reflex when the turn at V is clockwise in the face's plane, beyond rounding of
+            // the edge vectors (1e-12 relative).
+            a.cross(b).dot(pieces.normal[fan.faces[i] as usize]) < -1e-12 * a.length() * b.length()
+        });
         let c = corner::Corner {
             vertex: v as u32,
             v: mesh.positions[v],
             n,
             ring: &ring,
             faces: &fan.faces,
+            reflex,
         };
-        if !corner::build_corner(&mut hull, &c, options, &mut report.cases) {
+        if !corner::build_corner(&mut hull, &c, options, &mut report.cases, &mut hallway) {
             report.unseparable.push(v as u32);
         }
     }
+    corner::spread_hallway_apexes(&mut hull, &hallway);
     Ok((hull, report))
 }
