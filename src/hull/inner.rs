@@ -3,13 +3,20 @@
 //! ([`SimplicialHull`], Definition 3.6).
 //!
 //! Pipeline ([`build_with_report`]):
-//! 1. [`decompose`]: non-convex polygons are split into convex pieces whose centroids are the
-//!    corner guards (Algorithm 2 reduced to Algorithm 1, as §4 allows).
-//! 2. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
+//! 1. [`coplanar`]: edge-adjacent coplanar faces are merged into one polygon (one face per
+//!    plane, as the paper's polyhedra have; Appendix B's coplanarity treated at its source).
+//! 2. [`decompose`]: corner guards (§5, Algorithm 2 step (1)). A star-shaped non-convex polygon
+//!    keeps one guard, the centroid of its kernel (it sees every corner); other non-convex
+//!    polygons are split into convex pieces whose centroids are the guards (Algorithm 2
+//!    reduced to Algorithm 1, as §4 allows).
+//! 3. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
 //!    Appendix C) by rotating it where needed; corners where no direction is above all faces
 //!    are reported as errors.
-//! 3. [`corner`]: Algorithm 1 steps (3)–(5) vertex by vertex: T and the face tetrahedra.
-//! 4. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//! 4. [`corner`]: Algorithm 1 steps (3)–(5) vertex by vertex, with Algorithm 2's step (3')
+//!    for hallway corners (trihedral, one reflex face angle): T and the face tetrahedra; then
+//!    [`corner::spread_hallway_apexes`] moves the hallway corners' outer apexes off the
+//!    concave edge so the edge tetrahedra there are not inverted.
+//! 5. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
 //!
 //! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
 //!

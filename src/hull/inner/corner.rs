@@ -1,10 +1,16 @@
-//! Algorithm 1, steps (3)–(5): the triangles of T and the face tetrahedra built for one vertex V
+//! Algorithm 1, steps (3)–(5), and Algorithm 2's step (3'): the triangles of T and the face tetrahedra built for one vertex V
 //! of the (convex-faced) polyhedron.
 //!
 //! Reconstruction of the missing figures 4.3–4.5, as implemented:
 //! - step (3), trihedral V: T gets the triangle of the three face centroids C_1C_2C_3 (in the
 //!   counter-clockwise order of the faces round V), apex V. The tangent plane of every C_i is its
 //!   face plane, which contains V, so the tetrahedron is tangent-containing.
+//! - step (3') of Algorithm 2 (the hallway corner, Figure 5.7), trihedral V with a reflex angle
+//!   in one face f_1 (so the edge e_1 not in f_1 is a concave edge of the polyhedron): when e_1
+//!   crosses the plane of the guards' triangle at X before its midpoint M, a second apex
+//!   T_0 = (X + M)/2 on e_1 gives the L-U pair [G_1G_2G_3V], [G_1G_2G_3T_0]. Beyond the paper:
+//!   the outer apex V is later moved in f_1's plane away from f_1 ([`spread_hallway_apexes`]),
+//!   since with V itself the edge tetrahedra across e_1 (midpoint s = M) are inverted.
 //! - step (4), otherwise: t_i = n_V·(C_i − V). V is separable when all t_i have one sign; then
 //!   V̄ = V + t* n_V with |t*| = min |t_i| and the pseudo-centroid C_0 = αV + (1−α)V̄ (normal
 //!   n_V); unseparable V gives C_0 = V. T gets the fan C_0C_iC_{i+1}, one triangle per edge

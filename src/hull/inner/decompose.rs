@@ -1,16 +1,22 @@
-//! Corner guards of non-convex faces (§5, Definition 2.5) by convex decomposition.
+//! Corner guards of non-convex faces (§5, Definition 2.5).
 //!
-//! The paper notes (§4, after Theorem 4.1) that "the convex face restriction can be enforced by
-//! subdividing nonconvex faces into convex ones". We do that: every non-convex polygon is
-//! ear-clipped in its plane and the triangles are merged back greedily while the union stays
-//! convex (Hertel–Mehlhorn, at most 4× the minimum number of pieces). The centroid of every piece
-//! sees all of that piece's corners, so the piece centroids form a corner guard set; the dual tree
-//! of the pieces (two pieces adjacent over a diagonal) is the corner guard net that the surface
-//! interpolates (§7.2). Each piece keeps the normal of its polygon, so the edges of T inside the
-//! polygon are zero convex (§5: "the edges in corner guard nets are zero convex by construction").
+//! A star-shaped polygon (non-empty kernel: the points that see all of it) keeps a single corner
+//! guard, the centroid of its kernel ([`kernel_guard`]) — "for a convex polygon or a star-shaped
+//! polygon, a minimum corner guard set consists of just a single point" (§2). Its reflex
+//! corners then stay trihedral and become Algorithm 2's hallway corners (step (3'), in
+//! [`super::corner`]).
 //!
-//! Reflex corners (the hallway corner of step (3')) are split by a diagonal into corners of at
-//! most π, so after the decomposition every vertex is handled by Algorithm 1's steps (3)–(5).
+//! Other non-convex polygons are split, as the paper allows (§4, after Theorem 4.1: "the convex
+//! face restriction can be enforced by subdividing nonconvex faces into convex ones"): every
+//! such polygon is ear-clipped in its plane and the triangles are merged back greedily while the
+//! union stays convex (Hertel–Mehlhorn, at most 4× the minimum number of pieces). The centroid of
+//! every piece sees all of that piece's corners, so the piece centroids form a corner guard set;
+//! the dual tree of the pieces (two pieces adjacent over a diagonal) is the corner guard net
+//! that the surface interpolates (§7.2). Each piece keeps the normal of its polygon, so the
+//! edges of T inside the polygon are zero convex (§5: "the edges in corner guard nets are zero
+//! convex by construction"). Reflex corners are split there by a diagonal into corners of at
+//! most π, handled by Algorithm 1's steps (3)–(5); the hulls of such polygons still overlap
+//! (letter_P_poly: see `scenes/pending/paper1994/README.md`).
 
 use crate::error::{Error, Result};
 use crate::mesh::convexity::polygon_is_convex;
