@@ -797,7 +797,18 @@ fn assemble(
                     etab.eval(i, dw, drat, 1.0),
                 )
             });
-            bound::max_lemma_bound(lines, 0.0)
+            let seed = bound::max_lemma_bound(lines, 0.0);
+            // Certified over every line (x, y) of the tetrahedron (see `cover`).
+            let root = cover::EdgeFamily::root(&w0, &r0, dw, drat, sa.sigma);
+            let longest = sa.margin.max(sb.margin) / opts.bound_margin;
+            cover::sup_bound(
+                &cover::EdgeFamily,
+                root,
+                0.0,
+                seed,
+                &cover_opts(opts, longest),
+            )
+            .value
         })
         .collect();
     for (et, &be) in etets.iter().zip(&edge_bounds) {
@@ -856,7 +867,16 @@ fn assemble(
                 let (w, r) = et.frame.weights(&pa.weights(sa.f), &pb.weights(sb.f));
                 let lines = (0..egrid.len())
                     .map(|i| (etab.eval(i, &w, &r, sa.sigma), etab.eval(i, dw, drat, 1.0)));
-                bound::max_lemma_bound(lines, -margin) + margin
+                let seed = bound::max_lemma_bound(lines, -margin);
+                // Certified over every line; no tolerance above the floor (a face is raised
+                // only where some sub-square cannot be proved to need nothing).
+                let root = cover::EdgeFamily::root(&w, &r, dw, drat, sa.sigma);
+                let longest = sa.margin.max(sb.margin) / opts.bound_margin;
+                let copts = cover::CoverOptions {
+                    tol: 1e-12 * longest,
+                    ..cover_opts(opts, longest)
+                };
+                cover::sup_bound(&cover::EdgeFamily, root, -margin, seed, &copts).value + margin
             })
             .collect();
         let mut any = false;
