@@ -5,13 +5,19 @@
 //! Two faces at a vertex v belong to the same fan when they share an edge at v. Faces are
 //! linked across every edge at v that has two or more faces, whatever the faces' orientation
 //! (this runs before [`super::orient`]), so non-manifold *edges* are never split here: they stay
-//! for validation to report. Each extra fan gets a new vertex at the same position, appended
-//! after the others, with the original's file line and file normal; the fan containing the
-//! vertex's first corner (in face order) keeps the original index.
+//! for validation to report. Each extra fan gets a new vertex, appended after the others, with
+//! the original's file line and file normal; the fan containing the vertex's first corner (in
+//! face order) keeps the original index. The new vertex is moved [`SPLIT_OFFSET`] of the way
+//! towards the centroid of its fan's other corners: far below any visible size, but the two
+//! sheets no longer share a point, so consumers that identify vertices by their position (the
+//! check's interpolation measure, watertight tessellation) keep them apart.
 
 use super::report::{Element, FindingKind, Report};
 use super::topology::{Topology, UnionFind};
 use super::Mesh;
+
+/// How far (relative to the distance to its fan's centroid) a split-off vertex moves into its fan.
+pub const SPLIT_OFFSET: f64 = 1e-6;
 
 /// Splits every vertex whose incident faces form more than one edge-connected fan into one
 /// vertex per fan; records the split vertices (original index and line) in `report` as
@@ -61,7 +67,18 @@ pub fn split_vertex_fans(mesh: &mut Mesh, report: &mut Report) -> usize {
                 Some(&(_, nv)) => nv,
                 None => {
                     let nv = mesh.positions.len() as u32;
-                    mesh.positions.push(mesh.positions[v as usize]);
+                    let p = mesh.positions[v as usize];
+                    let (sum, count) = corners
+                        .iter()
+                        .zip(&roots)
+                        .filter(|&(_, &root)| root == r)
+                        .fold((glam::DVec3::ZERO, 0.0), |(s, k), (&c, _)| {
+                            let a = mesh.positions[topo.head(c) as usize];
+                            let b =
+                                mesh.positions[topo.corner_vertex[topo.prev(c) as usize] as usize];
+                            (s + a + b, k + 2.0)
+                        });
+                    mesh.positions.push(p + SPLIT_OFFSET * (sum / count - p));
                     mesh.vertex_lines.push(mesh.vertex_lines[v as usize]);
                     if let Some(n) = &mut mesh.file_normals {
                         n.push(n[v as usize]);
@@ -116,7 +133,9 @@ mod tests {
         let mut r = Report::default();
         assert_eq!(split_vertex_fans(&mut m, &mut r), 1);
         assert_eq!(m.faces, vec![vec![0, 1, 2], vec![5, 3, 4]]);
-        assert_eq!(m.positions[5], DVec3::ZERO);
+        // Moved 1e-6 of the way to the centroid (−1, −0.5, 0) of its fan's other corners.
+        assert_ne!(m.positions[5], DVec3::ZERO);
+        assert!((m.positions[5] - DVec3::new(-1e-6, -0.5e-6, 0.0)).length() < 1e-15);
         assert_eq!(m.vertex_lines.len(), 6);
         let f = r.get(FindingKind::SplitVertex).expect("finding");
         assert_eq!(f.elements, vec![Element::Vertex { index: 0, line: 0 }]);
