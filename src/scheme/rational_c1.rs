@@ -69,7 +69,11 @@ pub mod weights;
 
 use crate::complex::{Patch, PatchComplex, RationalTerm, Role, SheetRule};
 use crate::error::{Error, Result};
-use crate::hull::outer::{self, refine::RefineMesh, Convexity, HullOptions, OuterHull, NO_FACE};
+use crate::hull::outer::{
+    self,
+    refine::{RefineMesh, SplitRule},
+    Convexity, HullOptions, OuterHull, NO_FACE,
+};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::path::Path;
@@ -488,7 +492,58 @@ pub fn build(
     let hopts = HullOptions {
         epsilon: opts.epsilon,
     };
-    // §3.1: build, refine where adjacent face tetrahedra intersect, repeat.
+    // §3.1: build, refine where adjacent face tetrahedra intersect, repeat. Butterfly splits
+    // first (the paper's rule); when they do not converge within the bound, start again with
+    // midpoint splits, which make no new folds (see `outer::refine`).
+    let (mesh, hull, refined, replaced_normals) = match refine_hull(
+        positions,
+        triangles,
+        normals,
+        &hopts,
+        opts,
+        SplitRule::Butterfly,
+    ) {
+        Err(e @ Error::Invalid(_)) if e.to_string().contains(STILL_INTERSECT) => refine_hull(
+            positions,
+            triangles,
+            normals,
+            &hopts,
+            opts,
+            SplitRule::Midpoint,
+        )
+        .map_err(|e2| {
+            Error::Invalid(format!(
+                "{e}; with midpoint splits instead of butterfly points: {e2}"
+            ))
+        })?,
+        other => other?,
+    };
+    let RefineMesh {
+        positions,
+        normals,
+        triangles,
+        origin,
+    } = mesh;
+    let mut b = assemble(
+        &positions, &triangles, &normals, &origin, &hull, refined, opts,
+    )?;
+    b.replaced_normals = replaced_normals;
+    Ok(b)
+}
+
+/// Start of the error [`refine_hull`] gives when the round bound is reached.
+const STILL_INTERSECT: &str = "face tetrahedra still intersect after";
+
+/// The refinement loop of §3.1 with one split rule: the refined mesh, its hull, the number of
+/// split edges and of replaced normals.
+fn refine_hull(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    normals: &[DVec3],
+    hopts: &HullOptions,
+    opts: &RationalOptions,
+    rule: SplitRule,
+) -> Result<(RefineMesh, OuterHull, usize, usize)> {
     let mut mesh = RefineMesh {
         positions: positions.to_vec(),
         normals: normals.to_vec(),
@@ -499,7 +554,7 @@ pub fn build(
     let mut rounds = 0;
     let mut replaced_normals = repair_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals);
     let hull = loop {
-        let hull = outer::build(&mesh.positions, &mesh.triangles, &mesh.normals, &hopts)
+        let hull = outer::build(&mesh.positions, &mesh.triangles, &mesh.normals, hopts)
             .map_err(|e| {
                 if rounds == 0 {
                     e
@@ -516,7 +571,7 @@ pub fn build(
         if rounds >= opts.refine_rounds {
             let e = hull.edges[bad[0] as usize];
             return Err(Error::Invalid(format!(
-                "face tetrahedra still intersect after {} rounds of refinement ({} edges, e.g. \
+                "{STILL_INTERSECT} {} rounds of refinement ({} edges, e.g. \
                  the edge between vertices {} and {}); try a smaller `epsilon` or smoother normals",
                 opts.refine_rounds,
                 bad.len(),
@@ -524,22 +579,12 @@ pub fn build(
                 e.v[1]
             )));
         }
-        let n = outer::refine::split_edges(&mut mesh, &bad)?;
+        let n = outer::refine::split_edges_with(&mut mesh, &bad, rule)?;
         refined += n;
         rounds += 1;
         replaced_normals += repair_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals);
     };
-    let RefineMesh {
-        positions,
-        normals,
-        triangles,
-        origin,
-    } = mesh;
-    let mut b = assemble(
-        &positions, &triangles, &normals, &origin, &hull, refined, opts,
-    )?;
-    b.replaced_normals = replaced_normals;
-    Ok(b)
+    Ok((mesh, hull, refined, replaced_normals))
 }
 
 /// The documented fallback for vertex normals that are not strictly above every triangle
