@@ -140,47 +140,96 @@ pub struct CompiledPatch<'a> {
     form: Option<&'a RationalForm>,
 }
 
-/// Bernstein coefficients (degree |μ|) of α(s)^μ with α(s) = (1−s)a + s·b.
-#[inline]
-fn monomial_segment(mu: [u8; 4], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
-    out[0] = 1.0;
-    let mut len = 1;
-    for i in 0..4 {
-        for _ in 0..mu[i] {
-            // Multiply by (1−s)a_i + s·b_i in place, from the top coefficient down.
-            let k = len;
-            out[k] = 0.0;
-            for j in (0..=k).rev() {
-                let up = if j > 0 { out[j - 1] * b[i] } else { 0.0 };
-                let stay = if j < k { out[j] * a[i] } else { 0.0 };
-                out[j] = (stay * (k - j) as f64 + up * j as f64) / k as f64;
-            }
-            len += 1;
+/// Binomial coefficients C(m, j) and their inverses for m ≤ [`MAX_DEGREE`] (exact in f64).
+const BINOM: [[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1] = {
+    let mut t = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+    let mut m = 0;
+    while m <= MAX_DEGREE {
+        t[m][0] = 1.0;
+        let mut j = 1;
+        while j <= m {
+            t[m][j] = t[m - 1][j - 1] + if j < m { t[m - 1][j] } else { 0.0 };
+            j += 1;
         }
+        m += 1;
     }
-    len - 1
+    t
+};
+const INV_BINOM: [[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1] = {
+    let mut t = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+    let mut m = 0;
+    while m <= MAX_DEGREE {
+        let mut j = 0;
+        while j <= m {
+            t[m][j] = 1.0 / BINOM[m][j];
+            j += 1;
+        }
+        m += 1;
+    }
+    t
+};
+
+// The rational part of a segment is built in the *scaled* Bernstein basis, d_j = C(m, j)·c_j
+// (f(s) = Σ d_j s^j (1−s)^(m−j)): there a product is the plain convolution of the coefficient
+// sequences, multiplying by a linear factor (1−s)·a + s·b is d'_j = a·d_j + b·d_(j−1), and
+// degree elevation is multiplying by (1−s) + s. No binomial and no division until the one
+// conversion back at the end.
+
+/// Multiplies the scaled polynomial `d` of degree `deg` by (1−s)·a + s·b; returns deg + 1.
+#[inline(always)]
+fn scaled_mul_linear(d: &mut Coeffs, deg: usize, a: f64, b: f64) -> usize {
+    d[deg + 1] = b * d[deg];
+    for j in (1..=deg).rev() {
+        d[j] = a * d[j] + b * d[j - 1];
+    }
+    d[0] *= a;
+    deg + 1
 }
 
-/// Sum into `acc` (degree `*deg`) the polynomial `p` of degree `d`, elevating as needed.
+/// Scaled coefficients of w·α(s)^μ with α(s) = (1−s)a + s·b; returns the degree |μ|.
 #[inline]
-fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
+fn scaled_monomial(mu: [u8; 4], w: f64, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
+    out[0] = w;
+    let mut deg = 0;
+    for i in 0..4 {
+        for _ in 0..mu[i] {
+            deg = scaled_mul_linear(out, deg, a[i], b[i]);
+        }
+    }
+    deg
+}
+
+/// `acc` (degree `*deg`) += `p` (degree `d`), elevating the lower one (scaled basis).
+#[inline]
+fn scaled_add(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
+    if d == *deg {
+        for k in 0..=d {
+            acc[k] += p[k];
+        }
+        return;
+    }
     let mut q = *p;
     let mut dq = d;
     while dq < *deg {
-        dq = uni::elevate_in_place(&mut q, dq + 1) - 1;
+        dq = scaled_mul_linear(&mut q, dq, 1.0, 1.0);
     }
     while *deg < dq {
-        *deg = uni::elevate_in_place(acc, *deg + 1) - 1;
+        *deg = scaled_mul_linear(acc, *deg, 1.0, 1.0);
     }
     for k in 0..=*deg {
         acc[k] += q[k];
     }
 }
 
-/// `out[..=m+n]` = the product of `p[..=m]` and `q[..=n]`.
+/// `out[..=m+n]` = the product of `p[..=m]` and `q[..=n]` (scaled basis: a convolution).
 #[inline]
-fn product(p: &Coeffs, m: usize, q: &Coeffs, n: usize, out: &mut Coeffs) {
-    uni::multiply_into(&p[..=m], &q[..=n], out);
+fn scaled_product(p: &Coeffs, m: usize, q: &Coeffs, n: usize, out: &mut Coeffs) {
+    out[..=m + n].fill(0.0);
+    for i in 0..=m {
+        for j in 0..=n {
+            out[i + j] += p[i] * q[j];
+        }
+    }
 }
 
 /// BB weights of the product of two homogeneous BB polynomials of degrees `m` and `k`:
@@ -637,64 +686,83 @@ impl CompiledPatch<'_> {
         let Some(form) = self.form else {
             return n;
         };
-        // G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group.
+        // G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group in the scaled
+        // basis (see `scaled_mul_linear`).
+        let mut g = [0.0; MAX_DEGREE + 1];
+        for j in 0..=n {
+            g[j] = out[j] * BINOM[n][j];
+        }
         let mut w = self.numer.iter();
         let mut deg = n;
         let mut q = [0.0; MAX_DEGREE + 1]; // Π of the denominators so far
         q[0] = 1.0;
         let mut qdeg = 0;
-        for g in &form.groups {
+        let mut m = [0.0; MAX_DEGREE + 1];
+        for grp in &form.groups {
             let mut den = [0.0; MAX_DEGREE + 1];
             let mut dden = 0;
-            for mu in &g.denominator {
-                let mut m = [0.0; MAX_DEGREE + 1];
-                let d = monomial_segment(*mu, a, b, &mut m);
-                add_poly(&mut den, &mut dden, &m, d);
+            for (k, mu) in grp.denominator.iter().enumerate() {
+                if k == 0 {
+                    dden = scaled_monomial(*mu, 1.0, a, b, &mut den);
+                } else {
+                    let d = scaled_monomial(*mu, 1.0, a, b, &mut m);
+                    scaled_add(&mut den, &mut dden, &m, d);
+                }
             }
             let mut sum = [0.0; MAX_DEGREE + 1];
             let mut dsum = 0;
-            for t in &g.terms {
+            for (r, t) in grp.terms.iter().enumerate() {
                 let mut num = [0.0; MAX_DEGREE + 1];
                 let mut dnum = 0;
-                for mu in &t.numer {
+                for (k, mu) in t.numer.iter().enumerate() {
                     let wm = w.next().copied().unwrap_or(0.0);
-                    let mut m = [0.0; MAX_DEGREE + 1];
-                    let d = monomial_segment(*mu, a, b, &mut m);
-                    for x in &mut m[..=d] {
-                        *x *= wm;
+                    if k == 0 {
+                        dnum = scaled_monomial(*mu, wm, a, b, &mut num);
+                    } else {
+                        let d = scaled_monomial(*mu, wm, a, b, &mut m);
+                        scaled_add(&mut num, &mut dnum, &m, d);
                     }
-                    add_poly(&mut num, &mut dnum, &m, d);
                 }
-                let mut bern = [0.0; MAX_DEGREE + 1];
-                let dk = monomial_segment(t.kappa, a, b, &mut bern);
-                for x in &mut bern[..=dk] {
+                // N_r·B_r: multiply N_r by mult·α^κ one linear factor at a time.
+                for x in &mut num[..=dnum] {
                     *x *= t.mult;
                 }
-                let mut prod = [0.0; MAX_DEGREE + 1];
-                product(&num, dnum, &bern, dk, &mut prod);
-                add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
+                for i in 0..4 {
+                    for _ in 0..t.kappa[i] {
+                        dnum = scaled_mul_linear(&mut num, dnum, a[i], b[i]);
+                    }
+                }
+                if r == 0 {
+                    sum = num;
+                    dsum = dnum;
+                } else {
+                    scaled_add(&mut sum, &mut dsum, &num, dnum);
+                }
             }
             let mut left = [0.0; MAX_DEGREE + 1];
-            product(out, deg, &den, dden, &mut left);
+            scaled_product(&g, deg, &den, dden, &mut left);
             let mut dl = deg + dden;
             if qdeg == 0 {
                 // Π of no denominators is 1 (the only group of a face or edge patch).
-                add_poly(&mut left, &mut dl, &sum, dsum);
+                scaled_add(&mut left, &mut dl, &sum, dsum);
             } else {
                 let mut right = [0.0; MAX_DEGREE + 1];
-                product(&sum, dsum, &q, qdeg, &mut right);
-                add_poly(&mut left, &mut dl, &right, dsum + qdeg);
+                scaled_product(&sum, dsum, &q, qdeg, &mut right);
+                scaled_add(&mut left, &mut dl, &right, dsum + qdeg);
             }
-            *out = left;
+            g = left;
             deg = dl;
             if qdeg == 0 {
                 q = den;
             } else {
                 let mut nq = [0.0; MAX_DEGREE + 1];
-                product(&q, qdeg, &den, dden, &mut nq);
+                scaled_product(&q, qdeg, &den, dden, &mut nq);
                 q = nq;
             }
             qdeg += dden;
+        }
+        for j in 0..=deg {
+            out[j] = g[j] * INV_BINOM[deg][j];
         }
         deg
     }
