@@ -114,6 +114,8 @@ pub struct PatchHeader {
     offset: u32,
     /// Index of the rational form, or [`NO_FORM`].
     form: u16,
+    /// How many rational numerator weights follow the polynomial weights.
+    numer_len: u16,
     degree: u8,
     segment_degree: u8,
     base_order: u8,
@@ -138,6 +140,29 @@ pub struct CompiledPatch<'a> {
     weights: &'a [f64],
     numer: &'a [f64],
     form: Option<&'a RationalForm>,
+}
+
+/// α^μ and its gradient with respect to α1..α4: the value and gradient of
+/// [`monomial_jet`] by the same operations (so bit-identical), without the Hessian.
+#[inline]
+fn monomial_value_gradient(mu: [u8; 4], a: &[f64; 4]) -> (f64, [f64; 4]) {
+    let mut p = [1.0; 4];
+    let mut dp = [0.0; 4];
+    for i in 0..4 {
+        let e = i32::from(mu[i]);
+        p[i] = a[i].powi(e);
+        if e >= 1 {
+            dp[i] = f64::from(e) * a[i].powi(e - 1);
+        }
+    }
+    let v = p[0] * p[1] * p[2] * p[3];
+    let g = [
+        dp[0] * (p[1] * p[2] * p[3]),
+        dp[1] * (p[0] * p[2] * p[3]),
+        dp[2] * (p[0] * p[1] * p[3]),
+        dp[3] * (p[0] * p[1] * p[2]),
+    ];
+    (v, g)
 }
 
 /// Binomial coefficients C(m, j) and their inverses for m ≤ [`MAX_DEGREE`] (exact in f64).
@@ -347,13 +372,21 @@ impl PatchStore {
         let start = h.offset as usize;
         let nw = num_coeffs(usize::from(h.degree));
         let form = self.forms.get(usize::from(h.form));
-        let nn = form.map_or(0, RationalForm::numer_len);
+        let nn = usize::from(h.numer_len);
         CompiledPatch {
             h,
             weights: &self.data[start..start + nw],
             numer: &self.data[start + nw..start + nw + nn],
             form,
         }
+    }
+
+    /// The header of patch `i` alone: enough to clip a ray ([`PatchHeader::clip`]) before
+    /// touching the patch's weights.
+    #[must_use]
+    #[inline]
+    pub fn header(&self, i: usize) -> &PatchHeader {
+        &self.headers[i]
     }
 
     /// Bytes of the headers, the shared weights and the forms.
@@ -507,7 +540,10 @@ impl PatchStore {
             (l.min(w), h.max(w))
         });
         let numer: Vec<f64> = group_weights.into_iter().flatten().flatten().collect();
+        let numer_len = u16::try_from(numer.len())
+            .map_err(|_| format!("patch {index}: more than 65535 rational numerator weights"))?;
         let form = RationalForm { groups };
+        debug_assert_eq!(form.numer_len(), numer.len());
         let cleared = if form.groups.is_empty() {
             Vec::new()
         } else {
@@ -541,6 +577,7 @@ impl PatchStore {
             zero_tol,
             offset,
             form: form_id,
+            numer_len,
             degree: n as u8,
             segment_degree: segment_degree as u8,
             base_order: base_order.min(255) as u8,
@@ -549,6 +586,64 @@ impl PatchStore {
             no_zero,
         });
         Ok(())
+    }
+}
+
+impl PatchHeader {
+    /// Barycentric coordinates of `x`.
+    #[must_use]
+    #[inline]
+    pub fn bary(&self, x: DVec3) -> [f64; 4] {
+        let d = x - self.v0;
+        let a1 = self.grad[0].dot(d);
+        let a2 = self.grad[1].dot(d);
+        let a3 = self.grad[2].dot(d);
+        [1.0 - a1 - a2 - a3, a1, a2, a3]
+    }
+
+    /// The parameter interval [t0, t1] in which `o + t·d` lies inside the tetrahedron, with
+    /// α(o) and dα/dt (barycentrics along the ray are α(o) + t·rate), or `None`.
+    #[must_use]
+    #[inline]
+    pub fn clip(&self, o: DVec3, d: DVec3) -> Option<(f64, f64, [f64; 4], [f64; 4])> {
+        let a = self.bary(o);
+        let mut t0 = f64::NEG_INFINITY;
+        let mut t1 = f64::INFINITY;
+        let r1 = self.grad[0].dot(d);
+        let r2 = self.grad[1].dot(d);
+        let r3 = self.grad[2].dot(d);
+        let rate = [-(r1 + r2 + r3), r1, r2, r3];
+        // αi(t) = a_i + t·rate_i ≥ 0.
+        for i in 0..4 {
+            let r = rate[i];
+            if r > 0.0 {
+                t0 = t0.max(-a[i] / r);
+            } else if r < 0.0 {
+                t1 = t1.min(-a[i] / r);
+            } else if a[i] < 0.0 {
+                return None;
+            }
+        }
+        if !t0.is_finite() || !t1.is_finite() {
+            return None;
+        }
+        if t0 > t1 {
+            // A ray through a vertex or edge touches the closed tetrahedron in one point, which
+            // rounding can turn into an empty interval: keep it when the gap is rounding-sized.
+            if t0 - t1 > CLIP_SLACK * (t0.abs() + t1.abs()) {
+                return None;
+            }
+            let m = 0.5 * (t0 + t1);
+            return Some((m, m, a, rate));
+        }
+        Some((t0, t1, a, rate))
+    }
+
+    /// See [`CompiledPatch::no_zero`].
+    #[must_use]
+    #[inline]
+    pub fn no_zero(&self) -> bool {
+        self.no_zero
     }
 }
 
@@ -630,11 +725,7 @@ impl CompiledPatch<'_> {
     #[must_use]
     #[inline]
     pub fn bary(&self, x: DVec3) -> [f64; 4] {
-        let d = x - self.h.v0;
-        let a1 = self.h.grad[0].dot(d);
-        let a2 = self.h.grad[1].dot(d);
-        let a3 = self.h.grad[2].dot(d);
-        [1.0 - a1 - a2 - a3, a1, a2, a3]
+        self.h.bary(x)
     }
 
     /// The parameter interval [t0, t1] in which `o + t·d` lies inside the tetrahedron, with
@@ -642,37 +733,7 @@ impl CompiledPatch<'_> {
     #[must_use]
     #[inline]
     pub fn clip(&self, o: DVec3, d: DVec3) -> Option<(f64, f64, [f64; 4], [f64; 4])> {
-        let a = self.bary(o);
-        let mut t0 = f64::NEG_INFINITY;
-        let mut t1 = f64::INFINITY;
-        let r1 = self.h.grad[0].dot(d);
-        let r2 = self.h.grad[1].dot(d);
-        let r3 = self.h.grad[2].dot(d);
-        let rate = [-(r1 + r2 + r3), r1, r2, r3];
-        // αi(t) = a_i + t·rate_i ≥ 0.
-        for i in 0..4 {
-            let r = rate[i];
-            if r > 0.0 {
-                t0 = t0.max(-a[i] / r);
-            } else if r < 0.0 {
-                t1 = t1.min(-a[i] / r);
-            } else if a[i] < 0.0 {
-                return None;
-            }
-        }
-        if !t0.is_finite() || !t1.is_finite() {
-            return None;
-        }
-        if t0 > t1 {
-            // A ray through a vertex or edge touches the closed tetrahedron in one point, which
-            // rounding can turn into an empty interval: keep it when the gap is rounding-sized.
-            if t0 - t1 > CLIP_SLACK * (t0.abs() + t1.abs()) {
-                return None;
-            }
-            let m = 0.5 * (t0 + t1);
-            return Some((m, m, a, rate));
-        }
-        Some((t0, t1, a, rate))
+        self.h.clip(o, d)
     }
 
     /// Bernstein coefficients on s ∈ [0, 1] of F((1−s)·a + s·b) (barycentric endpoints), with
@@ -770,6 +831,14 @@ impl CompiledPatch<'_> {
     /// F, its gradient and Hessian with respect to the four barycentric variables at `alpha`.
     #[must_use]
     pub fn bary_derivatives(&self, alpha: &[f64; 4]) -> Jet {
+        self.bary_jet::<true>(alpha)
+    }
+
+    /// [`Self::bary_derivatives`], with the Hessian left 0 unless `HESSIAN`: the value and
+    /// gradient take the same operations either way (bit-identical), the gradient-only form
+    /// skips the second-order work the shading of most modes does not need.
+    #[inline]
+    fn bary_jet<const HESSIAN: bool>(&self, alpha: &[f64; 4]) -> Jet {
         let n = self.degree();
         let mut jet = Jet::default();
         if n == 1 {
@@ -789,7 +858,9 @@ impl CompiledPatch<'_> {
                 for j in 0..4 {
                     let d = work[IDX2[i][j]];
                     ci += alpha[j] * d;
-                    jet.h[i][j] = nf * (nf - 1.0) * d;
+                    if HESSIAN {
+                        jet.h[i][j] = nf * (nf - 1.0) * d;
+                    }
                 }
                 jet.v += alpha[i] * ci;
                 jet.g[i] = nf * ci;
@@ -798,17 +869,27 @@ impl CompiledPatch<'_> {
         let Some(form) = self.form else {
             return jet;
         };
+        let mono = |mu: [u8; 4]| {
+            if HESSIAN {
+                monomial_jet(mu, *alpha)
+            } else {
+                let (v, g) = monomial_value_gradient(mu, alpha);
+                (v, g, [[0.0; 4]; 4])
+            }
+        };
         let mut w = self.numer.iter();
         for g in &form.groups {
             // D = Σ α^μ over the group's monomials (shared by its terms).
             let (mut d, mut gd, mut hd) = (0.0, [0.0; 4], [[0.0; 4]; 4]);
             for mu in &g.denominator {
-                let (v, gv, hv) = monomial_jet(*mu, *alpha);
+                let (v, gv, hv) = mono(*mu);
                 d += v;
                 for i in 0..4 {
                     gd[i] += gv[i];
-                    for k in 0..4 {
-                        hd[i][k] += hv[i][k];
+                    if HESSIAN {
+                        for k in 0..4 {
+                            hd[i][k] += hv[i][k];
+                        }
                     }
                 }
             }
@@ -816,12 +897,14 @@ impl CompiledPatch<'_> {
                 let (mut nv, mut gn, mut hn) = (0.0, [0.0; 4], [[0.0; 4]; 4]);
                 for mu in &t.numer {
                     let wm = w.next().copied().unwrap_or(0.0);
-                    let (v, gv, hv) = monomial_jet(*mu, *alpha);
+                    let (v, gv, hv) = mono(*mu);
                     nv += wm * v;
                     for i in 0..4 {
                         gn[i] += wm * gv[i];
-                        for k in 0..4 {
-                            hn[i][k] += wm * hv[i][k];
+                        if HESSIAN {
+                            for k in 0..4 {
+                                hn[i][k] += wm * hv[i][k];
+                            }
                         }
                     }
                 }
@@ -830,18 +913,25 @@ impl CompiledPatch<'_> {
                     continue;
                 }
                 let c = t.mult;
-                let (bv, gb, hb) = monomial_jet(t.kappa, *alpha);
-                let (bv, gb, hb) = (c * bv, gb.map(|x| c * x), hb.map(|r| r.map(|x| c * x)));
+                let (bv, gb, hb) = mono(t.kappa);
+                let (bv, gb) = (c * bv, gb.map(|x| c * x));
+                let hb = if HESSIAN {
+                    hb.map(|r| r.map(|x| c * x))
+                } else {
+                    hb
+                };
                 // q = N/D, ∇q = (∇N − q∇D)/D, Hq = (HN − q HD − ∇q∇Dᵀ − ∇D∇qᵀ)/D.
                 let qv = nv / d;
                 let gq: [f64; 4] = std::array::from_fn(|i| (gn[i] - qv * gd[i]) / d);
                 jet.v += qv * bv;
                 for i in 0..4 {
                     jet.g[i] += bv * gq[i] + qv * gb[i];
-                    for k in 0..4 {
-                        let hq = (hn[i][k] - qv * hd[i][k] - gq[i] * gd[k] - gd[i] * gq[k]) / d;
-                        // R = q·B: HR = B Hq + ∇q∇Bᵀ + ∇B∇qᵀ + q HB.
-                        jet.h[i][k] += bv * hq + gq[i] * gb[k] + gb[i] * gq[k] + qv * hb[i][k];
+                    if HESSIAN {
+                        for k in 0..4 {
+                            let hq = (hn[i][k] - qv * hd[i][k] - gq[i] * gd[k] - gd[i] * gq[k]) / d;
+                            // R = q·B: HR = B Hq + ∇q∇Bᵀ + ∇B∇qᵀ + q HB.
+                            jet.h[i][k] += bv * hq + gq[i] * gb[k] + gb[i] * gq[k] + qv * hb[i][k];
+                        }
                     }
                 }
             }
@@ -854,7 +944,7 @@ impl CompiledPatch<'_> {
     /// gradient is bit-identical to the one `derivatives` returns.
     #[must_use]
     pub fn value_gradient(&self, alpha: &[f64; 4]) -> (f64, DVec3) {
-        let j = self.bary_derivatives(alpha);
+        let j = self.bary_jet::<false>(alpha);
         let grad = self.grad();
         let mut g = DVec3::ZERO;
         for i in 0..4 {
