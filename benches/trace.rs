@@ -12,8 +12,8 @@
 use apatch::export::{tessellate, TriMesh};
 use apatch::fixtures::{quadric_complex, Quadric};
 use apatch::scene;
-use apatch::trace::shade::{cosine_direction, hash01};
-use apatch::trace::{self, Geometry, Light, Mode};
+use apatch::trace::shade::{self, hash01};
+use apatch::trace::{self, Geometry, Mode};
 use glam::{DVec3, Vec3A};
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::cwbvh::node::CwBvhNode;
@@ -181,40 +181,21 @@ impl Triangles {
         // relative) by a wide margin.
         let eps = 1e-4 * self.extent;
         let origin = of + df * t + n * eps;
-        let rho = s.lighting.albedo;
-        let mut out = DVec3::ZERO;
-        for light in &s.lighting.lights {
-            match *light {
-                Light::Directional {
-                    direction,
-                    irradiance,
-                } => {
-                    let l = -direction;
-                    let cos = nd.dot(l);
-                    if cos > 0.0 && !self.occluded(origin, f(l), eps, f32::INFINITY) {
-                        out += rho * irradiance * (cos / std::f64::consts::PI);
-                    }
-                }
-                Light::Point {
-                    position,
-                    intensity,
-                } => {
-                    let to = f(position) - origin;
-                    let r = to.length();
-                    let l = to / r;
-                    let cos = f64::from(n.dot(l));
-                    if cos > 0.0 && !self.occluded(origin, l, eps, r) {
-                        out += rho * intensity * (cos / (std::f64::consts::PI * f64::from(r * r)));
-                    }
-                }
-                Light::Constant { radiance } => {
-                    let l = cosine_direction(nd, [hash01(x, y, 0, 2), hash01(x, y, 0, 3)]);
-                    if !self.occluded(origin, f(l), eps, f32::INFINITY) {
-                        out += rho * radiance;
-                    }
-                }
-            }
-        }
+        let o64 = DVec3::new(
+            f64::from(origin.x),
+            f64::from(origin.y),
+            f64::from(origin.z),
+        );
+        let rnd = [hash01(x, y, 0, 2), hash01(x, y, 0, 3)];
+        // The patch tracer's light loop with f32 triangle occlusion.
+        let out = shade::direct_light(&s.lighting, nd, o64, rnd, |l, tmax| {
+            let tmax = if tmax.is_finite() {
+                tmax as f32
+            } else {
+                f32::INFINITY
+            };
+            self.occluded(origin, f(l), eps, tmax)
+        });
         (out, true)
     }
 
@@ -377,7 +358,20 @@ fn profile_shaded(
     }
 }
 
+/// The first three fields of `/proc/loadavg` (1, 5 and 15 minute load averages), or "?".
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "?".into())
+}
+
 fn main() {
+    println!(
+        "trace bench: {} CPUs, load average {} (1/5/15 min) at start",
+        std::thread::available_parallelism().map_or(0, std::num::NonZero::get),
+        load_average()
+    );
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     // The teapot waits in scenes/pending (it does not build yet): its line says why.
     let only = std::env::var("APATCH_BENCH_MODELS").ok();
@@ -451,4 +445,5 @@ irradiance = 3.0
     if only.is_none() {
         bench("sphere fixture (degree 3)", &c, &sc.settings);
     }
+    println!("load average {} (1/5/15 min) at the end", load_average());
 }

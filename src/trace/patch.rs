@@ -142,6 +142,80 @@ pub struct CompiledPatch<'a> {
     form: Option<&'a RationalForm>,
 }
 
+/// Position of the multi-index λ in the decreasing lexicographic order ([`index_of`], as a
+/// const fn for the step tables).
+const fn const_index_of(l: [usize; 4]) -> usize {
+    let n = l[0] + l[1] + l[2] + l[3];
+    let m = n - l[0];
+    m * (m + 1) * (m + 2) / 6 + (m - l[1]) * (m - l[1] + 1) / 2 + (m - l[1] - l[2])
+}
+
+/// For each multi-index μ of degree d − 1 (in order, `K` = C(d+2, 3) of them), the positions
+/// of μ + e_0 … μ + e_3 among the degree-d weights: one de Casteljau step reads those four.
+const fn step_table<const K: usize>(d: usize) -> [[u8; 4]; K] {
+    let mut t = [[0u8; 4]; K];
+    let n = d - 1;
+    let mut k = 0;
+    let mut a = n as isize;
+    while a >= 0 {
+        let mut b = (n as isize) - a;
+        while b >= 0 {
+            let mut c = (n as isize) - a - b;
+            while c >= 0 {
+                let mu = [a as usize, b as usize, c as usize, n - (a + b + c) as usize];
+                let mut i = 0;
+                while i < 4 {
+                    let mut up = mu;
+                    up[i] += 1;
+                    t[k][i] = const_index_of(up) as u8;
+                    i += 1;
+                }
+                k += 1;
+                c -= 1;
+            }
+            b -= 1;
+        }
+        a -= 1;
+    }
+    t
+}
+
+const STEP3: [[u8; 4]; 10] = step_table::<10>(3);
+const STEP2: [[u8; 4]; 4] = step_table::<4>(2);
+
+/// One de Casteljau step with the table `t`: w'_μ = Σ_i a_i·w_(μ+e_i) (the operations of
+/// `poly::step_into`, in the same order).
+#[inline(always)]
+fn step_with<const K: usize>(w: &[f64], t: &[[u8; 4]; K], a: &[f64; 4]) -> [f64; K] {
+    let mut out = [0.0; K];
+    for k in 0..K {
+        let [i0, i1, i2, i3] = t[k];
+        let (i0, i1, i2, i3) = (
+            usize::from(i0),
+            usize::from(i1),
+            usize::from(i2),
+            usize::from(i3),
+        );
+        out[k] = a[0] * w[i0] + a[1] * w[i1] + a[2] * w[i2] + a[3] * w[i3];
+    }
+    out
+}
+
+/// The cubic's restriction to the segment from `a` to `b` (Bernstein coefficients
+/// c_k = blossom(a^(3−k), b^k)): `poly::restrict` for degree 3 by the same steps in the same
+/// order, inlined into the ray loop (the cubic polynomial part of every 2001 patch).
+#[inline]
+fn restrict_cubic(w: &[f64], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) {
+    let w = &w[..20];
+    let (wa, wb) = (step_with(w, &STEP3, a), step_with(w, &STEP3, b));
+    let (waa, wbb) = (step_with(&wa, &STEP2, a), step_with(&wb, &STEP2, b));
+    let dot = |x: &[f64; 4], y: &[f64; 4]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3];
+    out[0] = dot(a, &waa);
+    out[1] = dot(b, &waa);
+    out[2] = dot(a, &wbb);
+    out[3] = dot(b, &wbb);
+}
+
 /// α^μ and its gradient with respect to α1..α4: the value and gradient of
 /// [`monomial_jet`] by the same operations (so bit-identical), without the Hessian.
 #[inline]
@@ -743,7 +817,11 @@ impl CompiledPatch<'_> {
     #[inline]
     pub fn segment(&self, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
         let n = self.degree();
-        poly::restrict(n, self.weights, *a, *b, out);
+        if n == 3 {
+            restrict_cubic(self.weights, a, b, out);
+        } else {
+            poly::restrict(n, self.weights, *a, *b, out);
+        }
         let Some(form) = self.form else {
             return n;
         };
@@ -1120,6 +1198,28 @@ mod tests {
                 "{hd} vs {}",
                 h.col(axis)
             );
+        }
+    }
+
+    #[test]
+    fn cubic_restriction_is_poly_restrict_bit_for_bit() {
+        // The inlined cubic restriction takes poly::restrict's steps in its order: equal bits
+        // on random weights and segments (barycentrics outside [0, 1] included).
+        let mut seed = 99u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 0.5
+        };
+        for _ in 0..200 {
+            let w: Vec<f64> = (0..20).map(|_| rnd()).collect();
+            let a = [rnd(), rnd(), rnd(), rnd()];
+            let b = [rnd(), rnd(), rnd(), rnd()];
+            let (mut x, mut y) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+            restrict_cubic(&w, &a, &b, &mut x);
+            poly::restrict(3, &w, a, b, &mut y);
+            assert_eq!(x[..4], y[..4]);
         }
     }
 

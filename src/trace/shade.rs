@@ -226,6 +226,25 @@ pub fn radiance(
     }
     let eps = SHADOW_OFFSET * geo.extent().max(1e-300);
     let origin = s.p + s.n * eps;
+    direct_light(lighting, s.n, origin, rnd, |l, tmax| {
+        geo.occluded(origin, l, eps, tmax)
+    })
+}
+
+/// The lights' contribution at a point with unit normal `n` seen from outside, one-sided
+/// diffuse: the light loop of [`radiance`] for any tracer. `origin` is the shadow rays'
+/// (already offset) origin; `occluded(l, tmax)` tells whether the ray `origin + t·l` meets
+/// the surface before `tmax` (∞ for directional and constant emitters, the distance to a
+/// point light). `rnd` samples the constant emitter's direction.
+#[must_use]
+#[inline]
+pub fn direct_light(
+    lighting: &Lighting,
+    n: DVec3,
+    origin: DVec3,
+    rnd: [f64; 2],
+    mut occluded: impl FnMut(DVec3, f64) -> bool,
+) -> DVec3 {
     let rho = lighting.albedo;
     let mut out = DVec3::ZERO;
     for light in &lighting.lights {
@@ -235,8 +254,8 @@ pub fn radiance(
                 irradiance,
             } => {
                 let l = -direction;
-                let c = s.n.dot(l);
-                if c > 0.0 && !geo.occluded(origin, l, eps, f64::INFINITY) {
+                let c = n.dot(l);
+                if c > 0.0 && !occluded(l, f64::INFINITY) {
                     out += rho * irradiance * (c / std::f64::consts::PI);
                 }
             }
@@ -251,15 +270,15 @@ pub fn radiance(
                     continue;
                 }
                 let l = to / r;
-                let c = s.n.dot(l);
-                if c > 0.0 && !geo.occluded(origin, l, eps, r) {
+                let c = n.dot(l);
+                if c > 0.0 && !occluded(l, r) {
                     out += rho * intensity * (c / (std::f64::consts::PI * r2));
                 }
             }
             Light::Constant { radiance } => {
                 // Cosine-weighted direction: the estimator is ρ·L·V.
-                let l = cosine_direction(s.n, rnd);
-                if !geo.occluded(origin, l, eps, f64::INFINITY) {
+                let l = cosine_direction(n, rnd);
+                if !occluded(l, f64::INFINITY) {
                     out += rho * radiance;
                 }
             }
