@@ -67,7 +67,9 @@ fn explore_all() {
 /// ≤ 1e-9, Hessian jumps ≤ 1e-7 (the checker's relative measures), vertex values and normals
 /// interpolated (rounding-level tolerances of the checker's defaults), the solve's own residual
 /// at rounding level. Non-trihedral vertices (octahedron, icosahedron), L-U pairs and
-/// relaxed (coplanar) stars (l_prism, corner_poly), genus 1 (torus).
+/// relaxed (coplanar) stars (l_prism, corner_poly), genus 1 (torus), and cube_poly, whose
+/// staged solve is inconsistent at the number 10 weights of its bottom edges (apexes in the
+/// planes of the faces) and is solved at once instead (the global fallback, a sparse group).
 #[test]
 fn inner_hull_models_are_c2() {
     for name in [
@@ -76,6 +78,7 @@ fn inner_hull_models_are_c2() {
         "l_prism.obj",
         "corner_poly.obj",
         "torus_quad12x8.obj",
+        "cube_poly.obj",
     ] {
         let path = Path::new("scenes/models").join(name);
         let (m, _) = mesh::load(&path).unwrap();
@@ -115,4 +118,56 @@ fn inner_hull_models_are_c2() {
             assert!(r.passed(), "{name}: {:?}", r.failures());
         }
     }
+}
+
+/// Large coplanar regions (star_prism: 30 relaxed stars couple into one group of over 3000
+/// weights) build with exact C2 through the sparse solver. Its hull overlaps (another
+/// module's issue), so `apatch check` fails on T-junctions and j-lines; the continuity
+/// measures and interpolation must hold regardless.
+#[test]
+fn large_coplanar_regions_are_c2() {
+    let name = "star_prism.obj";
+    let c = c2_of(name, 3000);
+    let r = check(&c, &CheckOptions::default());
+    assert!(
+        r.gradient_jump.worst <= 1e-9,
+        "{name}: {:?}",
+        r.gradient_jump
+    );
+    assert!(r.hessian_jump.worst <= 1e-7, "{name}: {:?}", r.hessian_jump);
+    let f: Vec<&str> = r
+        .failures()
+        .into_iter()
+        .filter(|f| *f != "multiple sheets along j-lines" && *f != "t-junctions")
+        .collect();
+    assert!(f.is_empty(), "{name}: {f:?}");
+}
+
+/// torus_quad (quad faces in 50 coplanar stars, a group of over 7000 weights): as above;
+/// ignored because it takes ~20 s in release (extra evidence beside star_prism).
+#[test]
+#[ignore = "slow (~20 s release): extra evidence for the sparse solver beside star_prism"]
+fn torus_quad_is_c2() {
+    let c = c2_of("torus_quad.obj", 7000);
+    let r = check(&c, &CheckOptions::default());
+    assert!(r.gradient_jump.worst <= 1e-9, "{:?}", r.gradient_jump);
+    assert!(r.hessian_jump.worst <= 1e-7, "{:?}", r.hessian_jump);
+}
+
+/// Builds `name`'s quintic complex and checks that the solve went through a sparse group of at
+/// least `min_group` weights with a rounding-level residual.
+fn c2_of(name: &str, min_group: usize) -> apatch::complex::PatchComplex {
+    let path = Path::new("scenes/models").join(name);
+    let (m, _) = mesh::load(&path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+    let (c, stats) = build_with_stats(&hull, &QuinticOptions::default()).unwrap();
+    assert!(
+        stats.sparse_groups >= 1 && stats.largest_group >= min_group,
+        "{name}: {stats:?}"
+    );
+    // Relative residual: the sparse solve stops at 1e-13 of the group's largest datum; the
+    // global measure divides by the largest weight.
+    assert!(stats.max_residual < 1e-12, "{name}: {stats:?}");
+    c
 }
