@@ -171,3 +171,49 @@ fn c2_of(name: &str, min_group: usize) -> apatch::complex::PatchComplex {
     assert!(stats.max_residual < 1e-12, "{name}: {stats:?}");
     c
 }
+
+/// Every shipped quintic scene is closed as traced: no primary ray's first hit faces away
+/// from the camera (a ray that meets the surface's inside first went through a crack, such as
+/// the one the estimated curvature opened on cube_poly before its scene chose planar jets).
+/// `apatch check` samples lines from the patches' vertices and does not see such cracks.
+#[test]
+fn quintic_scenes_have_no_cracks() {
+    use apatch::trace::{self, Geometry, Mode};
+    use std::sync::atomic::AtomicBool;
+    let mut scenes: Vec<_> = std::fs::read_dir("scenes/paper1994")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with("_quintic.toml"))
+        // Known wrong, reported in docs/quintic.md: on the 12×8 torus 613 of the 160×160 rays
+        // (161 for the cubic scheme on the same hull) first meet a back face, through holes at
+        // the dimples near the apexes, which `apatch check` does not detect either.
+        .filter(|p| !p.to_string_lossy().contains("torus_quad12x8"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 6, "{scenes:?}");
+    for path in scenes {
+        let sc = apatch::scene::load(&path).unwrap();
+        let complex = apatch::scene::build_complex(&sc).unwrap();
+        let geo = Geometry::new(&complex).unwrap();
+        let mut s = sc.settings.clone();
+        s.camera = s.camera.resized(160, 160).unwrap();
+        s.spp = 1;
+        s.threads = 1;
+        s.mode = Mode::Normal;
+        let origin = s.camera.origin;
+        let frame = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
+        let back = frame
+            .pixels
+            .iter()
+            .filter(|p| p.alpha > 0.0)
+            .filter(|p| {
+                let n = glam::DVec3::from(p.normal.map(f64::from));
+                let d = (glam::DVec3::from(p.position.map(f64::from)) - origin).normalize();
+                // A hit through a crack faces away clearly (0.7 on cube_poly); grazing hits
+                // at the silhouette are within a few degrees of 0 (f32 normals).
+                n.dot(d) > 0.1
+            })
+            .count();
+        assert_eq!(back, 0, "{}: {back} back-facing first hits", path.display());
+    }
+}
