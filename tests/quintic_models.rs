@@ -178,42 +178,115 @@ fn c2_of(name: &str, min_group: usize) -> apatch::complex::PatchComplex {
 /// `apatch check` samples lines from the patches' vertices and does not see such cracks.
 #[test]
 fn quintic_scenes_have_no_cracks() {
-    use apatch::trace::{self, Geometry, Mode};
-    use std::sync::atomic::AtomicBool;
     let mut scenes: Vec<_> = std::fs::read_dir("scenes/paper1994")
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.to_string_lossy().ends_with("_quintic.toml"))
         // Known wrong, reported in docs/quintic.md: on the 12×8 torus 613 of the 160×160 rays
-        // (161 for the cubic scheme on the same hull) first meet a back face, through holes at
-        // the dimples near the apexes, which `apatch check` does not detect either.
+        // (161 for the cubic scheme on the same hull) first meet a back face, through holes
+        // where 24 single-sided face patches cross their base triangle on T (`base_crossings`),
+        // which `apatch check` does not detect either.
         .filter(|p| !p.to_string_lossy().contains("torus_quad12x8"))
         .collect();
     scenes.sort();
     assert!(scenes.len() >= 6, "{scenes:?}");
     for path in scenes {
-        let sc = apatch::scene::load(&path).unwrap();
-        let complex = apatch::scene::build_complex(&sc).unwrap();
-        let geo = Geometry::new(&complex).unwrap();
-        let mut s = sc.settings.clone();
-        s.camera = s.camera.resized(160, 160).unwrap();
-        s.spp = 1;
-        s.threads = 1;
-        s.mode = Mode::Normal;
-        let origin = s.camera.origin;
-        let frame = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
-        let back = frame
-            .pixels
-            .iter()
-            .filter(|p| p.alpha > 0.0)
-            .filter(|p| {
-                let n = glam::DVec3::from(p.normal.map(f64::from));
-                let d = (glam::DVec3::from(p.position.map(f64::from)) - origin).normalize();
-                // A hit through a crack faces away clearly (0.7 on cube_poly); grazing hits
-                // at the silhouette are within a few degrees of 0 (f32 normals).
-                n.dot(d) > 0.1
-            })
-            .count();
+        let back = back_facing_hits(&path);
         assert_eq!(back, 0, "{}: {back} back-facing first hits", path.display());
     }
+}
+
+/// Exploration: `SCENE=path cargo test --release --test quintic_models crack_count -- --ignored
+/// --nocapture` prints the back-facing first hits of a scene.
+#[test]
+#[ignore = "exploration: SCENE=path"]
+fn crack_count() {
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    eprintln!("{}: {}", path.display(), back_facing_hits(&path));
+}
+
+/// Primary rays (160×160, 1 spp) of the scene at `path` whose first hit faces away from the
+/// camera.
+fn back_facing_hits(path: &Path) -> usize {
+    use apatch::trace::{self, Geometry, Mode};
+    use std::sync::atomic::AtomicBool;
+    let sc = apatch::scene::load(path).unwrap();
+    let complex = apatch::scene::build_complex(&sc).unwrap();
+    let geo = Geometry::new(&complex).unwrap();
+    let mut s = sc.settings.clone();
+    s.camera = s.camera.resized(160, 160).unwrap();
+    s.spp = 1;
+    s.threads = 1;
+    s.mode = Mode::Normal;
+    let origin = s.camera.origin;
+    let frame = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
+    frame
+        .pixels
+        .iter()
+        .filter(|p| p.alpha > 0.0)
+        .filter(|p| {
+            let n = glam::DVec3::from(p.normal.map(f64::from));
+            let d = (glam::DVec3::from(p.position.map(f64::from)) - origin).normalize();
+            // A hit through a crack faces away clearly (0.7 on cube_poly); grazing hits
+            // at the silhouette are within a few degrees of 0 (f32 normals).
+            n.dot(d) > 0.1
+        })
+        .count()
+}
+
+/// Exploration: face patches of a scene whose zero set crosses the base triangle on T (F takes
+/// the apex's sign somewhere inside the base), which opens a hole in the surface.
+#[test]
+#[ignore = "exploration: SCENE=path"]
+fn base_crossings() {
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    let sc = apatch::scene::load(&path).unwrap();
+    let c = apatch::scene::build_complex(&sc).unwrap();
+    let (mut bad, mut faces) = (0, 0);
+    let base = |p: &apatch::complex::Patch| {
+        let mut b: Vec<[u64; 3]> = p.tet[..3].iter().map(|v| v.map(f64::to_bits)).collect();
+        b.sort_unstable();
+        b
+    };
+    let mut count = std::collections::HashMap::new();
+    for p in &c.patches {
+        if p.role == apatch::complex::Role::Face {
+            *count.entry(base(p)).or_insert(0) += 1;
+        }
+    }
+    for (k, p) in c.patches.iter().enumerate() {
+        // Single-sided face tetrahedra only: an L-U pair's base is inside the hull.
+        if p.role != apatch::complex::Role::Face || count[&base(p)] > 1 {
+            continue;
+        }
+        faces += 1;
+        let n = usize::from(p.degree);
+        let apex = p.weights[apatch::bb::index_of([0, 0, 0, p.degree])];
+        let m = 24;
+        let mut worst = 0.0_f64;
+        for i in 1..m {
+            for j in 1..m - i {
+                let a = [
+                    i as f64 / m as f64,
+                    j as f64 / m as f64,
+                    (m - i - j) as f64 / m as f64,
+                    0.0,
+                ];
+                let f = apatch::bb::poly::eval(n, &p.weights, a);
+                if f * apex > 0.0 {
+                    worst = worst.max(f.abs());
+                }
+            }
+        }
+        if worst > 0.0 {
+            bad += 1;
+            if bad <= 5 {
+                eprintln!("patch {k}: apex F {apex:.3e}, base F up to {worst:.3e} with its sign; tet {:?}", p.tet);
+            }
+        }
+    }
+    eprintln!(
+        "{}: {bad} of {faces} single-sided face patches cross their base",
+        path.display()
+    );
 }
