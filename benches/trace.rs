@@ -351,10 +351,40 @@ fn compare(
     );
 }
 
+/// `APATCH_BENCH_PROFILE=N`: only the first selected model's patch tracer, shaded, 1 thread,
+/// N renders (a steady loop for `perf record`); prints rays per CPU-second per render.
+fn profile_shaded(
+    name: &str,
+    complex: &apatch::complex::PatchComplex,
+    settings: &trace::RenderSettings,
+    n: usize,
+) {
+    let geo = Geometry::new(complex).expect("compiles");
+    let mut s = settings.clone();
+    s.camera = s.camera.resized(1024, 1024).unwrap();
+    s.spp = 1;
+    s.mode = Mode::Shaded;
+    s.threads = 1;
+    for _ in 0..n {
+        let cpu = cpu_seconds();
+        let f = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
+        let cpu = cpu_seconds() - cpu;
+        let sum: f64 = f.pixels.iter().map(|p| f64::from(p.rgb[0])).sum();
+        println!(
+            "{name} shaded 1 thread: {:.2} M rays per CPU-second (sum R {sum:.6})",
+            1.048_576 / cpu
+        );
+    }
+}
+
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     // The teapot waits in scenes/pending (it does not build yet): its line says why.
     let only = std::env::var("APATCH_BENCH_MODELS").ok();
+    let profile: usize = std::env::var("APATCH_BENCH_PROFILE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
     for (name, dir) in [
         ("teapot", "scenes/pending"),
         ("teapot", "scenes"),
@@ -380,6 +410,10 @@ fn main() {
         };
         let t = Instant::now();
         match scene::build_complex(&sc) {
+            Ok(c) if profile > 0 => {
+                profile_shaded(name, &c, &sc.settings, profile);
+                return;
+            }
             Ok(c) => {
                 println!(
                     "{name}: complex built in {:.2} s",

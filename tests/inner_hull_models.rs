@@ -65,7 +65,7 @@ fn explore_all() {
     }
 }
 
-/// Non-convex polygon models (Algorithm 2 via convex pieces) and the real models: each builds, its
+/// Non-convex polygon models (Algorithm 2: kernel guards or convex pieces) and the real models: each builds, its
 /// T is a closed oriented manifold of the input's genus, the non-convex polygons are split into
 /// corner guards lying in their polygons' planes, and every corner guard net edge is zero convex.
 /// (Overlaps between tetrahedra are still reported on these: see ARCHITECTURE.md.)
@@ -75,7 +75,7 @@ fn nonconvex_and_real_models_give_closed_hulls() {
     use apatch::hull::simplicial::PointOrigin;
     for (name, nonconvex) in [
         ("l_prism.obj", true),
-        ("hallway_corner.obj", false),
+        ("hallway_corner.obj", true),
         ("star_prism.obj", true),
         ("corner_poly.obj", true),
         ("letter_P_poly.obj", false),
@@ -83,14 +83,20 @@ fn nonconvex_and_real_models_give_closed_hulls() {
         ("mpi_poly.obj", true),
         ("spot.obj", false),
         ("bunny_npm_lowres.obj", false),
-        ("fandisk.obj", false),
+        ("fandisk.obj", true), // flat regions merged into non-convex polygons
     ] {
         let path = Path::new("scenes/models").join(name);
         let (m, _) = mesh::load(&path).unwrap();
         let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
         let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default())
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(!rep.split_faces.is_empty(), nonconvex, "{name}");
+        // Non-convex polygons (after coplanar triangles are merged: the hallway corner's caps)
+        // are kept whole with one kernel guard when star shaped, else split.
+        assert_eq!(
+            !rep.split_faces.is_empty() || !rep.star_faces.is_empty(),
+            nonconvex,
+            "{name}"
+        );
         let topo = mesh::Topology::new(m.positions.len(), &m.faces);
         let chi = m.positions.len() as i64 - topo.edges.len() as i64 + m.faces.len() as i64;
         assert_eq!(euler_characteristic(&hull), Some(chi), "{name}: genus");

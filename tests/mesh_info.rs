@@ -66,6 +66,10 @@ fn text_output_and_exit_codes() {
     let (code, out, _) = info(&["scenes/models/teapot_npm.obj"]);
     assert_eq!(code, 1);
     assert!(out.contains("boundary edges"), "{out}");
+    // The spout touches the body at one vertex: split, reported as a repaired warning.
+    assert!(out.contains("split into one vertex per fan"), "{out}");
+    assert!(out.contains("vertex 115 (line 123)"), "{out}");
+    assert!(!out.contains("non-manifold (their faces"), "{out}");
     // `file` normals on a model without them: still describes the mesh, exit 1.
     let (code, out, _) = info(&["--normals", "file", "scenes/models/cube.obj"]);
     assert_eq!(code, 1);

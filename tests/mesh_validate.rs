@@ -56,14 +56,53 @@ fn non_manifold_edge() {
     assert!(r.require(false).is_err());
 }
 
+/// Two closed tetrahedra touching at one vertex (a bow-tie of solids): the vertex is split into
+/// one vertex per fan, and the result is two closed genus-0 components.
 #[test]
-fn non_manifold_vertex() {
-    let (_, r) = corpus("nonmanifold_vertex.obj");
-    assert_eq!(
-        elements(&r, FindingKind::NonManifoldVertex),
-        vec![vertex(0, 1)]
-    );
+fn non_manifold_vertex_is_split() {
+    let (m, r) = corpus("nonmanifold_vertex.obj");
+    assert_eq!(elements(&r, FindingKind::SplitVertex), vec![vertex(0, 1)]);
+    assert!(r.get(FindingKind::NonManifoldVertex).is_none());
     assert!(r.get(FindingKind::NonManifoldEdge).is_none());
+    assert!(r.require(true).is_ok(), "{:#?}", r.findings);
+    // 7 file vertices + 1 copy of vertex 0, appended with its line, moved a relative 1e-6 into
+    // its own fan (so the two sheets do not share a point).
+    assert_eq!(m.positions.len(), 8);
+    let d = (m.positions[7] - m.positions[0]).length();
+    assert!(d > 0.0 && d < 1e-5, "{d}");
+    assert_eq!(m.vertex_lines[7], 1);
+    let t = Topology::new(m.positions.len(), &m.faces);
+    assert_eq!(t.components().0, 2);
+    assert_eq!(t.edges.len(), 12);
+    assert_eq!(t.boundary_loops(), 0);
+    for v in 0..m.positions.len() as u32 {
+        let fan = t
+            .vertex_fan(v)
+            .expect("every vertex is manifold after the split");
+        assert!(fan.closed);
+        assert_eq!(fan.faces.len(), 3, "vertex {v}");
+    }
+    let s = mesh::summary(&m, &r, mesh::NormalMethod::Angle);
+    // V − E + F = 8 − 12 + 8 = 4 − 6 + 4 twice: two spheres.
+    assert_eq!(s.euler_characteristic, 4);
+    assert_eq!(s.genus, Some(0));
+    assert_eq!(s.non_manifold_vertices, 0);
+    assert_consistent(&m);
+}
+
+/// A bow-tie of two triangles sharing only a vertex (open surfaces): split, and each triangle
+/// keeps its three boundary edges.
+#[test]
+fn bow_tie_triangles_are_split() {
+    let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n";
+    let (m, r) = mesh::load_bytes(text.as_bytes(), Format::Obj, Path::new("bowtie.obj")).unwrap();
+    assert_eq!(elements(&r, FindingKind::SplitVertex), vec![vertex(0, 1)]);
+    assert!(r.is_manifold());
+    assert_eq!(m.positions.len(), 6);
+    let t = Topology::new(m.positions.len(), &m.faces);
+    assert_eq!(t.components().0, 2);
+    assert_eq!(t.boundary_loops(), 2);
+    assert!((0..6).all(|v| t.vertex_fan(v).is_some_and(|f| !f.closed)));
 }
 
 #[test]

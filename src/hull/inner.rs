@@ -3,13 +3,20 @@
 //! ([`SimplicialHull`], Definition 3.6).
 //!
 //! Pipeline ([`build_with_report`]):
-//! 1. [`decompose`]: non-convex polygons are split into convex pieces whose centroids are the
-//!    corner guards (Algorithm 2 reduced to Algorithm 1, as §4 allows).
-//! 2. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
+//! 1. [`coplanar`]: edge-adjacent coplanar faces are merged into one polygon (one face per
+//!    plane, as the paper's polyhedra have; Appendix B's coplanarity treated at its source).
+//! 2. [`decompose`]: corner guards (§5, Algorithm 2 step (1)). A star-shaped non-convex polygon
+//!    keeps one guard, the centroid of its kernel (it sees every corner); other non-convex
+//!    polygons are split into convex pieces whose centroids are the guards (Algorithm 2
+//!    reduced to Algorithm 1, as §4 allows).
+//! 3. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
 //!    Appendix C) by rotating it where needed; corners where no direction is above all faces
 //!    are reported as errors.
-//! 3. [`corner`]: Algorithm 1 steps (3)–(5) vertex by vertex: T and the face tetrahedra.
-//! 4. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//! 4. [`corner`]: Algorithm 1 steps (3)–(5) vertex by vertex, with Algorithm 2's step (3')
+//!    for hallway corners (trihedral, one reflex face angle): T and the face tetrahedra; then
+//!    [`corner::spread_hallway_apexes`] moves the hallway corners' outer apexes off the
+//!    concave edge so the edge tetrahedra there are not inverted.
+//! 5. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
 //!
 //! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
 //!
@@ -21,6 +28,7 @@
 //! carries it ([`InnerOptions::trihedral_level`]).
 
 pub mod above;
+pub mod coplanar;
 pub mod corner;
 pub mod decompose;
 pub mod verify;
@@ -122,6 +130,8 @@ pub struct InnerReport {
     pub adjusted_normals: Vec<(u32, DVec3)>,
     /// Non-convex input polygons split into convex pieces (corner guards), with the piece count.
     pub split_faces: Vec<(u32, usize)>,
+    /// Non-convex but star-shaped input polygons kept whole, with their single corner guard.
+    pub star_faces: Vec<(u32, DVec3)>,
     /// Non-trihedral vertices that are unseparable from their face centroids (C_0 = V).
     pub unseparable: Vec<u32>,
     /// How the face tetrahedra were chosen.
@@ -167,28 +177,28 @@ pub fn build_with_report(
     }
     let line = |v: usize| mesh.vertex_lines.get(v).copied().unwrap_or(0);
     let mut report = InnerReport::default();
+    let merged = coplanar::merge_coplanar(mesh);
+    let mesh = &merged;
     let pieces = decompose::convex_pieces(mesh)?;
-    report.split_faces.clone_from(&pieces.split);
+    let input_face = |f: u32| mesh.face_parent[f as usize];
+    report.split_faces = pieces
+        .split
+        .iter()
+        .map(|&(f, n)| (input_face(f), n))
+        .collect();
+    report.star_faces = pieces
+        .star
+        .iter()
+        .map(|&(f, g)| (input_face(f), g))
+        .collect();
     let topo = Topology::new(nv, &pieces.faces);
 
     let mut hull = SimplicialHull::default();
-    let mean = |face: &[u32]| {
-        face.iter()
-            .map(|&v| mesh.positions[v as usize])
-            .sum::<DVec3>()
-            / face.len() as f64
-    };
-    for (f, piece) in pieces.faces.iter().enumerate() {
-        let mut c = mean(piece);
-        if pieces.guard[f] {
-            // Corner guards of one polygon lie exactly in its plane (through its vertex mean),
-            // so the guard net's edges are zero convex even when the polygon is slightly bent.
-            let o = mean(&mesh.faces[pieces.parent[f] as usize]);
-            c -= pieces.normal[f].dot(c - o) * pieces.normal[f];
-        }
+    for (f, _) in pieces.faces.iter().enumerate() {
+        let c = pieces.center[f];
         hull.points.push(c);
         hull.normals.push(pieces.normal[f]);
-        let face = pieces.parent[f];
+        let face = mesh.face_parent[pieces.parent[f] as usize];
         hull.origins.push(if pieces.guard[f] {
             PointOrigin::CornerGuard { face }
         } else {
@@ -196,6 +206,7 @@ pub fn build_with_report(
         });
     }
     let mut ring = Vec::new();
+    let mut hallway = Vec::new();
     #[allow(clippy::needless_range_loop)] // v indexes positions, normals, lines and topology
     for v in 0..nv {
         if topo.vertex_corners(v as u32).is_empty() {
@@ -252,16 +263,25 @@ pub fn build_with_report(
         }
         ring.clear();
         ring.extend(fan.ring.iter().map(|&w| mesh.positions[w as usize]));
+        let reflex = (0..fan.faces.len()).find(|&i| {
+            let a = ring[i] - mesh.positions[v];
+            let b = ring[(i + 1) % ring.len()] - mesh.positions[v];
+            // Reflex when the turn at V is clockwise in the face's plane, beyond rounding of
+            // the edge vectors (1e-12 relative).
+            a.cross(b).dot(pieces.normal[fan.faces[i] as usize]) < -1e-12 * a.length() * b.length()
+        });
         let c = corner::Corner {
             vertex: v as u32,
             v: mesh.positions[v],
             n,
             ring: &ring,
             faces: &fan.faces,
+            reflex,
         };
-        if !corner::build_corner(&mut hull, &c, options, &mut report.cases) {
+        if !corner::build_corner(&mut hull, &c, options, &mut report.cases, &mut hallway) {
             report.unseparable.push(v as u32);
         }
     }
+    corner::spread_hallway_apexes(&mut hull, &hallway);
     Ok((hull, report))
 }

@@ -2,7 +2,7 @@
 
 use super::raw::{RawMesh, NO_NORMAL};
 use super::report::{Element, FindingKind, Report};
-use super::{obj, off, orient, validate, Mesh};
+use super::{obj, off, orient, split, validate, Mesh};
 use crate::error::{Error, Result};
 use glam::DVec3;
 use std::path::Path;
@@ -110,7 +110,7 @@ fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<RawMesh> {
     })
 }
 
-/// Welds, cleans, orients and validates a polygon soup.
+/// Welds, cleans, splits non-manifold vertices, orients and validates a polygon soup.
 fn finish(raw: RawMesh, path: &Path) -> Result<(Mesh, Report)> {
     let mut report = Report {
         path: path.display().to_string(),
@@ -120,6 +120,7 @@ fn finish(raw: RawMesh, path: &Path) -> Result<(Mesh, Report)> {
         path: path.into(),
         message,
     })?;
+    split::split_vertex_fans(&mut mesh, &mut report);
     let topology = orient::orient(&mut mesh, &mut report);
     validate::validate(&mesh, topology, &mut report);
     Ok((mesh, report))

@@ -28,7 +28,8 @@
 //! - notes: welded duplicates, boundary edges, averaged file normals, ignored statements;
 //! - warnings, repaired: repeated vertices in a face (removed), faces with < 3 distinct
 //!   vertices (dropped), duplicate faces (dropped), unreferenced vertices (dropped),
-//!   inconsistent orientation (flipped), inward closed surface (flipped);
+//!   vertices whose faces form several edge-connected fans (split into one vertex per fan, see
+//!   `split`), inconsistent orientation (flipped), inward closed surface (flipped);
 //! - warnings, kept: zero-area faces, non-planar polygons, non-manifold edges and vertices,
 //!   non-orientable components, incomplete file normals.
 //!
@@ -50,6 +51,7 @@ mod off;
 mod orient;
 pub mod raw;
 mod report;
+mod split;
 mod summary;
 pub mod topology;
 mod triangulate;

@@ -38,6 +38,9 @@ pub enum FindingKind {
     NonManifoldEdge,
     /// A vertex whose faces do not form one fan (Warning; no scheme accepts it).
     NonManifoldVertex,
+    /// A vertex whose faces formed several edge-connected fans (surfaces touching at a point);
+    /// split into one vertex per fan at the same position (Warning, repaired).
+    SplitVertex,
     /// An edge with only one face (Note; the 1994 inner-hull schemes need closed meshes).
     BoundaryEdge,
     /// Faces flipped to make the orientation consistent with their neighbours (Warning, repaired).

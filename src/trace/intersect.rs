@@ -153,11 +153,11 @@ impl Geometry {
         tmin: f64,
         tmax: f64,
     ) -> Option<(f64, [f64; 4])> {
-        let p = self.patches.get(i);
-        if p.no_zero() {
+        let h = self.patches.header(i);
+        if h.no_zero() {
             return None;
         }
-        let (t0, t1, a0, rate) = p.clip(o, d)?;
+        let (t0, t1, a0, rate) = h.clip(o, d)?;
         let pad = CLIP_PAD * (t1 - t0) + 1e-14 * t0.abs().max(t1.abs()).max(1e-300);
         let (t0, t1) = (t0 - pad, t1 + pad);
         let lo_t = t0.max(tmin);
@@ -173,6 +173,7 @@ impl Geometry {
             b
         };
         let (a, b) = (at(t0), at(t1));
+        let p = self.patches.get(i);
         let mut c = [0.0; MAX_DEGREE + 1];
         let n = p.segment(&a, &b, &mut c);
         let len = t1 - t0;

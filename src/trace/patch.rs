@@ -114,6 +114,8 @@ pub struct PatchHeader {
     offset: u32,
     /// Index of the rational form, or [`NO_FORM`].
     form: u16,
+    /// How many rational numerator weights follow the polynomial weights.
+    numer_len: u16,
     degree: u8,
     segment_degree: u8,
     base_order: u8,
@@ -140,47 +142,119 @@ pub struct CompiledPatch<'a> {
     form: Option<&'a RationalForm>,
 }
 
-/// Bernstein coefficients (degree |μ|) of α(s)^μ with α(s) = (1−s)a + s·b.
+/// α^μ and its gradient with respect to α1..α4: the value and gradient of
+/// [`monomial_jet`] by the same operations (so bit-identical), without the Hessian.
 #[inline]
-fn monomial_segment(mu: [u8; 4], a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
-    out[0] = 1.0;
-    let mut len = 1;
+fn monomial_value_gradient(mu: [u8; 4], a: &[f64; 4]) -> (f64, [f64; 4]) {
+    let mut p = [1.0; 4];
+    let mut dp = [0.0; 4];
     for i in 0..4 {
-        for _ in 0..mu[i] {
-            // Multiply by (1−s)a_i + s·b_i in place, from the top coefficient down.
-            let k = len;
-            out[k] = 0.0;
-            for j in (0..=k).rev() {
-                let up = if j > 0 { out[j - 1] * b[i] } else { 0.0 };
-                let stay = if j < k { out[j] * a[i] } else { 0.0 };
-                out[j] = (stay * (k - j) as f64 + up * j as f64) / k as f64;
-            }
-            len += 1;
+        let e = i32::from(mu[i]);
+        p[i] = a[i].powi(e);
+        if e >= 1 {
+            dp[i] = f64::from(e) * a[i].powi(e - 1);
         }
     }
-    len - 1
+    let v = p[0] * p[1] * p[2] * p[3];
+    let g = [
+        dp[0] * (p[1] * p[2] * p[3]),
+        dp[1] * (p[0] * p[2] * p[3]),
+        dp[2] * (p[0] * p[1] * p[3]),
+        dp[3] * (p[0] * p[1] * p[2]),
+    ];
+    (v, g)
 }
 
-/// Sum into `acc` (degree `*deg`) the polynomial `p` of degree `d`, elevating as needed.
+/// Binomial coefficients C(m, j) and their inverses for m ≤ [`MAX_DEGREE`] (exact in f64).
+const BINOM: [[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1] = {
+    let mut t = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+    let mut m = 0;
+    while m <= MAX_DEGREE {
+        t[m][0] = 1.0;
+        let mut j = 1;
+        while j <= m {
+            t[m][j] = t[m - 1][j - 1] + if j < m { t[m - 1][j] } else { 0.0 };
+            j += 1;
+        }
+        m += 1;
+    }
+    t
+};
+const INV_BINOM: [[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1] = {
+    let mut t = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+    let mut m = 0;
+    while m <= MAX_DEGREE {
+        let mut j = 0;
+        while j <= m {
+            t[m][j] = 1.0 / BINOM[m][j];
+            j += 1;
+        }
+        m += 1;
+    }
+    t
+};
+
+// The rational part of a segment is built in the *scaled* Bernstein basis, d_j = C(m, j)·c_j
+// (f(s) = Σ d_j s^j (1−s)^(m−j)): there a product is the plain convolution of the coefficient
+// sequences, multiplying by a linear factor (1−s)·a + s·b is d'_j = a·d_j + b·d_(j−1), and
+// degree elevation is multiplying by (1−s) + s. No binomial and no division until the one
+// conversion back at the end.
+
+/// Multiplies the scaled polynomial `d` of degree `deg` by (1−s)·a + s·b; returns deg + 1.
+#[inline(always)]
+fn scaled_mul_linear(d: &mut Coeffs, deg: usize, a: f64, b: f64) -> usize {
+    d[deg + 1] = b * d[deg];
+    for j in (1..=deg).rev() {
+        d[j] = a * d[j] + b * d[j - 1];
+    }
+    d[0] *= a;
+    deg + 1
+}
+
+/// Scaled coefficients of w·α(s)^μ with α(s) = (1−s)a + s·b; returns the degree |μ|.
 #[inline]
-fn add_poly(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
+fn scaled_monomial(mu: [u8; 4], w: f64, a: &[f64; 4], b: &[f64; 4], out: &mut Coeffs) -> usize {
+    out[0] = w;
+    let mut deg = 0;
+    for i in 0..4 {
+        for _ in 0..mu[i] {
+            deg = scaled_mul_linear(out, deg, a[i], b[i]);
+        }
+    }
+    deg
+}
+
+/// `acc` (degree `*deg`) += `p` (degree `d`), elevating the lower one (scaled basis).
+#[inline]
+fn scaled_add(acc: &mut Coeffs, deg: &mut usize, p: &Coeffs, d: usize) {
+    if d == *deg {
+        for k in 0..=d {
+            acc[k] += p[k];
+        }
+        return;
+    }
     let mut q = *p;
     let mut dq = d;
     while dq < *deg {
-        dq = uni::elevate_in_place(&mut q, dq + 1) - 1;
+        dq = scaled_mul_linear(&mut q, dq, 1.0, 1.0);
     }
     while *deg < dq {
-        *deg = uni::elevate_in_place(acc, *deg + 1) - 1;
+        *deg = scaled_mul_linear(acc, *deg, 1.0, 1.0);
     }
     for k in 0..=*deg {
         acc[k] += q[k];
     }
 }
 
-/// `out[..=m+n]` = the product of `p[..=m]` and `q[..=n]`.
+/// `out[..=m+n]` = the product of `p[..=m]` and `q[..=n]` (scaled basis: a convolution).
 #[inline]
-fn product(p: &Coeffs, m: usize, q: &Coeffs, n: usize, out: &mut Coeffs) {
-    uni::multiply_into(&p[..=m], &q[..=n], out);
+fn scaled_product(p: &Coeffs, m: usize, q: &Coeffs, n: usize, out: &mut Coeffs) {
+    out[..=m + n].fill(0.0);
+    for i in 0..=m {
+        for j in 0..=n {
+            out[i + j] += p[i] * q[j];
+        }
+    }
 }
 
 /// BB weights of the product of two homogeneous BB polynomials of degrees `m` and `k`:
@@ -298,13 +372,21 @@ impl PatchStore {
         let start = h.offset as usize;
         let nw = num_coeffs(usize::from(h.degree));
         let form = self.forms.get(usize::from(h.form));
-        let nn = form.map_or(0, RationalForm::numer_len);
+        let nn = usize::from(h.numer_len);
         CompiledPatch {
             h,
             weights: &self.data[start..start + nw],
             numer: &self.data[start + nw..start + nw + nn],
             form,
         }
+    }
+
+    /// The header of patch `i` alone: enough to clip a ray ([`PatchHeader::clip`]) before
+    /// touching the patch's weights.
+    #[must_use]
+    #[inline]
+    pub fn header(&self, i: usize) -> &PatchHeader {
+        &self.headers[i]
     }
 
     /// Bytes of the headers, the shared weights and the forms.
@@ -458,7 +540,10 @@ impl PatchStore {
             (l.min(w), h.max(w))
         });
         let numer: Vec<f64> = group_weights.into_iter().flatten().flatten().collect();
+        let numer_len = u16::try_from(numer.len())
+            .map_err(|_| format!("patch {index}: more than 65535 rational numerator weights"))?;
         let form = RationalForm { groups };
+        debug_assert_eq!(form.numer_len(), numer.len());
         let cleared = if form.groups.is_empty() {
             Vec::new()
         } else {
@@ -492,6 +577,7 @@ impl PatchStore {
             zero_tol,
             offset,
             form: form_id,
+            numer_len,
             degree: n as u8,
             segment_degree: segment_degree as u8,
             base_order: base_order.min(255) as u8,
@@ -500,6 +586,64 @@ impl PatchStore {
             no_zero,
         });
         Ok(())
+    }
+}
+
+impl PatchHeader {
+    /// Barycentric coordinates of `x`.
+    #[must_use]
+    #[inline]
+    pub fn bary(&self, x: DVec3) -> [f64; 4] {
+        let d = x - self.v0;
+        let a1 = self.grad[0].dot(d);
+        let a2 = self.grad[1].dot(d);
+        let a3 = self.grad[2].dot(d);
+        [1.0 - a1 - a2 - a3, a1, a2, a3]
+    }
+
+    /// The parameter interval [t0, t1] in which `o + t·d` lies inside the tetrahedron, with
+    /// α(o) and dα/dt (barycentrics along the ray are α(o) + t·rate), or `None`.
+    #[must_use]
+    #[inline]
+    pub fn clip(&self, o: DVec3, d: DVec3) -> Option<(f64, f64, [f64; 4], [f64; 4])> {
+        let a = self.bary(o);
+        let mut t0 = f64::NEG_INFINITY;
+        let mut t1 = f64::INFINITY;
+        let r1 = self.grad[0].dot(d);
+        let r2 = self.grad[1].dot(d);
+        let r3 = self.grad[2].dot(d);
+        let rate = [-(r1 + r2 + r3), r1, r2, r3];
+        // αi(t) = a_i + t·rate_i ≥ 0.
+        for i in 0..4 {
+            let r = rate[i];
+            if r > 0.0 {
+                t0 = t0.max(-a[i] / r);
+            } else if r < 0.0 {
+                t1 = t1.min(-a[i] / r);
+            } else if a[i] < 0.0 {
+                return None;
+            }
+        }
+        if !t0.is_finite() || !t1.is_finite() {
+            return None;
+        }
+        if t0 > t1 {
+            // A ray through a vertex or edge touches the closed tetrahedron in one point, which
+            // rounding can turn into an empty interval: keep it when the gap is rounding-sized.
+            if t0 - t1 > CLIP_SLACK * (t0.abs() + t1.abs()) {
+                return None;
+            }
+            let m = 0.5 * (t0 + t1);
+            return Some((m, m, a, rate));
+        }
+        Some((t0, t1, a, rate))
+    }
+
+    /// See [`CompiledPatch::no_zero`].
+    #[must_use]
+    #[inline]
+    pub fn no_zero(&self) -> bool {
+        self.no_zero
     }
 }
 
@@ -581,11 +725,7 @@ impl CompiledPatch<'_> {
     #[must_use]
     #[inline]
     pub fn bary(&self, x: DVec3) -> [f64; 4] {
-        let d = x - self.h.v0;
-        let a1 = self.h.grad[0].dot(d);
-        let a2 = self.h.grad[1].dot(d);
-        let a3 = self.h.grad[2].dot(d);
-        [1.0 - a1 - a2 - a3, a1, a2, a3]
+        self.h.bary(x)
     }
 
     /// The parameter interval [t0, t1] in which `o + t·d` lies inside the tetrahedron, with
@@ -593,37 +733,7 @@ impl CompiledPatch<'_> {
     #[must_use]
     #[inline]
     pub fn clip(&self, o: DVec3, d: DVec3) -> Option<(f64, f64, [f64; 4], [f64; 4])> {
-        let a = self.bary(o);
-        let mut t0 = f64::NEG_INFINITY;
-        let mut t1 = f64::INFINITY;
-        let r1 = self.h.grad[0].dot(d);
-        let r2 = self.h.grad[1].dot(d);
-        let r3 = self.h.grad[2].dot(d);
-        let rate = [-(r1 + r2 + r3), r1, r2, r3];
-        // αi(t) = a_i + t·rate_i ≥ 0.
-        for i in 0..4 {
-            let r = rate[i];
-            if r > 0.0 {
-                t0 = t0.max(-a[i] / r);
-            } else if r < 0.0 {
-                t1 = t1.min(-a[i] / r);
-            } else if a[i] < 0.0 {
-                return None;
-            }
-        }
-        if !t0.is_finite() || !t1.is_finite() {
-            return None;
-        }
-        if t0 > t1 {
-            // A ray through a vertex or edge touches the closed tetrahedron in one point, which
-            // rounding can turn into an empty interval: keep it when the gap is rounding-sized.
-            if t0 - t1 > CLIP_SLACK * (t0.abs() + t1.abs()) {
-                return None;
-            }
-            let m = 0.5 * (t0 + t1);
-            return Some((m, m, a, rate));
-        }
-        Some((t0, t1, a, rate))
+        self.h.clip(o, d)
     }
 
     /// Bernstein coefficients on s ∈ [0, 1] of F((1−s)·a + s·b) (barycentric endpoints), with
@@ -637,64 +747,83 @@ impl CompiledPatch<'_> {
         let Some(form) = self.form else {
             return n;
         };
-        // G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group.
+        // G = P·ΠD_g + Σ_g (Σ_r N_r·B_r)·Π_{g'≠g} D_g', built group by group in the scaled
+        // basis (see `scaled_mul_linear`).
+        let mut g = [0.0; MAX_DEGREE + 1];
+        for j in 0..=n {
+            g[j] = out[j] * BINOM[n][j];
+        }
         let mut w = self.numer.iter();
         let mut deg = n;
         let mut q = [0.0; MAX_DEGREE + 1]; // Π of the denominators so far
         q[0] = 1.0;
         let mut qdeg = 0;
-        for g in &form.groups {
+        let mut m = [0.0; MAX_DEGREE + 1];
+        for grp in &form.groups {
             let mut den = [0.0; MAX_DEGREE + 1];
             let mut dden = 0;
-            for mu in &g.denominator {
-                let mut m = [0.0; MAX_DEGREE + 1];
-                let d = monomial_segment(*mu, a, b, &mut m);
-                add_poly(&mut den, &mut dden, &m, d);
+            for (k, mu) in grp.denominator.iter().enumerate() {
+                if k == 0 {
+                    dden = scaled_monomial(*mu, 1.0, a, b, &mut den);
+                } else {
+                    let d = scaled_monomial(*mu, 1.0, a, b, &mut m);
+                    scaled_add(&mut den, &mut dden, &m, d);
+                }
             }
             let mut sum = [0.0; MAX_DEGREE + 1];
             let mut dsum = 0;
-            for t in &g.terms {
+            for (r, t) in grp.terms.iter().enumerate() {
                 let mut num = [0.0; MAX_DEGREE + 1];
                 let mut dnum = 0;
-                for mu in &t.numer {
+                for (k, mu) in t.numer.iter().enumerate() {
                     let wm = w.next().copied().unwrap_or(0.0);
-                    let mut m = [0.0; MAX_DEGREE + 1];
-                    let d = monomial_segment(*mu, a, b, &mut m);
-                    for x in &mut m[..=d] {
-                        *x *= wm;
+                    if k == 0 {
+                        dnum = scaled_monomial(*mu, wm, a, b, &mut num);
+                    } else {
+                        let d = scaled_monomial(*mu, wm, a, b, &mut m);
+                        scaled_add(&mut num, &mut dnum, &m, d);
                     }
-                    add_poly(&mut num, &mut dnum, &m, d);
                 }
-                let mut bern = [0.0; MAX_DEGREE + 1];
-                let dk = monomial_segment(t.kappa, a, b, &mut bern);
-                for x in &mut bern[..=dk] {
+                // N_r·B_r: multiply N_r by mult·α^κ one linear factor at a time.
+                for x in &mut num[..=dnum] {
                     *x *= t.mult;
                 }
-                let mut prod = [0.0; MAX_DEGREE + 1];
-                product(&num, dnum, &bern, dk, &mut prod);
-                add_poly(&mut sum, &mut dsum, &prod, dnum + dk);
+                for i in 0..4 {
+                    for _ in 0..t.kappa[i] {
+                        dnum = scaled_mul_linear(&mut num, dnum, a[i], b[i]);
+                    }
+                }
+                if r == 0 {
+                    sum = num;
+                    dsum = dnum;
+                } else {
+                    scaled_add(&mut sum, &mut dsum, &num, dnum);
+                }
             }
             let mut left = [0.0; MAX_DEGREE + 1];
-            product(out, deg, &den, dden, &mut left);
+            scaled_product(&g, deg, &den, dden, &mut left);
             let mut dl = deg + dden;
             if qdeg == 0 {
                 // Π of no denominators is 1 (the only group of a face or edge patch).
-                add_poly(&mut left, &mut dl, &sum, dsum);
+                scaled_add(&mut left, &mut dl, &sum, dsum);
             } else {
                 let mut right = [0.0; MAX_DEGREE + 1];
-                product(&sum, dsum, &q, qdeg, &mut right);
-                add_poly(&mut left, &mut dl, &right, dsum + qdeg);
+                scaled_product(&sum, dsum, &q, qdeg, &mut right);
+                scaled_add(&mut left, &mut dl, &right, dsum + qdeg);
             }
-            *out = left;
+            g = left;
             deg = dl;
             if qdeg == 0 {
                 q = den;
             } else {
                 let mut nq = [0.0; MAX_DEGREE + 1];
-                product(&q, qdeg, &den, dden, &mut nq);
+                scaled_product(&q, qdeg, &den, dden, &mut nq);
                 q = nq;
             }
             qdeg += dden;
+        }
+        for j in 0..=deg {
+            out[j] = g[j] * INV_BINOM[deg][j];
         }
         deg
     }
@@ -702,6 +831,14 @@ impl CompiledPatch<'_> {
     /// F, its gradient and Hessian with respect to the four barycentric variables at `alpha`.
     #[must_use]
     pub fn bary_derivatives(&self, alpha: &[f64; 4]) -> Jet {
+        self.bary_jet::<true>(alpha)
+    }
+
+    /// [`Self::bary_derivatives`], with the Hessian left 0 unless `HESSIAN`: the value and
+    /// gradient take the same operations either way (bit-identical), the gradient-only form
+    /// skips the second-order work the shading of most modes does not need.
+    #[inline]
+    fn bary_jet<const HESSIAN: bool>(&self, alpha: &[f64; 4]) -> Jet {
         let n = self.degree();
         let mut jet = Jet::default();
         if n == 1 {
@@ -721,7 +858,9 @@ impl CompiledPatch<'_> {
                 for j in 0..4 {
                     let d = work[IDX2[i][j]];
                     ci += alpha[j] * d;
-                    jet.h[i][j] = nf * (nf - 1.0) * d;
+                    if HESSIAN {
+                        jet.h[i][j] = nf * (nf - 1.0) * d;
+                    }
                 }
                 jet.v += alpha[i] * ci;
                 jet.g[i] = nf * ci;
@@ -730,17 +869,27 @@ impl CompiledPatch<'_> {
         let Some(form) = self.form else {
             return jet;
         };
+        let mono = |mu: [u8; 4]| {
+            if HESSIAN {
+                monomial_jet(mu, *alpha)
+            } else {
+                let (v, g) = monomial_value_gradient(mu, alpha);
+                (v, g, [[0.0; 4]; 4])
+            }
+        };
         let mut w = self.numer.iter();
         for g in &form.groups {
             // D = Σ α^μ over the group's monomials (shared by its terms).
             let (mut d, mut gd, mut hd) = (0.0, [0.0; 4], [[0.0; 4]; 4]);
             for mu in &g.denominator {
-                let (v, gv, hv) = monomial_jet(*mu, *alpha);
+                let (v, gv, hv) = mono(*mu);
                 d += v;
                 for i in 0..4 {
                     gd[i] += gv[i];
-                    for k in 0..4 {
-                        hd[i][k] += hv[i][k];
+                    if HESSIAN {
+                        for k in 0..4 {
+                            hd[i][k] += hv[i][k];
+                        }
                     }
                 }
             }
@@ -748,12 +897,14 @@ impl CompiledPatch<'_> {
                 let (mut nv, mut gn, mut hn) = (0.0, [0.0; 4], [[0.0; 4]; 4]);
                 for mu in &t.numer {
                     let wm = w.next().copied().unwrap_or(0.0);
-                    let (v, gv, hv) = monomial_jet(*mu, *alpha);
+                    let (v, gv, hv) = mono(*mu);
                     nv += wm * v;
                     for i in 0..4 {
                         gn[i] += wm * gv[i];
-                        for k in 0..4 {
-                            hn[i][k] += wm * hv[i][k];
+                        if HESSIAN {
+                            for k in 0..4 {
+                                hn[i][k] += wm * hv[i][k];
+                            }
                         }
                     }
                 }
@@ -762,18 +913,25 @@ impl CompiledPatch<'_> {
                     continue;
                 }
                 let c = t.mult;
-                let (bv, gb, hb) = monomial_jet(t.kappa, *alpha);
-                let (bv, gb, hb) = (c * bv, gb.map(|x| c * x), hb.map(|r| r.map(|x| c * x)));
+                let (bv, gb, hb) = mono(t.kappa);
+                let (bv, gb) = (c * bv, gb.map(|x| c * x));
+                let hb = if HESSIAN {
+                    hb.map(|r| r.map(|x| c * x))
+                } else {
+                    hb
+                };
                 // q = N/D, ∇q = (∇N − q∇D)/D, Hq = (HN − q HD − ∇q∇Dᵀ − ∇D∇qᵀ)/D.
                 let qv = nv / d;
                 let gq: [f64; 4] = std::array::from_fn(|i| (gn[i] - qv * gd[i]) / d);
                 jet.v += qv * bv;
                 for i in 0..4 {
                     jet.g[i] += bv * gq[i] + qv * gb[i];
-                    for k in 0..4 {
-                        let hq = (hn[i][k] - qv * hd[i][k] - gq[i] * gd[k] - gd[i] * gq[k]) / d;
-                        // R = q·B: HR = B Hq + ∇q∇Bᵀ + ∇B∇qᵀ + q HB.
-                        jet.h[i][k] += bv * hq + gq[i] * gb[k] + gb[i] * gq[k] + qv * hb[i][k];
+                    if HESSIAN {
+                        for k in 0..4 {
+                            let hq = (hn[i][k] - qv * hd[i][k] - gq[i] * gd[k] - gd[i] * gq[k]) / d;
+                            // R = q·B: HR = B Hq + ∇q∇Bᵀ + ∇B∇qᵀ + q HB.
+                            jet.h[i][k] += bv * hq + gq[i] * gb[k] + gb[i] * gq[k] + qv * hb[i][k];
+                        }
                     }
                 }
             }
@@ -786,7 +944,7 @@ impl CompiledPatch<'_> {
     /// gradient is bit-identical to the one `derivatives` returns.
     #[must_use]
     pub fn value_gradient(&self, alpha: &[f64; 4]) -> (f64, DVec3) {
-        let j = self.bary_derivatives(alpha);
+        let j = self.bary_jet::<false>(alpha);
         let grad = self.grad();
         let mut g = DVec3::ZERO;
         for i in 0..4 {

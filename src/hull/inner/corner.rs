@@ -1,10 +1,16 @@
-//! Algorithm 1, steps (3)–(5): the triangles of T and the face tetrahedra built for one vertex V
+//! Algorithm 1, steps (3)–(5), and Algorithm 2's step (3'): the triangles of T and the face tetrahedra built for one vertex V
 //! of the (convex-faced) polyhedron.
 //!
 //! Reconstruction of the missing figures 4.3–4.5, as implemented:
 //! - step (3), trihedral V: T gets the triangle of the three face centroids C_1C_2C_3 (in the
 //!   counter-clockwise order of the faces round V), apex V. The tangent plane of every C_i is its
 //!   face plane, which contains V, so the tetrahedron is tangent-containing.
+//! - step (3') of Algorithm 2 (the hallway corner, Figure 5.7), trihedral V with a reflex angle
+//!   in one face f_1 (so the edge e_1 not in f_1 is a concave edge of the polyhedron): when e_1
+//!   crosses the plane of the guards' triangle at X before its midpoint M, a second apex
+//!   T_0 = (X + M)/2 on e_1 gives the L-U pair [G_1G_2G_3V], [G_1G_2G_3T_0]. Beyond the paper:
+//!   the outer apex V is later moved in f_1's plane away from f_1 ([`spread_hallway_apexes`]),
+//!   since with V itself the edge tetrahedra across e_1 (midpoint s = M) are inverted.
 //! - step (4), otherwise: t_i = n_V·(C_i − V). V is separable when all t_i have one sign; then
 //!   V̄ = V + t* n_V with |t*| = min |t_i| and the pseudo-centroid C_0 = αV + (1−α)V̄ (normal
 //!   n_V); unseparable V gives C_0 = V. T gets the fan C_0C_iC_{i+1}, one triangle per edge
@@ -37,6 +43,8 @@ pub struct CaseCounts {
     pub case_iii: usize,
     /// Step (5)(iv): L-U pair with moved T_0, T_1.
     pub case_iv: usize,
+    /// Step (3'): hallway corners (trihedral with a reflex face angle), L-U pair V, T_0.
+    pub hallway: usize,
 }
 
 /// One vertex's data for steps (3)–(5).
@@ -52,6 +60,22 @@ pub struct Corner<'a> {
     pub ring: &'a [DVec3],
     /// The faces round it (indices of T points: their centroids / corner guards).
     pub faces: &'a [u32],
+    /// The face (index into `faces`) in which the corner at V is reflex (angle > π), if any:
+    /// with three faces that is the hallway corner of Algorithm 2 step (3').
+    pub reflex: Option<usize>,
+}
+
+/// An outer apex of a hallway corner (step (3')) that may be moved in its face's plane, away
+/// from the face, when an edge tetrahedron's midpoint would otherwise fall on the wrong side of
+/// T ([`spread_hallway_apexes`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HallwayApex {
+    /// The triangle of T.
+    pub triangle: usize,
+    /// Unit direction in the reflex face's plane, bisecting the corner's convex (outer) angle.
+    pub dir: DVec3,
+    /// Longest move allowed (three quarters of the shorter polygon edge at V).
+    pub limit: f64,
 }
 
 /// Orientation of q against the triangle (a, b, c): > 0 on its outer (counter-clockwise normal)
@@ -73,6 +97,7 @@ pub fn build_corner(
     c: &Corner,
     options: &InnerOptions,
     counts: &mut CaseCounts,
+    hallway: &mut Vec<HallwayApex>,
 ) -> bool {
     let k = c.faces.len();
     let pts: Vec<DVec3> = c.faces.iter().map(|&f| hull.points[f as usize]).collect();
@@ -80,7 +105,35 @@ pub fn build_corner(
     if k == 3 {
         let tri = [c.faces[0], c.faces[1], c.faces[2]];
         let mut slot = [None, None];
-        set_apex(&mut slot, [pts[0], pts[1], pts[2]], c.v);
+        let base = [pts[0], pts[1], pts[2]];
+        set_apex(&mut slot, base, c.v);
+        if let Some(r) = c.reflex {
+            // Step (3'): the edge e_1 not in the reflex face runs from V through the plane of
+            // the guards' triangle; the polyhedron near e_1 lies beyond it, so a second face
+            // tetrahedron with apex T_0 on e_1, between that crossing X and the midpoint M,
+            // forms an L-U pair with [G_1G_2G_3V].
+            let d = c.ring[(r + 2) % 3] - c.v;
+            let m = (base[1] - base[0]).cross(base[2] - base[0]);
+            let o_v = orient(base[0], base[1], base[2], c.v);
+            let rate = m.dot(d);
+            let u = if rate.abs() > 1e-12 * m.length() * d.length() {
+                -o_v / rate
+            } else {
+                f64::INFINITY
+            };
+            if o_v > 0.0 && u > 0.0 && u < 0.5 {
+                set_apex(&mut slot, base, c.v + 0.5 * (u + 0.5) * d);
+                let (a, b) = (c.ring[r] - c.v, c.ring[(r + 1) % 3] - c.v);
+                if let Some(dir) = (a.normalize_or_zero() + b.normalize_or_zero()).try_normalize() {
+                    hallway.push(HallwayApex {
+                        triangle: hull.triangles.len(),
+                        dir,
+                        limit: 0.75 * a.length().min(b.length()),
+                    });
+                }
+                counts.hallway += 1;
+            }
+        }
         hull.triangles.push(tri);
         hull.apexes.push(slot);
         hull.element.push(c.vertex);
@@ -233,4 +286,76 @@ pub fn build_corner(
         hull.element.push(c.vertex);
     }
     separable
+}
+
+/// Smallest distance of an edge tetrahedron's midpoint s from the planes of its two triangles,
+/// relative to the edge of T, that [`spread_hallway_apexes`] establishes.
+pub const MIDPOINT_MARGIN: f64 = 0.05;
+
+/// The outer apexes V of hallway corners (step (3')) make the outer edge tetrahedra over the
+/// edge G_2G_3 (across e_1) and their neighbours degenerate or inverted: the midpoint s of two
+/// apexes on the polyhedron's concave edge lies on T's inner side there. Each such apex is moved
+/// in its reflex face's plane, out of the face (the tangent plane at G_1 still contains it, so
+/// the tetrahedron stays tangent-containing), just far enough that every outer midpoint s over
+/// its triangle's edges lies [`MIDPOINT_MARGIN`] on the outer side of both triangles.
+pub fn spread_hallway_apexes(hull: &mut SimplicialHull, hallway: &[HallwayApex]) {
+    if hallway.is_empty() {
+        return;
+    }
+    let Ok(edges) = hull.edges() else {
+        return;
+    };
+    let mut movable = vec![None; hull.triangles.len()];
+    for h in hallway {
+        movable[h.triangle] = Some(*h);
+    }
+    let mut moved = vec![0.0f64; hull.triangles.len()];
+    let outer = crate::hull::simplicial::Side::Outer as usize;
+    let unit_normal = |hull: &SimplicialHull, t: usize| {
+        let [a, b, c] = hull.triangles[t].map(|i| hull.points[i as usize]);
+        ((b - a).cross(c - a).normalize_or_zero(), a)
+    };
+    for _ in 0..4 {
+        for e in &edges {
+            let [fa, fb] = e.faces.map(|f| f as usize);
+            if e.faces[1] == u32::MAX || (movable[fa].is_none() && movable[fb].is_none()) {
+                continue;
+            }
+            let (Some(qa), Some(qb)) = (hull.apexes[fa][outer], hull.apexes[fb][outer]) else {
+                continue;
+            };
+            let len = (hull.points[e.v[1] as usize] - hull.points[e.v[0] as usize]).length();
+            let target = MIDPOINT_MARGIN * len;
+            let s = 0.5 * (qa + qb);
+            let ds = 0.5
+                * (movable[fa].map_or(DVec3::ZERO, |h| h.dir)
+                    + movable[fb].map_or(DVec3::ZERO, |h| h.dir));
+            let mut lambda: f64 = 0.0;
+            let mut ok = true;
+            for t in [fa, fb] {
+                let (n, p) = unit_normal(hull, t);
+                let dist = n.dot(s - p);
+                if dist < target {
+                    let rate = n.dot(ds);
+                    if rate > 1e-9 {
+                        lambda = lambda.max((target - dist) / rate);
+                    } else {
+                        ok = false;
+                    }
+                }
+            }
+            if !ok || lambda <= 0.0 {
+                continue;
+            }
+            for t in [fa, fb] {
+                if let Some(h) = movable[t] {
+                    let step = lambda.min(h.limit - moved[t]).max(0.0);
+                    moved[t] += step;
+                    if let Some(q) = hull.apexes[t][outer].as_mut() {
+                        *q += step * h.dir;
+                    }
+                }
+            }
+        }
+    }
 }

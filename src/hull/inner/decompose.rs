@@ -1,16 +1,22 @@
-//! Corner guards of non-convex faces (§5, Definition 2.5) by convex decomposition.
+//! Corner guards of non-convex faces (§5, Definition 2.5).
 //!
-//! The paper notes (§4, after Theorem 4.1) that "the convex face restriction can be enforced by
-//! subdividing nonconvex faces into convex ones". We do that: every non-convex polygon is
-//! ear-clipped in its plane and the triangles are merged back greedily while the union stays
-//! convex (Hertel–Mehlhorn, at most 4× the minimum number of pieces). The centroid of every piece
-//! sees all of that piece's corners, so the piece centroids form a corner guard set; the dual tree
-//! of the pieces (two pieces adjacent over a diagonal) is the corner guard net that the surface
-//! interpolates (§7.2). Each piece keeps the normal of its polygon, so the edges of T inside the
-//! polygon are zero convex (§5: "the edges in corner guard nets are zero convex by construction").
+//! A star-shaped polygon (non-empty kernel: the points that see all of it) keeps a single corner
+//! guard, the centroid of its kernel ([`kernel_guard`]) — "for a convex polygon or a star-shaped
+//! polygon, a minimum corner guard set consists of just a single point" (§2). Its reflex
+//! corners then stay trihedral and become Algorithm 2's hallway corners (step (3'), in
+//! [`super::corner`]).
 //!
-//! Reflex corners (the hallway corner of step (3')) are split by a diagonal into corners of at
-//! most π, so after the decomposition every vertex is handled by Algorithm 1's steps (3)–(5).
+//! Other non-convex polygons are split, as the paper allows (§4, after Theorem 4.1: "the convex
+//! face restriction can be enforced by subdividing nonconvex faces into convex ones"): every
+//! such polygon is ear-clipped in its plane and the triangles are merged back greedily while the
+//! union stays convex (Hertel–Mehlhorn, at most 4× the minimum number of pieces). The centroid of
+//! every piece sees all of that piece's corners, so the piece centroids form a corner guard set;
+//! the dual tree of the pieces (two pieces adjacent over a diagonal) is the corner guard net
+//! that the surface interpolates (§7.2). Each piece keeps the normal of its polygon, so the
+//! edges of T inside the polygon are zero convex (§5: "the edges in corner guard nets are zero
+//! convex by construction"). Reflex corners are split there by a diagonal into corners of at
+//! most π, handled by Algorithm 1's steps (3)–(5); the hulls of such polygons still overlap
+//! (letter_P_poly: see `scenes/pending/paper1994/README.md`).
 
 use crate::error::{Error, Result};
 use crate::mesh::convexity::polygon_is_convex;
@@ -33,7 +39,18 @@ pub struct Pieces {
     pub guard: Vec<bool>,
     /// Input polygons that were split, with their number of pieces.
     pub split: Vec<(u32, usize)>,
+    /// The point of T standing for each piece: the vertex mean of a convex piece, or the
+    /// corner guard (in the polygon's plane) of a non-convex one.
+    pub center: Vec<DVec3>,
+    /// Non-convex input polygons kept whole because they are star shaped, with their single
+    /// corner guard (a point in the interior of the kernel, which sees every corner).
+    pub star: Vec<(u32, DVec3)>,
 }
+
+/// Smallest kernel area, relative to the polygon's area, for which a star-shaped polygon keeps
+/// a single corner guard: below it the guard would sit within rounding of a reflex corner's
+/// edge lines and the tetrahedra there would be thin, so the polygon is split instead.
+pub const MIN_KERNEL_AREA: f64 = 1e-3;
 
 /// Splits the non-convex polygons of `mesh` into convex pieces; convex polygons pass unchanged.
 ///
@@ -49,11 +66,28 @@ pub fn convex_pieces(mesh: &Mesh) -> Result<Pieces> {
                 mesh.face_lines.get(f).copied().unwrap_or(0)
             )));
         };
+        let mean = face
+            .iter()
+            .map(|&v| mesh.positions[v as usize])
+            .sum::<DVec3>()
+            / face.len() as f64;
         if face.len() == 3 || polygon_is_convex(&mesh.positions, face) {
             out.faces.push(face.clone());
             out.parent.push(f as u32);
             out.normal.push(normal);
             out.guard.push(false);
+            out.center.push(mean);
+            continue;
+        }
+        if let Some(g) = kernel_guard(&mesh.positions, face, normal) {
+            // Corner guards lie exactly in the polygon's plane (through its vertex mean).
+            let g = g - normal.dot(g - mean) * normal;
+            out.faces.push(face.clone());
+            out.parent.push(f as u32);
+            out.normal.push(normal);
+            out.guard.push(true);
+            out.center.push(g);
+            out.star.push((f as u32, g));
             continue;
         }
         let mut tris = Vec::new();
@@ -61,6 +95,8 @@ pub fn convex_pieces(mesh: &Mesh) -> Result<Pieces> {
         let pieces = merge_convex(&mesh.positions, normal, tris);
         out.split.push((f as u32, pieces.len()));
         for p in pieces {
+            let c = p.iter().map(|&v| mesh.positions[v as usize]).sum::<DVec3>() / p.len() as f64;
+            out.center.push(c - normal.dot(c - mean) * normal);
             out.faces.push(p);
             out.parent.push(f as u32);
             out.normal.push(normal);
@@ -68,6 +104,71 @@ pub fn convex_pieces(mesh: &Mesh) -> Result<Pieces> {
         }
     }
     Ok(out)
+}
+
+/// The centroid of the kernel of a star-shaped polygon (the points that see all of it: the
+/// intersection of the inner half-planes of its edges), when the kernel has at least
+/// [`MIN_KERNEL_AREA`] of the polygon's area; `None` otherwise. The centroid of a convex region
+/// of positive area lies in its interior, so every corner is visible from it (Definition 2.5).
+#[must_use]
+pub fn kernel_guard(positions: &[DVec3], face: &[u32], normal: DVec3) -> Option<DVec3> {
+    let u = normal.any_orthonormal_vector();
+    let v = normal.cross(u);
+    let o = positions[face[0] as usize];
+    let flat: Vec<DVec2> = face
+        .iter()
+        .map(|&i| {
+            let p = positions[i as usize] - o;
+            DVec2::new(p.dot(u), p.dot(v))
+        })
+        .collect();
+    let n = flat.len();
+    let area = polygon_area(&flat);
+    if area <= 0.0 {
+        return None;
+    }
+    let (lo, hi) = flat.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(a, b), &p| (a.min(p), b.max(p)),
+    );
+    let mut kernel = vec![lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+    for i in 0..n {
+        let (a, b) = (flat[i], flat[(i + 1) % n]);
+        let inside = |p: DVec2| (b - a).perp_dot(p - a);
+        let mut next = Vec::with_capacity(kernel.len() + 1);
+        for k in 0..kernel.len() {
+            let (p, q) = (kernel[k], kernel[(k + 1) % kernel.len()]);
+            let (sp, sq) = (inside(p), inside(q));
+            if sp >= 0.0 {
+                next.push(p);
+            }
+            if (sp >= 0.0) != (sq >= 0.0) {
+                next.push(p + (q - p) * (sp / (sp - sq)));
+            }
+        }
+        kernel = next;
+        if kernel.len() < 3 {
+            return None;
+        }
+    }
+    let ka = polygon_area(&kernel);
+    if ka < MIN_KERNEL_AREA * area {
+        return None;
+    }
+    // Area centroid of the kernel.
+    let mut c = DVec2::ZERO;
+    for k in 0..kernel.len() {
+        let (p, q) = (kernel[k], kernel[(k + 1) % kernel.len()]);
+        c += (p + q) * p.perp_dot(q);
+    }
+    c /= 6.0 * ka;
+    Some(o + c.x * u + c.y * v)
+}
+
+/// Signed area of a 2D polygon (positive counter-clockwise).
+fn polygon_area(p: &[DVec2]) -> f64 {
+    let n = p.len();
+    0.5 * (0..n).map(|k| p[k].perp_dot(p[(k + 1) % n])).sum::<f64>()
 }
 
 /// Hertel–Mehlhorn: removes diagonals between triangles of one polygon while the union of the
@@ -145,33 +246,62 @@ fn is_convex_2d(p: &[DVec2]) -> bool {
 mod tests {
     use super::*;
 
-    /// An L-shaped hexagon splits into two convex quadrilaterals that tile it (areas add up).
+    fn flat_mesh(pts: &[(f64, f64)]) -> Mesh {
+        let positions: Vec<DVec3> = pts.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
+        let n = positions.len() as u32;
+        Mesh::new(positions, vec![(0..n).collect()])
+    }
+
+    /// An L-shaped hexagon is star shaped: it stays whole, with one corner guard at the centroid
+    /// of its kernel, the unit square [0, 1]².
     #[test]
-    fn l_shape_splits_into_two_convex_pieces() {
-        let positions: Vec<DVec3> = [
+    fn l_shape_keeps_one_guard_in_its_kernel() {
+        let mesh = flat_mesh(&[
             (0.0, 0.0),
             (2.0, 0.0),
             (2.0, 1.0),
             (1.0, 1.0),
             (1.0, 2.0),
             (0.0, 2.0),
-        ]
-        .iter()
-        .map(|&(x, y)| DVec3::new(x, y, 0.0))
-        .collect();
-        let mesh = Mesh::new(positions.clone(), vec![(0..6).collect()]);
+        ]);
         let pieces = convex_pieces(&mesh).unwrap();
-        assert_eq!(pieces.faces.len(), 2);
-        assert_eq!(pieces.split, vec![(0, 2)]);
+        assert_eq!(pieces.faces.len(), 1);
+        assert!(pieces.split.is_empty());
+        assert_eq!(pieces.star.len(), 1);
+        assert!(pieces.guard[0]);
+        // The kernel's centroid is (0.5, 0.5); clipping rounds at the 1e-16 level.
+        assert!((pieces.center[0] - DVec3::new(0.5, 0.5, 0.0)).length() < 1e-12);
+    }
+
+    /// A U-shaped octagon has an empty kernel (no point sees both prongs): it is split into
+    /// convex pieces that tile it (areas add up).
+    #[test]
+    fn u_shape_splits_into_convex_pieces() {
+        let pts = [
+            (0.0, 0.0),
+            (3.0, 0.0),
+            (3.0, 2.0),
+            (2.0, 2.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 2.0),
+        ];
+        let mesh = flat_mesh(&pts);
+        let n = DVec3::Z;
+        assert!(kernel_guard(&mesh.positions, &mesh.faces[0], n).is_none());
+        let pieces = convex_pieces(&mesh).unwrap();
+        assert!(pieces.faces.len() >= 3);
+        assert_eq!(pieces.split, vec![(0, pieces.faces.len())]);
         let area: f64 = pieces
             .faces
             .iter()
             .map(|f| {
-                assert!(polygon_is_convex(&positions, f));
-                area_vector(&positions, f).z
+                assert!(polygon_is_convex(&mesh.positions, f));
+                area_vector(&mesh.positions, f).z
             })
             .sum();
-        // Exact area 3; the pieces are made of the input vertices, so only rounding differs.
-        assert!((area - 3.0).abs() < 1e-12);
+        // Exact area 5; the pieces are made of the input vertices, so only rounding differs.
+        assert!((area - 5.0).abs() < 1e-12);
     }
 }

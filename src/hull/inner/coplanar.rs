@@ -1,0 +1,196 @@
+//! Coplanar faces merged into polygons before the hull is built (Appendix B's coplanarity,
+//! treated at its source).
+//!
+//! A triangulated flat region (the triangulated hallway corner, the flat sides of the nut or
+//! fandisk) gives Algorithm 1 corners whose faces share one plane: a "non-trihedral" vertex
+//! whose centroids are coplanar with it has no pseudo-centroid off that plane, and the face
+//! tetrahedra built there are flat. The paper's own polyhedra have one face per plane; we
+//! restore that: edge-adjacent faces with the same plane are merged into one polygon (when the
+//! merged region is a disk bounded by one simple loop), and vertices then left on a straight
+//! edge between only two polygons are dropped from both (their edges are collinear). Vertex
+//! indices and positions are unchanged; every merged polygon remembers one of its input faces.
+
+use crate::mesh::geometry::area_vector;
+use crate::mesh::Mesh;
+use glam::DVec3;
+use std::collections::HashMap;
+
+/// Two faces are coplanar when their unit normals differ by less than this (about 1e-6 rad)
+/// and each one's vertices lie within [`PLANE_DISTANCE`] of the other's plane.
+pub const NORMAL_TOL: f64 = 1e-6;
+
+/// Largest distance of a face's vertices from a coplanar neighbour's plane, relative to the
+/// pair's size: rounding of unit-size coordinates, far below any modelled feature.
+pub const PLANE_DISTANCE: f64 = 1e-9;
+
+/// Merges coplanar edge-adjacent faces of `mesh` (see the module documentation). The result
+/// has the same positions and vertex lines; `face_parent` names, for each polygon, the input
+/// face it contains first, and `face_lines` that face's line. Returns the mesh unchanged (a
+/// clone) when nothing is coplanar.
+#[must_use]
+pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
+    let nf = mesh.faces.len();
+    let normals: Vec<Option<DVec3>> = mesh
+        .faces
+        .iter()
+        .map(|f| area_vector(&mesh.positions, f).try_normalize())
+        .collect();
+    let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for k in 0..face.len() {
+            directed.insert((face[k], face[(k + 1) % face.len()]), f);
+        }
+    }
+    let mut parent: Vec<usize> = (0..nf).collect();
+    fn root(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    let coplanar = |f: usize, g: usize| -> bool {
+        let (Some(nf_), Some(ng)) = (normals[f], normals[g]) else {
+            return false;
+        };
+        if (nf_ - ng).length() > NORMAL_TOL {
+            return false;
+        }
+        let pts = |h: usize| mesh.faces[h].iter().map(|&v| mesh.positions[v as usize]);
+        let size = pts(f)
+            .chain(pts(g))
+            .map(|p| (p - mesh.positions[mesh.faces[f][0] as usize]).length())
+            .fold(0.0, f64::max);
+        let o = mesh.positions[mesh.faces[f][0] as usize];
+        pts(g).all(|p| nf_.dot(p - o).abs() <= PLANE_DISTANCE * size)
+    };
+    let mut any = false;
+    for (&(a, b), &f) in &directed {
+        if let Some(&g) = directed.get(&(b, a)) {
+            if f < g && coplanar(f, g) {
+                let (rf, rg) = (root(&mut parent, f), root(&mut parent, g));
+                if rf != rg {
+                    parent[rf.max(rg)] = rf.min(rg);
+                    any = true;
+                }
+            }
+        }
+    }
+    if !any {
+        return mesh.clone();
+    }
+    let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
+    for f in 0..nf {
+        let r = root(&mut parent, f);
+        groups.entry(r).or_default().push(f);
+    }
+    let mut roots: Vec<usize> = groups.keys().copied().collect();
+    roots.sort_unstable();
+    let mut faces: Vec<Vec<u32>> = Vec::new();
+    let mut reps: Vec<u32> = Vec::new();
+    for r in roots {
+        let group = &groups[&r];
+        let keep_all = |faces: &mut Vec<Vec<u32>>, reps: &mut Vec<u32>| {
+            for &f in group {
+                faces.push(mesh.faces[f].clone());
+                reps.push(f as u32);
+            }
+        };
+        if group.len() == 1 {
+            keep_all(&mut faces, &mut reps);
+            continue;
+        }
+        match boundary_loop(mesh, group) {
+            Some(poly) => {
+                faces.push(poly);
+                reps.push(group[0] as u32);
+            }
+            None => keep_all(&mut faces, &mut reps),
+        }
+    }
+    // Vertices on a straight edge between only two polygons.
+    let mut count: HashMap<u32, Vec<usize>> = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        for &v in face {
+            let e = count.entry(v).or_default();
+            if !e.contains(&f) {
+                e.push(f);
+            }
+        }
+    }
+    for face in &mut faces {
+        let kept: Vec<u32> = face
+            .iter()
+            .copied()
+            .filter(|v| count[v].len() > 2)
+            .collect();
+        if kept.len() >= 3 {
+            *face = kept;
+        }
+    }
+    Mesh {
+        positions: mesh.positions.clone(),
+        file_normals: mesh.file_normals.clone(),
+        vertex_lines: mesh.vertex_lines.clone(),
+        face_lines: reps
+            .iter()
+            .map(|&f| mesh.face_lines.get(f as usize).copied().unwrap_or(0))
+            .collect(),
+        face_parent: reps,
+        faces,
+    }
+}
+
+/// The boundary of the union of `group`'s faces as one simple loop (counter-clockwise from
+/// outside like its faces), or `None` when it is not a disk with a simple boundary.
+fn boundary_loop(mesh: &Mesh, group: &[usize]) -> Option<Vec<u32>> {
+    let mut half: HashMap<(u32, u32), ()> = HashMap::new();
+    for &f in group {
+        let face = &mesh.faces[f];
+        for k in 0..face.len() {
+            half.insert((face[k], face[(k + 1) % face.len()]), ());
+        }
+    }
+    let mut next: HashMap<u32, u32> = HashMap::new();
+    for &(a, b) in half.keys() {
+        if !half.contains_key(&(b, a)) && next.insert(a, b).is_some() {
+            return None; // a pinched boundary
+        }
+    }
+    let start = *next.keys().min()?;
+    let mut poly = vec![start];
+    let mut cur = next[&start];
+    while cur != start {
+        if poly.len() > next.len() {
+            return None;
+        }
+        poly.push(cur);
+        cur = *next.get(&cur)?;
+    }
+    (poly.len() == next.len()).then_some(poly)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The triangulated hallway corner (an L-shaped block) becomes the L prism: two hexagons
+    /// and six quadrilaterals, same vertices.
+    #[test]
+    fn triangulated_l_block_merges_to_prism() {
+        let (m, _) =
+            crate::mesh::load(std::path::Path::new("scenes/models/hallway_corner.obj")).unwrap();
+        let merged = merge_coplanar(&m);
+        let mut sizes: Vec<usize> = merged.faces.iter().map(Vec::len).collect();
+        sizes.sort_unstable();
+        assert_eq!(sizes, vec![4, 4, 4, 4, 4, 4, 6, 6]);
+        // Every merged polygon is planar with its representative input face's normal.
+        for (f, face) in merged.faces.iter().enumerate() {
+            let n = area_vector(&merged.positions, face).normalize();
+            let rep = &m.faces[merged.face_parent[f] as usize];
+            let nr = area_vector(&m.positions, rep).normalize();
+            // Axis-aligned unit-size geometry: exact up to rounding.
+            assert!((n - nr).length() < 1e-12);
+        }
+    }
+}
