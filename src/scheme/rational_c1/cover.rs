@@ -334,7 +334,15 @@ pub fn sup_bound<F: Family>(
         }
     }
     let open = s.heap.peek().map_or(f64::NEG_INFINITY, |o| o.u);
-    let value = floor.max(s.stuck).max(open);
+    let mut value = floor.max(s.stuck).max(open);
+    if !value.is_finite() {
+        // Some lines have no finite Lemma 2.3 bound (a derivative coefficient d_k ≤ 0 there,
+        // so no f_0003 certifies them): the documented fallback is the largest finite bound
+        // met on the sampled lines, as before certificates existed; `converged` stays false
+        // and `apatch check` samples those patches' sheets.
+        value = floor.max(s.sampled);
+        converged = false;
+    }
     if value > floor.max(s.sampled) + opts.tol {
         converged = false;
     }
