@@ -270,6 +270,12 @@ pub fn build_corner(
             let h0 = up.dot(t0 - c0);
             if h0 < shift {
                 t0 += (shift - h0) * up;
+            } else if !separable {
+                // T_0 is still on e, in both face planes with C_0 = V: lift it off them as in
+                // cases (i)–(iii), away from the triangle.
+                let mm = (c1 - c0).cross(c2 - c0);
+                let side = orient(c0, c1, c2, t0).signum();
+                t0 += shift * side * mm.normalize_or_zero();
             }
             t1 = keep_side(t1 - shift * up);
             let o0 = orient(c0, c1, c2, t0);
