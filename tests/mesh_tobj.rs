@@ -67,15 +67,18 @@ fn tobj_faces(path: &Path) -> Vec<Key> {
 
 fn our_faces(path: &Path) -> Vec<Key> {
     let (m, _) = mesh::load(path).unwrap_or_else(|e| panic!("{e}"));
+    // A vertex split off a non-manifold vertex (`split_vertex`) is appended with the line of its
+    // original and moved a relative 1e-6 into its fan: put it back where the file has it, so both
+    // readers see the file's coordinates.
+    let mut by_line = std::collections::HashMap::new();
+    for (v, &line) in m.vertex_lines.iter().enumerate() {
+        by_line.entry(line).or_insert(v);
+    }
+    let file_position = |i: u32| m.positions[by_line[&m.vertex_lines[i as usize]]].to_array();
     sorted(
         m.faces
             .iter()
-            .map(|f| {
-                (
-                    f.len(),
-                    centroid(f.iter().map(|&i| m.positions[i as usize].to_array())),
-                )
-            })
+            .map(|f| (f.len(), centroid(f.iter().map(|&i| file_position(i)))))
             .collect(),
     )
 }
