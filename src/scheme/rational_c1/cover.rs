@@ -268,7 +268,15 @@ struct Search<'a, F: Family> {
     stuck: f64,
     nodes: usize,
     seq: usize,
+    /// Whether some sub-domain was given up as uncertifiable (see [`UNCERTIFIED_DEPTH`]).
+    uncertified: bool,
 }
+
+/// Depth from which a sub-domain whose every certificate is +∞ (some derivative coefficient
+/// e_i ≤ 0 there, so Lemma 2.3's ratio bound does not exist) is given up: its lines count
+/// through their sampled centres only, as in the sampled bound before certificates. Without
+/// this cut such a sub-domain is split until the node budget runs out, for nothing.
+const UNCERTIFIED_DEPTH: u32 = 4;
 
 impl<F: Family> Search<'_, F> {
     /// Examines one node: samples its centre, certifies it, keeps it open unless settled.
@@ -282,6 +290,10 @@ impl<F: Family> Search<'_, F> {
         let b = self.fam.bundle(&node);
         let (u, t) = best_certificate(&b, F::N, tc, t_parent, self.floor);
         if u <= self.floor {
+            return;
+        }
+        if u == f64::INFINITY && depth >= UNCERTIFIED_DEPTH {
+            self.uncertified = true;
             return;
         }
         if depth >= self.opts.max_depth {
@@ -317,6 +329,7 @@ pub fn sup_bound<F: Family>(
         stuck: floor,
         nodes: 0,
         seq: 0,
+        uncertified: false,
     };
     s.visit(root, 0, 0.5);
     let mut converged = true;
@@ -343,7 +356,7 @@ pub fn sup_bound<F: Family>(
         value = floor.max(s.sampled);
         converged = false;
     }
-    if value > floor.max(s.sampled) + opts.tol {
+    if value > floor.max(s.sampled) + opts.tol || s.uncertified {
         converged = false;
     }
     Certified {
