@@ -190,10 +190,11 @@ fn global_fallback_uses_sparse_solver() {
     assert!(r.passed(), "{:?}", r.failures());
 }
 
-/// torus_quad (quad faces in 50 coplanar stars, a group of over 7000 weights): as above;
-/// ignored because it takes ~20 s in release (extra evidence beside star_prism).
+/// torus_quad (quad faces in 50 coplanar stars, a group of over 7000 weights) is C2 through
+/// the sparse solver;
+/// ignored because it takes ~8 s in release (extra evidence).
 #[test]
-#[ignore = "slow (~20 s release): extra evidence for the sparse solver beside star_prism"]
+#[ignore = "slow (~8 s release): extra evidence for the sparse solver beside global_fallback_uses_sparse_solver"]
 fn torus_quad_is_c2() {
     let c = c2_of("torus_quad.obj", 7000);
     let r = check(&c, &CheckOptions::default());
