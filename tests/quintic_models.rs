@@ -120,33 +120,81 @@ fn inner_hull_models_are_c2() {
     }
 }
 
-/// Large coplanar regions (star_prism: 30 relaxed stars couple into one group of over 3000
-/// weights) build with exact C2 through the sparse solver. Its hull overlaps (another
-/// module's issue), so `apatch check` fails on T-junctions and j-lines; the continuity
-/// measures and interpolation must hold regardless.
+/// The inner hull cube_poly had before coplanar faces were merged (its top face split into two
+/// triangles with their own centroids; pseudo-centroids at the two non-trihedral corners). The
+/// staged solve is inconsistent there at the number 10 weights of the bottom edges (apexes in
+/// the planes of both faces), so every weight is solved at once: one group of over 1000
+/// weights, which goes to the sparse solver. The result must be C2 and pass `apatch check`.
 #[test]
-fn large_coplanar_regions_are_c2() {
-    let name = "star_prism.obj";
-    let c = c2_of(name, 3000);
-    let r = check(&c, &CheckOptions::default());
+fn global_fallback_uses_sparse_solver() {
+    use apatch::hull::simplicial::{PointOrigin, SimplicialHull};
+    use glam::DVec3;
+    let (t, s3) = (1.0 / 3.0, 1.0 / 3.0_f64.sqrt());
+    let v = DVec3::new;
+    let points = vec![
+        v(t, t, 1.0),
+        v(-t, -t, 1.0),
+        v(-1.0, 0.0, 0.0),
+        v(0.0, 1.0, 0.0),
+        v(1.0, 0.0, 0.0),
+        v(0.0, -1.0, 0.0),
+        v(0.0, 0.0, -1.0),
+        v(-2.0 * t, 2.0 * t, 2.0 * t),
+        v(2.0 * t, -2.0 * t, 2.0 * t),
+    ];
+    let normals = vec![
+        DVec3::Z,
+        DVec3::Z,
+        -DVec3::X,
+        DVec3::Y,
+        DVec3::X,
+        -DVec3::Y,
+        -DVec3::Z,
+        v(-s3, s3, s3),
+        v(s3, -s3, s3),
+    ];
+    let tris: [([u32; 3], DVec3); 14] = [
+        ([1, 2, 5], v(-1.0, -1.0, 1.0)),
+        ([7, 0, 3], v(-0.1, 1.0, 1.0)),
+        ([7, 3, 2], v(-1.0, 1.0, 0.1)),
+        ([7, 2, 1], v(-1.0, 0.1, 1.0)),
+        ([7, 1, 0], v(-t, t, 4.0 * t)),
+        ([0, 4, 3], v(1.0, 1.0, 1.0)),
+        ([8, 0, 1], v(t, -t, 4.0 * t)),
+        ([8, 1, 5], v(0.1, -1.0, 1.0)),
+        ([8, 5, 4], v(1.0, -1.0, 0.1)),
+        ([8, 4, 0], v(1.0, -0.1, 1.0)),
+        ([2, 6, 5], v(-1.0, -1.0, -1.0)),
+        ([2, 3, 6], v(-1.0, 1.0, -1.0)),
+        ([3, 4, 6], v(1.0, 1.0, -1.0)),
+        ([4, 5, 6], v(1.0, -1.0, -1.0)),
+    ];
+    let hull = SimplicialHull {
+        origins: vec![PointOrigin::Other; points.len()],
+        points,
+        normals,
+        triangles: tris.iter().map(|t| t.0).collect(),
+        apexes: tris.iter().map(|t| [Some(t.1), None]).collect(),
+        element: (0..14).collect(),
+    };
+    let (c, stats) = build_with_stats(&hull, &QuinticOptions::default()).unwrap();
     assert!(
-        r.gradient_jump.worst <= 1e-9,
-        "{name}: {:?}",
-        r.gradient_jump
+        stats.global && stats.sparse_groups >= 1 && stats.largest_group >= 1000,
+        "{stats:?}"
     );
-    assert!(r.hessian_jump.worst <= 1e-7, "{name}: {:?}", r.hessian_jump);
-    let f: Vec<&str> = r
-        .failures()
-        .into_iter()
-        .filter(|f| *f != "multiple sheets along j-lines" && *f != "t-junctions")
-        .collect();
-    assert!(f.is_empty(), "{name}: {f:?}");
+    // Relative residual: the sparse solve stops at 1e-13 of the group's largest datum.
+    assert!(stats.max_residual < 1e-12, "{stats:?}");
+    let r = check(&c, &CheckOptions::default());
+    assert!(r.gradient_jump.worst <= 1e-9, "{:?}", r.gradient_jump);
+    assert!(r.hessian_jump.worst <= 1e-7, "{:?}", r.hessian_jump);
+    assert!(r.passed(), "{:?}", r.failures());
 }
 
-/// torus_quad (quad faces in 50 coplanar stars, a group of over 7000 weights): as above;
-/// ignored because it takes ~20 s in release (extra evidence beside star_prism).
+/// torus_quad (quad faces in 50 coplanar stars, a group of over 7000 weights) is C2 through
+/// the sparse solver;
+/// ignored because it takes ~8 s in release (extra evidence).
 #[test]
-#[ignore = "slow (~20 s release): extra evidence for the sparse solver beside star_prism"]
+#[ignore = "slow (~8 s release): extra evidence for the sparse solver beside global_fallback_uses_sparse_solver"]
 fn torus_quad_is_c2() {
     let c = c2_of("torus_quad.obj", 7000);
     let r = check(&c, &CheckOptions::default());
