@@ -165,3 +165,36 @@ fn spot_control_cage_needs_appendix_c() {
         "{e}"
     );
 }
+
+/// Unseparable vertices (C_0 = V) of the triangle models: T_0 on an edge lies in both face
+/// planes, as do V and the centroid between them, so two such apexes beside one edge VC_i of T
+/// made its edge tetrahedra exactly flat (this stopped the cubic build of the knot). T_0 is now
+/// lifted off the face planes in every case that uses it; no edge tetrahedron of the knot's hull
+/// is flat.
+#[test]
+fn knot_has_no_flat_edge_tetrahedra() {
+    let path = Path::new("scenes/models/knot1.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+    assert!(
+        !rep.unseparable.is_empty(),
+        "the knot has unseparable vertices"
+    );
+    let flat = hull
+        .edge_tets()
+        .unwrap()
+        .iter()
+        .filter(|et| {
+            let t = et.tet;
+            let v6 = (t[1] - t[0]).cross(t[2] - t[0]).dot(t[3] - t[0]).abs();
+            let l = (0..4)
+                .flat_map(|i| (0..4).map(move |j| (t[i] - t[j]).length()))
+                .fold(0.0, f64::max);
+            // Exactly flat (coplanar points) gives rounding-level volumes ~1e-16 L³; the
+            // lifted apexes are 5% of an edge off the planes.
+            v6 < 1e-12 * l * l * l
+        })
+        .count();
+    assert_eq!(flat, 0);
+}

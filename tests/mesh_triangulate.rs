@@ -93,6 +93,38 @@ fn non_convex_model_faces() {
     }
 }
 
+/// Polygons with collinear vertices (mpi_poly.obj: face 15, line 113, has a notch whose side is
+/// collinear with a vertex across the polygon) give no zero-area triangle, in every model.
+#[test]
+fn no_zero_area_triangles_in_any_model() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .collect();
+    names.sort();
+    for path in names {
+        let (m, _) = mesh::load(&path).unwrap();
+        let t = mesh::triangulate(&m);
+        for (i, tri) in t.faces.iter().enumerate() {
+            let p: Vec<DVec3> = tri.iter().map(|&v| t.positions[v as usize]).collect();
+            let longest = (p[1] - p[0])
+                .length()
+                .max((p[2] - p[1]).length())
+                .max((p[0] - p[2]).length());
+            let area = area_vector(&t.positions, tri).length();
+            // The zero-area face tolerance of validation (far above rounding of real triangles).
+            assert!(
+                area > mesh::ZERO_AREA_TOL * longest * longest,
+                "{}: triangle {i} {tri:?} of face {} has zero area",
+                path.display(),
+                t.face_parent[i]
+            );
+        }
+    }
+}
+
 #[test]
 fn random_star_shaped_polygons_in_tilted_planes() {
     let mut rng = Lcg(99);

@@ -67,7 +67,9 @@ fn explore_all() {
 /// ≤ 1e-9, Hessian jumps ≤ 1e-7 (the checker's relative measures), vertex values and normals
 /// interpolated (rounding-level tolerances of the checker's defaults), the solve's own residual
 /// at rounding level. Non-trihedral vertices (octahedron, icosahedron), L-U pairs and
-/// relaxed (coplanar) stars (l_prism, corner_poly), genus 1 (torus).
+/// relaxed (coplanar) stars (l_prism, corner_poly), genus 1 (torus), and cube_poly, whose
+/// staged solve is inconsistent at the number 10 weights of its bottom edges (apexes in the
+/// planes of the faces) and is solved at once instead (the global fallback, a sparse group).
 #[test]
 fn inner_hull_models_are_c2() {
     for name in [
@@ -76,6 +78,7 @@ fn inner_hull_models_are_c2() {
         "l_prism.obj",
         "corner_poly.obj",
         "torus_quad12x8.obj",
+        "cube_poly.obj",
     ] {
         let path = Path::new("scenes/models").join(name);
         let (m, _) = mesh::load(&path).unwrap();
@@ -115,4 +118,175 @@ fn inner_hull_models_are_c2() {
             assert!(r.passed(), "{name}: {:?}", r.failures());
         }
     }
+}
+
+/// Large coplanar regions (star_prism: 30 relaxed stars couple into one group of over 3000
+/// weights) build with exact C2 through the sparse solver. Its hull overlaps (another
+/// module's issue), so `apatch check` fails on T-junctions and j-lines; the continuity
+/// measures and interpolation must hold regardless.
+#[test]
+fn large_coplanar_regions_are_c2() {
+    let name = "star_prism.obj";
+    let c = c2_of(name, 3000);
+    let r = check(&c, &CheckOptions::default());
+    assert!(
+        r.gradient_jump.worst <= 1e-9,
+        "{name}: {:?}",
+        r.gradient_jump
+    );
+    assert!(r.hessian_jump.worst <= 1e-7, "{name}: {:?}", r.hessian_jump);
+    let f: Vec<&str> = r
+        .failures()
+        .into_iter()
+        .filter(|f| *f != "multiple sheets along j-lines" && *f != "t-junctions")
+        .collect();
+    assert!(f.is_empty(), "{name}: {f:?}");
+}
+
+/// torus_quad (quad faces in 50 coplanar stars, a group of over 7000 weights): as above;
+/// ignored because it takes ~20 s in release (extra evidence beside star_prism).
+#[test]
+#[ignore = "slow (~20 s release): extra evidence for the sparse solver beside star_prism"]
+fn torus_quad_is_c2() {
+    let c = c2_of("torus_quad.obj", 7000);
+    let r = check(&c, &CheckOptions::default());
+    assert!(r.gradient_jump.worst <= 1e-9, "{:?}", r.gradient_jump);
+    assert!(r.hessian_jump.worst <= 1e-7, "{:?}", r.hessian_jump);
+}
+
+/// Builds `name`'s quintic complex and checks that the solve went through a sparse group of at
+/// least `min_group` weights with a rounding-level residual.
+fn c2_of(name: &str, min_group: usize) -> apatch::complex::PatchComplex {
+    let path = Path::new("scenes/models").join(name);
+    let (m, _) = mesh::load(&path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+    let (c, stats) = build_with_stats(&hull, &QuinticOptions::default()).unwrap();
+    assert!(
+        stats.sparse_groups >= 1 && stats.largest_group >= min_group,
+        "{name}: {stats:?}"
+    );
+    // Relative residual: the sparse solve stops at 1e-13 of the group's largest datum; the
+    // global measure divides by the largest weight.
+    assert!(stats.max_residual < 1e-12, "{name}: {stats:?}");
+    c
+}
+
+/// Every shipped quintic scene is closed as traced: no primary ray's first hit faces away
+/// from the camera (a ray that meets the surface's inside first went through a crack, such as
+/// the one the estimated curvature opened on cube_poly before its scene chose planar jets).
+/// `apatch check` samples lines from the patches' vertices and does not see such cracks.
+#[test]
+fn quintic_scenes_have_no_cracks() {
+    let mut scenes: Vec<_> = std::fs::read_dir("scenes/paper1994")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with("_quintic.toml"))
+        // Known wrong, reported in docs/quintic.md: on the 12×8 torus 613 of the 160×160 rays
+        // (161 for the cubic scheme on the same hull) first meet a back face, through holes
+        // where 24 single-sided face patches cross their base triangle on T (`base_crossings`),
+        // which `apatch check` does not detect either.
+        .filter(|p| !p.to_string_lossy().contains("torus_quad12x8"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 6, "{scenes:?}");
+    for path in scenes {
+        let back = back_facing_hits(&path);
+        assert_eq!(back, 0, "{}: {back} back-facing first hits", path.display());
+    }
+}
+
+/// Exploration: `SCENE=path cargo test --release --test quintic_models crack_count -- --ignored
+/// --nocapture` prints the back-facing first hits of a scene.
+#[test]
+#[ignore = "exploration: SCENE=path"]
+fn crack_count() {
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    eprintln!("{}: {}", path.display(), back_facing_hits(&path));
+}
+
+/// Primary rays (160×160, 1 spp) of the scene at `path` whose first hit faces away from the
+/// camera.
+fn back_facing_hits(path: &Path) -> usize {
+    use apatch::trace::{self, Geometry, Mode};
+    use std::sync::atomic::AtomicBool;
+    let sc = apatch::scene::load(path).unwrap();
+    let complex = apatch::scene::build_complex(&sc).unwrap();
+    let geo = Geometry::new(&complex).unwrap();
+    let mut s = sc.settings.clone();
+    s.camera = s.camera.resized(160, 160).unwrap();
+    s.spp = 1;
+    s.threads = 1;
+    s.mode = Mode::Normal;
+    let origin = s.camera.origin;
+    let frame = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
+    frame
+        .pixels
+        .iter()
+        .filter(|p| p.alpha > 0.0)
+        .filter(|p| {
+            let n = glam::DVec3::from(p.normal.map(f64::from));
+            let d = (glam::DVec3::from(p.position.map(f64::from)) - origin).normalize();
+            // A hit through a crack faces away clearly (0.7 on cube_poly); grazing hits
+            // at the silhouette are within a few degrees of 0 (f32 normals).
+            n.dot(d) > 0.1
+        })
+        .count()
+}
+
+/// Exploration: face patches of a scene whose zero set crosses the base triangle on T (F takes
+/// the apex's sign somewhere inside the base), which opens a hole in the surface.
+#[test]
+#[ignore = "exploration: SCENE=path"]
+fn base_crossings() {
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    let sc = apatch::scene::load(&path).unwrap();
+    let c = apatch::scene::build_complex(&sc).unwrap();
+    let (mut bad, mut faces) = (0, 0);
+    let base = |p: &apatch::complex::Patch| {
+        let mut b: Vec<[u64; 3]> = p.tet[..3].iter().map(|v| v.map(f64::to_bits)).collect();
+        b.sort_unstable();
+        b
+    };
+    let mut count = std::collections::HashMap::new();
+    for p in &c.patches {
+        if p.role == apatch::complex::Role::Face {
+            *count.entry(base(p)).or_insert(0) += 1;
+        }
+    }
+    for (k, p) in c.patches.iter().enumerate() {
+        // Single-sided face tetrahedra only: an L-U pair's base is inside the hull.
+        if p.role != apatch::complex::Role::Face || count[&base(p)] > 1 {
+            continue;
+        }
+        faces += 1;
+        let n = usize::from(p.degree);
+        let apex = p.weights[apatch::bb::index_of([0, 0, 0, p.degree])];
+        let m = 24;
+        let mut worst = 0.0_f64;
+        for i in 1..m {
+            for j in 1..m - i {
+                let a = [
+                    i as f64 / m as f64,
+                    j as f64 / m as f64,
+                    (m - i - j) as f64 / m as f64,
+                    0.0,
+                ];
+                let f = apatch::bb::poly::eval(n, &p.weights, a);
+                if f * apex > 0.0 {
+                    worst = worst.max(f.abs());
+                }
+            }
+        }
+        if worst > 0.0 {
+            bad += 1;
+            if bad <= 5 {
+                eprintln!("patch {k}: apex F {apex:.3e}, base F up to {worst:.3e} with its sign; tet {:?}", p.tet);
+            }
+        }
+    }
+    eprintln!(
+        "{}: {bad} of {faces} single-sided face patches cross their base",
+        path.display()
+    );
 }

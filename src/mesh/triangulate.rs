@@ -38,8 +38,11 @@ pub fn triangulate(mesh: &Mesh) -> Mesh {
 
 /// Ear clipping of one polygon (vertex indices `face`) projected onto the plane normal to its
 /// area vector. Pushes `face.len() − 2` triangles onto `out`. An ear is a convex corner whose
-/// triangle contains no other polygon vertex; when rounding leaves no strict ear (nearly
-/// degenerate input), the most convex corner is clipped so the count is always right.
+/// triangle contains no other polygon vertex, not even on its sides up to a rounding tolerance
+/// (1e-12 of the polygon's size squared, so a vertex exactly on a diagonal in 3D, like the
+/// collinear notch of mpi_poly.obj's face 15, still blocks the ear after projection to 2D and
+/// cannot end in a zero-area triangle); when rounding leaves no strict ear (nearly degenerate
+/// input), the most convex corner is clipped so the count is always right.
 pub fn ear_clip(
     positions: &[DVec3],
     face: &[u32],
@@ -65,6 +68,10 @@ pub fn ear_clip(
     let mut next: Vec<usize> = (0..n).map(|i| (i + 1) % n).collect();
     let mut prev: Vec<usize> = (0..n).map(|i| (i + n - 1) % n).collect();
     let cross = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
+    let (lo, hi) = p
+        .iter()
+        .fold((p[0], p[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+    let on = -1e-12 * (hi - lo).length_squared();
     let mut remaining = n;
     let mut i = 0usize;
     let mut since_clip = 0usize;
@@ -77,9 +84,9 @@ pub fn ear_clip(
                 let mut clear = true;
                 while j != a {
                     let q = p[j];
-                    if cross(p[a], p[b], q) >= 0.0
-                        && cross(p[b], p[c], q) >= 0.0
-                        && cross(p[c], p[a], q) >= 0.0
+                    if cross(p[a], p[b], q) >= on
+                        && cross(p[b], p[c], q) >= on
+                        && cross(p[c], p[a], q) >= on
                         && q != p[a]
                         && q != p[c]
                     {

@@ -10,6 +10,7 @@
 
 pub mod dense;
 pub mod jets;
+pub mod sparse;
 pub mod system;
 
 use crate::complex::{Patch, PatchComplex, SheetRule};

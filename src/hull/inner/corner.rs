@@ -239,6 +239,13 @@ pub fn build_corner(
                 set_apex(&mut slot, tri, t0);
                 counts.case_i += 1;
             } else {
+                if !separable {
+                    // As in case (i): T_0 on e lies in both face planes, as do C_0 = V and the
+                    // centroids, so the edge tetrahedra over VC_i between two such apexes would
+                    // be flat; lift T_0 away from the triangle.
+                    let side = orient(c0, c1, c2, t0).signum();
+                    t0 += 0.05 * d.length() * side * mm.normalize_or_zero();
+                }
                 let o0 = orient(c0, c1, c2, t0);
                 // T_1 must lie on the corner's side of the triangle unless T_0 already does.
                 if o0 * want <= 0.0 {

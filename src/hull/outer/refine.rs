@@ -134,3 +134,45 @@ pub fn split_edges_with(mesh: &mut RefineMesh, edges: &[u32], rule: SplitRule) -
     }
     Ok(split)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn midpoint_split_keeps_planes_and_origins() {
+        // Two triangles folded along the edge 0-1 (the x axis).
+        let positions = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 1.0, 0.0),
+            DVec3::new(0.5, -0.5, -0.8),
+        ];
+        let normals = vec![DVec3::Z; 4];
+        let mut mesh = RefineMesh {
+            positions,
+            normals,
+            triangles: vec![[0, 1, 2], [1, 0, 3]],
+            origin: vec![0, 1],
+        };
+        let (emap, _) = edge_map(4, &mesh.triangles).unwrap();
+        let e = emap
+            .iter()
+            .position(|(v, _)| v.contains(&0) && v.contains(&1));
+        let n = split_edges_with(&mut mesh, &[e.unwrap() as u32], SplitRule::Midpoint).unwrap();
+        assert_eq!(n, 1);
+        assert_eq!(mesh.positions[4], DVec3::new(0.5, 0.0, 0.0));
+        assert_eq!(mesh.normals[4], DVec3::Z);
+        assert_eq!(mesh.triangles.len(), 4);
+        assert_eq!(mesh.origin, vec![0, 1, 0, 1]);
+        // Every new triangle lies in the plane of the triangle it came from (exact: the
+        // midpoint of an axis edge and the old corners are representable).
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let q = tri.map(|i| mesh.positions[i as usize]);
+            let nt = (q[1] - q[0]).cross(q[2] - q[0]).normalize();
+            let o = [[0, 1, 2], [1, 0, 3]][mesh.origin[t] as usize].map(|i| mesh.positions[i]);
+            let no = (o[1] - o[0]).cross(o[2] - o[0]).normalize();
+            assert!((nt.dot(no) - 1.0).abs() < 1e-12, "triangle {t}");
+        }
+    }
+}

@@ -29,8 +29,8 @@
 //!    paper's b_3110) and 11.
 //! 6. everything else in the edge tetrahedra (number 14, 15, 17 and the free ones of λ4 > 2).
 
-use super::dense;
 use super::jets::Jet;
+use super::{dense, sparse};
 use crate::bb::{multi_indices, Tet};
 use crate::complex::Role;
 use crate::error::{Error, Result};
@@ -42,6 +42,10 @@ use std::collections::HashMap;
 pub const N: usize = 5;
 /// Weights per patch: C(8, 3).
 pub const NW: usize = 56;
+/// Largest group solved by the dense QR ([`dense`]); larger ones go to [`sparse`].
+pub const DENSE_LIMIT: usize = 1000;
+/// Iteration limit of a [`sparse`] solve.
+const SPARSE_ITERATIONS: usize = 50_000;
 
 /// One tetrahedron of the hull with its vertices as global ids.
 #[derive(Clone, Debug)]
@@ -347,6 +351,11 @@ pub struct SolveStats {
     /// Points of T whose star needed its edge middles or Hessian relaxed (not in general
     /// position).
     pub relaxed_points: usize,
+    /// Whether the staged solve failed and every weight was solved at once (one group per
+    /// connected component of the equations), see [`System::solve`].
+    pub global: bool,
+    /// Groups above [`DENSE_LIMIT`] unknowns, solved by [`sparse`].
+    pub sparse_groups: usize,
 }
 
 /// A group whose equations could not be met in one pass.
@@ -364,7 +373,9 @@ impl System {
     /// around that point, e.g. coplanar triangles), the solve is repeated with the number 3/4
     /// weights of the edges at that point solved together with the star, and if that is not
     /// enough, with the point's Hessian (number 2 weights) chosen by the system too (closest to
-    /// the estimated one).
+    /// the estimated one). If a group still cannot be met, or a later stage (face middles, edge
+    /// tetrahedra) is inconsistent with the free weights fixed before it, every unknown is solved
+    /// at once instead, closest to its target ([`SolveStats::global`]).
     ///
     /// # Errors
     /// A group whose equations cannot be met even so, naming where.
@@ -376,11 +387,16 @@ impl System {
         target: &dyn Fn(usize, [u8; 4]) -> f64,
     ) -> Result<(Vec<f64>, SolveStats)> {
         let mut level: HashMap<u32, u8> = HashMap::new();
+        let mut first_failure = None;
         for _pass in 0..6 {
-            let (value, mut stats, failures) = self.solve_pass(tets, jets, nt, target, &level);
+            let (value, mut stats, failures) =
+                self.solve_pass(tets, jets, nt, target, &level, false);
             if failures.is_empty() {
                 stats.relaxed_points = level.len();
                 return Ok((value, stats));
+            }
+            if first_failure.is_none() {
+                first_failure = Some(failures[0].message.clone());
             }
             let mut bumped = false;
             for f in &failures {
@@ -407,12 +423,24 @@ impl System {
                 }
             }
             if !bumped {
-                return Err(Error::Invalid(failures[0].message.clone()));
+                first_failure = Some(failures[0].message.clone());
+                break;
             }
         }
-        Err(Error::Invalid(
-            "quintic-c2: the vertex-star systems did not become consistent".into(),
-        ))
+        // The staged solve fixed free weights that a later stage cannot live with (e.g. the
+        // number 10 system of an edge whose apexes lie in the planes of its points' faces, as on
+        // cube_poly): solve every unknown at once, each connected group closest to its targets.
+        let (value, mut stats, failures) = self.solve_pass(tets, jets, nt, target, &level, true);
+        if failures.is_empty() {
+            stats.relaxed_points = level.len();
+            stats.global = true;
+            return Ok((value, stats));
+        }
+        let staged = first_failure.unwrap_or_default();
+        Err(Error::Invalid(format!(
+            "{staged}; solving all weights at once does not help either: {}",
+            failures[0].message
+        )))
     }
 
     #[allow(clippy::too_many_lines)]
@@ -423,6 +451,7 @@ impl System {
         nt: u32,
         target: &dyn Fn(usize, [u8; 4]) -> f64,
         level: &HashMap<u32, u8>,
+        global: bool,
     ) -> (Vec<f64>, SolveStats, Vec<Failure>) {
         let ns = self.keys.len();
         let np = self.np;
@@ -476,7 +505,7 @@ impl System {
                     known[s] = true;
                 }
             }
-            stage_of[s] = st;
+            stage_of[s] = if global { st.min(1) } else { st };
         }
         // Each equation is solved at the stage of its last unknown.
         let mut by_stage: Vec<Vec<usize>> = vec![Vec::new(); 7];
@@ -577,29 +606,20 @@ impl System {
                     }
                     pts
                 };
-                if unk.len() > 2500 {
-                    failures.push(Failure {
-                        stage: 9,
-                        points: Vec::new(),
-                        message: format!(
-                            "quintic-c2: {} weights are coupled at stage {st} (expected local systems); the hull is not smoothable as built",
-                            unk.len()
-                        ),
-                    });
-                    continue;
-                }
                 let col: HashMap<u32, usize> =
                     unk.iter().enumerate().map(|(i, s)| (*s, i)).collect();
                 let (m, n) = (eqs.len(), unk.len());
-                let mut a = vec![0.0; m * n];
+                let mut rows: Vec<sparse::Row> = Vec::with_capacity(m);
                 let mut c = vec![0.0; m];
                 for (i, &e) in eqs.iter().enumerate() {
+                    let mut row = Vec::new();
                     for &(s, k) in &self.equations[e].terms {
                         match col.get(&s) {
-                            Some(&j) => a[i * n + j] += k,
+                            Some(&j) => row.push((j, k)),
                             None => c[i] -= k * value[s as usize],
                         }
                     }
+                    rows.push(row);
                 }
                 let tgt: Vec<f64> = unk
                     .iter()
@@ -617,7 +637,18 @@ impl System {
                     .iter()
                     .chain(tgt.iter())
                     .fold(1e-300_f64, |acc, x| acc.max(x.abs()));
-                let sol = dense::solve_near(&a, m, n, &c, &tgt, 1e-11);
+                let sol = if n <= DENSE_LIMIT {
+                    let mut a = vec![0.0; m * n];
+                    for (i, row) in rows.iter().enumerate() {
+                        for &(j, k) in row {
+                            a[i * n + j] += k;
+                        }
+                    }
+                    dense::solve_near(&a, m, n, &c, &tgt, 1e-11)
+                } else {
+                    stats.sparse_groups += 1;
+                    sparse::solve_near(&rows, n, &c, &tgt, 1e-13 * scale, SPARSE_ITERATIONS)
+                };
                 let bad = sol.residual.is_nan()
                     || sol.residual > 1e-9 * scale
                     || sol.x.iter().any(|x| !x.is_finite());

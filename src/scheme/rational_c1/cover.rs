@@ -161,9 +161,9 @@ const T_GRID: [f64; 14] = [
 
 /// The smallest [`certificate`] found over t*: the centre's best t* `tc`, the parent's `tp`,
 /// the second case's limit, a fixed grid, then 10 golden-section steps around the best grid
-/// value. Returns the value and its t*. (Any t* gives a valid certificate; the search only
-/// makes it tighter.)
-fn best_certificate(b: &Bundle, n: usize, tc: f64, tp: f64) -> (f64, f64) {
+/// value; it stops as soon as a value ≤ `floor` is found. Returns the value and its t*.
+/// (Any t* gives a valid certificate; the search only makes it tighter.)
+fn best_certificate(b: &Bundle, n: usize, tc: f64, tp: f64, floor: f64) -> (f64, f64) {
     let mut best = (f64::INFINITY, tc);
     let consider = |t: f64, best: &mut (f64, f64)| {
         if t > 0.0 && t <= 1.0 {
@@ -174,10 +174,17 @@ fn best_certificate(b: &Bundle, n: usize, tc: f64, tp: f64) -> (f64, f64) {
         }
     };
     consider(tc, &mut best);
+    if best.0 <= floor {
+        // Settled: the node's lines need nothing above the floor.
+        return best;
+    }
     consider(tp, &mut best);
     if let Some(l) = case2_limit(b, n) {
         consider(l.min(tc), &mut best);
         consider(l, &mut best);
+    }
+    if best.0 <= floor {
+        return best;
     }
     let mut grid_best = (f64::INFINITY, 0usize);
     for (k, &t) in T_GRID.iter().enumerate() {
@@ -273,7 +280,7 @@ impl<F: Family> Search<'_, F> {
             self.sampled = self.sampled.max(v);
         }
         let b = self.fam.bundle(&node);
-        let (u, t) = best_certificate(&b, F::N, tc, t_parent);
+        let (u, t) = best_certificate(&b, F::N, tc, t_parent, self.floor);
         if u <= self.floor {
             return;
         }
