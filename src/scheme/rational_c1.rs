@@ -12,7 +12,8 @@
 //! free = "default"            # or "quadric", or { offset = 0.5 }
 //! epsilon = 0.05              # hull ε relative to each face's longest edge
 //! refine_rounds = 4           # bound on the rounds of butterfly refinement
-//! bound_samples = 8           # resolution of the lower-bound sampling grids
+//! bound_samples = 8           # grid of the promotion sign test (and optional bound seeds)
+//! bound_tolerance = 1e-4      # accuracy of the certified lower bounds (× longest edge)
 //! bound_margin = 0.001        # f_0003 exceeds its bound by this × the face's longest edge
 //! faces = { "12" = { offset = 2.0 }, "40" = "quadric" }   # per input-triangle overrides
 //! ```
@@ -45,9 +46,13 @@
 //! mesh edge ([`crate::hull::outer::EdgeBlossom`], the closed form of the directional-derivative
 //! interpolation (4.10)–(4.12) and Step 4). Step 5 by the least squares (4.13)/(4.14); for a
 //! nonconvex face the Clough–Tocher values (see [`weights::nonconvex_pieces`]). Step 6 lower
-//! bounds with [`bound::lemma_bound`] sampled on grids (accuracy there), taken ≥ 0, plus
-//! `bound_margin`; a face or edge tetrahedron whose top two weight layers prove the bound
-//! ([`certify`], Bernstein coefficients) is not sampled at all, which gives the same result.
+//! bounds B_ijk and B_ijkl of Lemma 2.3 as certificates over *every* shooting line
+//! ([`cover`]: Bernstein subdivision of the base triangle / the edge tetrahedron's (x, y)
+//! square), never below the exact bound and at most `bound_tolerance` × the longest edge
+//! above the bound of a line the subdivision sampled (unless its budget of 2^−24 / 20 000
+//! sub-domains runs out, when it stays safe but may be looser); taken ≥ 0, plus
+//! `bound_margin`. A face or edge tetrahedron whose top two weight layers prove the bound
+//! ([`certify`]) is settled without subdivision.
 //! Steps 7, 9 by the C¹ conditions (2.3). Step 8 and the `free` choices in
 //! [`Free`]. After the choice, every edge tetrahedron is checked again with the chosen values
 //! and both faces are raised if needed (the paper's bound is taken along f_A − B_A = f_B − B_B
@@ -98,7 +103,8 @@ pub struct RationalOptions {
     pub epsilon: f64,
     /// Maximum rounds of local butterfly refinement.
     pub refine_rounds: usize,
-    /// Sampling resolution of the lower bounds (grid points per edge of the parameter domain).
+    /// Grid resolution (points per edge of the base triangle) of the promotion sign test; the
+    /// lower bounds are certified by subdivision and do not depend on it.
     pub bound_samples: usize,
     /// Margin above the lower bound, relative to the face's longest edge.
     pub bound_margin: f64,
