@@ -1034,16 +1034,24 @@ fn assemble(
             jedge: None,
         }
     };
-    let per_face: Vec<Vec<Patch>> = faces
-        .par_iter()
-        .enumerate()
-        .map(|(t, fo)| face_patches(t, fo))
-        .collect();
-    let total = per_face.iter().map(Vec::len).sum::<usize>() + etets.len();
-    complex.patches.reserve_exact(total);
-    for v in per_face {
-        complex.patches.extend(v);
-    }
+    // Straight into the complex (rayon keeps the sequential order), no per-face vectors.
+    let face_count: usize = faces
+        .iter()
+        .map(|fo| {
+            if fo.class == Convexity::Zero {
+                1
+            } else {
+                fo.sides.iter().flatten().map(|s| s.pieces.len()).sum()
+            }
+        })
+        .sum();
+    complex.patches.reserve_exact(face_count + etets.len());
+    complex.patches.par_extend(
+        faces
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(t, fo)| face_patches(t, fo)),
+    );
     complex.patches.par_extend(etets.par_iter().map(edge_patch));
     let mut edges_by_class = [0; 4];
     for e in &hull.edges {
