@@ -770,14 +770,14 @@ mod tests {
     }
 
     /// A reference b_min of one line, from above but much finer in t* than
-    /// [`lemma_bound_arg`]: the minimum of the threshold over 4096 values of t*, refined by
+    /// [`lemma_bound_arg`]: the minimum of the threshold over 1024 values of t*, refined by
     /// 80 golden-section steps around the best one (to ~1e-15 in t*).
     fn fine_bound(p: [f64; 4], d: [f64; 4]) -> f64 {
         if p[0] > 0.0 {
             return f64::NEG_INFINITY;
         }
         let f = |t: f64| threshold_at(p, d, t);
-        let n = 4096;
+        let n = 1024;
         let (k, best) = (1..=n)
             .map(|k| (k, f(f64::from(k) / f64::from(n))))
             .fold((1, f64::INFINITY), |a, x| if x.1 < a.1 { x } else { a });
