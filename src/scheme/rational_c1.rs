@@ -1201,7 +1201,8 @@ mod tests {
         let dense = tri_grid(32);
         let opts = RationalOptions::default();
         let mut covered = 0;
-        for c in random_cases() {
+        let cases = random_cases();
+        for c in &cases {
             let d = plain_bound(&c.side, &dense);
             let scale = c.side.pieces[0]
                 .w0
@@ -1215,6 +1216,12 @@ mod tests {
                 c.fast,
                 c.longest
             );
+        }
+        for c in &cases {
+            let scale = c.side.pieces[0]
+                .w0
+                .iter()
+                .fold(1e-300f64, |m, x| m.max(x.abs()));
             // Tightness: each covered piece converged, so its bound is at most the tolerance
             // above a line the search sampled (the 32-interval grid can miss narrow peaks of
             // the bound near the zero curve of p_0; the subdivision does not).
