@@ -52,7 +52,10 @@
 //! above the bound of a line the subdivision sampled (unless its budget of 2^−24 / 20 000
 //! sub-domains runs out, when it stays safe but may be looser); taken ≥ 0, plus
 //! `bound_margin`. A face or edge tetrahedron whose top two weight layers prove the bound
-//! ([`certify`]) is settled without subdivision.
+//! ([`certify`]) is settled without subdivision. Known gap: where the Bernstein coefficients
+//! of D_2 or D_3 are not all positive on a sub-domain at its deepest level (D vanishes on the
+//! domain's boundary; seen on edge tetrahedra of bunny, nut, spot), no t* certifies it and
+//! that tetrahedron falls back to the old sampled bound (`bound_samples` grid).
 //! Steps 7, 9 by the C¹ conditions (2.3). Step 8 and the `free` choices in
 //! [`Free`]. After the choice, every edge tetrahedron is checked again with the chosen values
 //! and both faces are raised if needed (the paper's bound is taken along f_A − B_A = f_B − B_B
