@@ -1,7 +1,8 @@
 //! Build timings on generated ~100k-triangle models (ignored by default; speed figures belong
 //! to `benches/rational.rs`, this prints one build per model with its stage counts).
 //! Run: `cargo test --release --test rational_throughput -- --ignored --nocapture`
-//! (`RAYON_NUM_THREADS=1` for the one-thread figure). Besides wall time it prints the
+//! (each model is built on 1 and then 2 threads in the same process; `APATCH_THREADS=n` for
+//! only n). Besides wall time it prints the
 //! process CPU time of the build (from `/proc/self/stat`, Linux only): on a shared, loaded
 //! machine the wall time mostly measures the other processes, CPU time / threads does not.
 //! `APATCH_TORUS=n` builds only the n × n torus (peak memory at several sizes).
@@ -39,29 +40,47 @@ fn build_throughput() {
             support::torus(1.0, 0.4, 224, 224),
         ],
     };
+    // APATCH_THREADS=<n>: only that many threads (default: 1 then 2, in the same process, so
+    // both figures see the same machine load).
+    let threads: Vec<usize> = match std::env::var("APATCH_THREADS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+    {
+        Some(n) => vec![n],
+        None => vec![1, 2],
+    };
     for m in models {
-        let c0 = cpu_seconds();
-        let t = Instant::now();
-        let b = build(
-            &m.positions,
-            &m.triangles,
-            &m.normals,
-            &RationalOptions::default(),
-        )
-        .unwrap();
-        let s = t.elapsed().as_secs_f64();
-        let cpu = c0.zip(cpu_seconds()).map_or(f64::NAN, |(a, b)| b - a);
-        eprintln!(
-            "{}: {} triangles, {} patches, refined {}, {:.3} s wall, {:.0} triangles/s wall, \
-             {:.2} s CPU, {:.0} triangles per CPU second",
-            m.name,
-            m.triangles.len(),
-            b.complex.patches.len(),
-            b.refined_edges,
-            s,
-            m.triangles.len() as f64 / s,
-            cpu,
-            m.triangles.len() as f64 / cpu
-        );
+        for &n in &threads {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .expect("thread pool");
+            let c0 = cpu_seconds();
+            let t = Instant::now();
+            let b = pool.install(|| {
+                build(
+                    &m.positions,
+                    &m.triangles,
+                    &m.normals,
+                    &RationalOptions::default(),
+                )
+                .unwrap()
+            });
+            let s = t.elapsed().as_secs_f64();
+            let cpu = c0.zip(cpu_seconds()).map_or(f64::NAN, |(a, b)| b - a);
+            eprintln!(
+                "{} ({n} threads): {} triangles, {} patches, refined {}, {:.3} s wall, {:.0} \
+                 triangles/s wall, {:.2} s CPU, {:.0} triangles per CPU second",
+                m.name,
+                m.triangles.len(),
+                b.complex.patches.len(),
+                b.refined_edges,
+                s,
+                m.triangles.len() as f64 / s,
+                cpu,
+                m.triangles.len() as f64 / cpu
+            );
+            drop(b);
+        }
     }
 }

@@ -12,7 +12,8 @@
 //! free = "default"            # or "quadric", or { offset = 0.5 }
 //! epsilon = 0.05              # hull ε relative to each face's longest edge
 //! refine_rounds = 4           # bound on the rounds of butterfly refinement
-//! bound_samples = 8           # resolution of the lower-bound sampling grids
+//! bound_samples = 8           # grid of the promotion sign test (and optional bound seeds)
+//! bound_tolerance = 1e-4      # accuracy of the certified lower bounds (× longest edge)
 //! bound_margin = 0.001        # f_0003 exceeds its bound by this × the face's longest edge
 //! faces = { "12" = { offset = 2.0 }, "40" = "quadric" }   # per input-triangle overrides
 //! ```
@@ -45,9 +46,16 @@
 //! mesh edge ([`crate::hull::outer::EdgeBlossom`], the closed form of the directional-derivative
 //! interpolation (4.10)–(4.12) and Step 4). Step 5 by the least squares (4.13)/(4.14); for a
 //! nonconvex face the Clough–Tocher values (see [`weights::nonconvex_pieces`]). Step 6 lower
-//! bounds with [`bound::lemma_bound`] sampled on grids (accuracy there), taken ≥ 0, plus
-//! `bound_margin`; a face or edge tetrahedron whose top two weight layers prove the bound
-//! ([`certify`], Bernstein coefficients) is not sampled at all, which gives the same result.
+//! bounds B_ijk and B_ijkl of Lemma 2.3 as certificates over *every* shooting line
+//! ([`cover`]: Bernstein subdivision of the base triangle / the edge tetrahedron's (x, y)
+//! square), never below the exact bound and at most `bound_tolerance` × the longest edge
+//! above the bound of a line the subdivision sampled (unless its budget of 2^−24 / 20 000
+//! sub-domains runs out, when it stays safe but may be looser); taken ≥ 0, plus
+//! `bound_margin`. A face or edge tetrahedron whose top two weight layers prove the bound
+//! ([`certify`]) is settled without subdivision. Known gap: where the Bernstein coefficients
+//! of D_2 or D_3 are not all positive on a sub-domain at its deepest level (D vanishes on the
+//! domain's boundary; seen on edge tetrahedra of bunny, nut, spot), no t* certifies it and
+//! that tetrahedron falls back to the old sampled bound (`bound_samples` grid).
 //! Steps 7, 9 by the C¹ conditions (2.3). Step 8 and the `free` choices in
 //! [`Free`]. After the choice, every edge tetrahedron is checked again with the chosen values
 //! and both faces are raised if needed (the paper's bound is taken along f_A − B_A = f_B − B_B
@@ -102,7 +110,8 @@ pub struct RationalOptions {
     pub epsilon: f64,
     /// Maximum rounds of local butterfly refinement.
     pub refine_rounds: usize,
-    /// Sampling resolution of the lower bounds (grid points per edge of the parameter domain).
+    /// Grid resolution (points per edge of the base triangle) of the promotion sign test; the
+    /// lower bounds are certified by subdivision and do not depend on it.
     pub bound_samples: usize,
     /// Margin above the lower bound, relative to the face's longest edge.
     pub bound_margin: f64,
@@ -450,7 +459,16 @@ fn face_bound(side: &Side, tab: &Tab, cover_opts: &cover::CoverOptions) -> f64 {
             best
         };
         let (fam, root) = cover::FaceFamily::new(&pc.w0, pc.rat.as_ref(), side.sigma);
-        best = cover::sup_bound(&fam, root, best, seed, cover_opts).value;
+        let c = cover::sup_bound(&fam, root, best, seed, cover_opts);
+        best = if c.uncertified {
+            // No t* certifies some sub-triangle (D vanishes on it): the certified rest, and
+            // the old sampled bound for the lines there.
+            let r = pc.rat.map_or([0.0; 4], |r| [r[0], r[1], r[2], 0.0]);
+            let lines = (0..tab.basis.len()).map(|i| (tab.eval(i, &pc.w0, &r, side.sigma), D));
+            bound::max_lemma_bound(lines, best.max(c.value))
+        } else {
+            c.value
+        };
     }
     best
 }
@@ -859,14 +877,26 @@ fn assemble(
             // Certified over every line (x, y) of the tetrahedron (see `cover`).
             let root = cover::EdgeFamily::root(&w0, &r0, dw, drat, sa.sigma);
             let longest = sa.margin.max(sb.margin) / opts.bound_margin;
-            cover::sup_bound(
+            let c = cover::sup_bound(
                 &cover::EdgeFamily,
                 root,
                 0.0,
                 seed,
                 &cover_opts(opts, longest),
-            )
-            .value
+            );
+            if c.uncertified {
+                // No t* certifies some sub-square (D vanishes on it): the certified rest, and
+                // the old sampled bound for the lines there.
+                let lines = (0..egrid.len()).map(|i| {
+                    (
+                        etab.eval(i, &w0, &r0, sa.sigma),
+                        etab.eval(i, dw, drat, 1.0),
+                    )
+                });
+                bound::max_lemma_bound(lines, c.value.max(0.0))
+            } else {
+                c.value
+            }
         })
         .collect();
     for (et, &be) in etets.iter().zip(&edge_bounds) {
@@ -938,7 +968,16 @@ fn assemble(
                     tol: 1e-12 * longest,
                     ..cover_opts(opts, longest)
                 };
-                cover::sup_bound(&cover::EdgeFamily, root, -margin, seed, &copts).value + margin
+                let c = cover::sup_bound(&cover::EdgeFamily, root, -margin, seed, &copts);
+                if c.uncertified {
+                    // No t* certifies some sub-square (D vanishes on it): the old sampling
+                    // there, the certificate elsewhere.
+                    let lines = (0..egrid.len())
+                        .map(|i| (etab.eval(i, &w, &r, sa.sigma), etab.eval(i, dw, drat, 1.0)));
+                    bound::max_lemma_bound(lines, c.value.max(-margin)) + margin
+                } else {
+                    c.value + margin
+                }
             })
             .collect();
         let mut any = false;
@@ -1073,16 +1112,24 @@ fn assemble(
             jedge: None,
         }
     };
-    let per_face: Vec<Vec<Patch>> = faces
-        .par_iter()
-        .enumerate()
-        .map(|(t, fo)| face_patches(t, fo))
-        .collect();
-    let total = per_face.iter().map(Vec::len).sum::<usize>() + etets.len();
-    complex.patches.reserve_exact(total);
-    for v in per_face {
-        complex.patches.extend(v);
-    }
+    // Straight into the complex (rayon keeps the sequential order), no per-face vectors.
+    let face_count: usize = faces
+        .iter()
+        .map(|fo| {
+            if fo.class == Convexity::Zero {
+                1
+            } else {
+                fo.sides.iter().flatten().map(|s| s.pieces.len()).sum()
+            }
+        })
+        .sum();
+    complex.patches.reserve_exact(face_count + etets.len());
+    complex.patches.par_extend(
+        faces
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(t, fo)| face_patches(t, fo)),
+    );
     complex.patches.par_extend(etets.par_iter().map(edge_patch));
     let mut edges_by_class = [0; 4];
     for e in &hull.edges {
@@ -1232,7 +1279,8 @@ mod tests {
         let dense = tri_grid(32);
         let opts = RationalOptions::default();
         let mut covered = 0;
-        for c in random_cases() {
+        let cases = random_cases();
+        for c in &cases {
             let d = plain_bound(&c.side, &dense);
             let scale = c.side.pieces[0]
                 .w0
@@ -1246,6 +1294,12 @@ mod tests {
                 c.fast,
                 c.longest
             );
+        }
+        for c in &cases {
+            let scale = c.side.pieces[0]
+                .w0
+                .iter()
+                .fold(1e-300f64, |m, x| m.max(x.abs()));
             // Tightness: each covered piece converged, so its bound is at most the tolerance
             // above a line the search sampled (the 32-interval grid can miss narrow peaks of
             // the bound near the zero curve of p_0; the subdivision does not).
@@ -1271,8 +1325,8 @@ mod thread_tests {
     use super::*;
 
     /// The build (certified bounds included) is bit-identical on 1 and 2 threads: every
-    /// subdivision runs inside one face or edge, in a fixed order. A noisy sphere, so that
-    /// many bounds are not settled by the top-layer certificates.
+    /// subdivision runs inside one face or edge, in a fixed order. A noisy sphere (10 %
+    /// radial noise), so that some bounds are not settled by the top-layer certificates.
     #[test]
     fn build_is_identical_across_thread_counts() {
         let (v, f) = crate::fixtures::icosahedron();

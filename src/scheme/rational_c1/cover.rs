@@ -61,6 +61,10 @@ pub struct Certified {
     pub sampled: f64,
     /// Sub-domains examined.
     pub nodes: usize,
+    /// Some sub-domain had no finite certificate (D_k not certifiably positive there) and was
+    /// given up: `value` covers the rest, those lines only through their sampled centres, so
+    /// the caller adds a grid sampling of the family (the bound before certificates).
+    pub uncertified: bool,
     /// Whether `value` ≤ max(floor, sampled) + tol (the budget did not run out first).
     pub converged: bool,
 }
@@ -348,21 +352,20 @@ pub fn sup_bound<F: Family>(
     }
     let open = s.heap.peek().map_or(f64::NEG_INFINITY, |o| o.u);
     let mut value = floor.max(s.stuck).max(open);
+    let mut uncertified = s.uncertified;
     if !value.is_finite() {
-        // Some lines have no finite Lemma 2.3 bound (a derivative coefficient d_k ≤ 0 there,
-        // so no f_0003 certifies them): the documented fallback is the largest finite bound
-        // met on the sampled lines, as before certificates existed; `converged` stays false
-        // and `apatch check` samples those patches' sheets.
-        value = floor.max(s.sampled);
-        converged = false;
+        // Left open at +∞ (the node budget ran out first): as uncertified.
+        value = floor.max(s.stuck).max(s.sampled);
+        uncertified = true;
     }
-    if value > floor.max(s.sampled) + opts.tol || s.uncertified {
+    if value > floor.max(s.sampled) + opts.tol || uncertified {
         converged = false;
     }
     Certified {
         value,
         sampled: s.sampled,
         nodes: s.nodes,
+        uncertified,
         converged,
     }
 }
@@ -791,14 +794,14 @@ mod tests {
     }
 
     /// A reference b_min of one line, from above but much finer in t* than
-    /// [`lemma_bound_arg`]: the minimum of the threshold over 4096 values of t*, refined by
+    /// [`lemma_bound_arg`]: the minimum of the threshold over 1024 values of t*, refined by
     /// 80 golden-section steps around the best one (to ~1e-15 in t*).
     fn fine_bound(p: [f64; 4], d: [f64; 4]) -> f64 {
         if p[0] > 0.0 {
             return f64::NEG_INFINITY;
         }
         let f = |t: f64| threshold_at(p, d, t);
-        let n = 4096;
+        let n = 1024;
         let (k, best) = (1..=n)
             .map(|k| (k, f(f64::from(k) / f64::from(n))))
             .fold((1, f64::INFINITY), |a, x| if x.1 < a.1 { x } else { a });
