@@ -77,6 +77,7 @@ pub mod weights;
 
 use crate::complex::{Patch, PatchComplex, RationalTerm, Role, SheetRule};
 use crate::error::{Error, Result};
+use crate::hull::inner::above;
 use crate::hull::outer::{
     self,
     refine::{RefineMesh, SplitRule},
@@ -616,9 +617,13 @@ fn refine_hull(
 
 /// The documented fallback for vertex normals that are not strictly above every triangle
 /// around them (n_ijk · n_l ≤ 1e-9, which §3.1 cannot handle; Loop limit normals do this at
-/// sharp creases): such a normal is replaced by the normalised angle-weighted sum of its
-/// triangles' normals (each oriented to the side of its corners' normals) when that one is
-/// above all of them; otherwise it is left for [`outer::build`] to report. Returns how many
+/// sharp creases, angle-weighted ones at saddle-like corners of coarse cages): such a normal is
+/// replaced by the normalised angle-weighted sum of its triangles' normals (each oriented to the
+/// side of its corners' normals) when that one is above all of them; otherwise by the
+/// "above-face" normal of [`above::make_above`]: the angle-weighted sum rotated towards the unit
+/// direction maximising min_f n · n_f over the vertex's triangles, far enough to clear
+/// [`above::ABOVE_MARGIN`]. Only when no direction is above all the triangles (they wrap round
+/// more than a hemisphere) is the normal left for [`outer::build`] to report. Returns how many
 /// normals were replaced.
 fn repair_normals(positions: &[DVec3], triangles: &[[u32; 3]], normals: &mut [DVec3]) -> usize {
     let nv = positions.len();
@@ -658,26 +663,118 @@ fn repair_normals(positions: &[DVec3], triangles: &[[u32; 3]], normals: &mut [DV
             }
         }
     }
-    let mut ok = vec![true; nv];
+    // The unit normals of the triangles around each bad vertex.
+    let mut fans: Vec<Vec<DVec3>> = vec![Vec::new(); nv];
     for (tri, f) in triangles.iter().zip(&nf) {
         let Some(f) = f else { continue };
         for &v in tri {
-            let v = v as usize;
-            if bad[v] && f.dot(sum[v].normalize_or_zero()) <= 1e-9 {
-                ok[v] = false;
+            if bad[v as usize] {
+                fans[v as usize].push(*f);
             }
         }
     }
     let mut count = 0;
     for v in 0..nv {
-        if bad[v] && ok[v] {
-            if let Some(n) = sum[v].try_normalize() {
-                normals[v] = n;
-                count += 1;
-            }
+        if !bad[v] {
+            continue;
+        }
+        let angle = sum[v].normalize_or_zero();
+        let n = if angle != DVec3::ZERO && above::clearance(angle, &fans[v]) > 1e-9 {
+            Some(angle)
+        } else {
+            above::make_above(angle, &fans[v])
+        };
+        if let Some(n) = n.filter(|n| n.is_normalized()) {
+            normals[v] = n;
+            count += 1;
         }
     }
     count
+}
+
+#[cfg(test)]
+mod repair_normals_tests {
+    use super::*;
+
+    /// A triangle with corner 0 at the origin, lying in the plane with unit normal `n` (wound so
+    /// its geometric normal is `n`), with corner angle `angle` there.
+    fn wedge(
+        n: DVec3,
+        angle: f64,
+        positions: &mut Vec<DVec3>,
+        normals: &mut Vec<DVec3>,
+    ) -> [u32; 3] {
+        let e1 = n.any_orthonormal_vector();
+        let e2 = n.cross(e1);
+        let (s, c) = (0.5 * angle).sin_cos();
+        let (a, b) = (c * e2 - s * e1, c * e2 + s * e1);
+        let (a, b) = if a.cross(b).dot(n) > 0.0 {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let i = positions.len() as u32;
+        positions.extend([a, b]);
+        // The other corners' normals are the face's own: above it, and they orient it.
+        normals.extend([n, n]);
+        [0, i, i + 1]
+    }
+
+    /// A vertex fan (a wide triangle tilted 60° one way, a narrow one tilted 60° the other) whose
+    /// angle-weighted normal is below the narrow triangle, while the axis between them is 30°
+    /// above both: the old fallback (angle-weighted sum only) left the normal, the above-face
+    /// normal fixes it. Independent truth: the triangles' normals from their own corners.
+    #[test]
+    fn angle_normal_below_a_triangle_is_replaced_by_an_above_face_normal() {
+        let t = 60f64.to_radians();
+        let wide = DVec3::new(t.sin(), 0.0, t.cos());
+        let narrow = DVec3::new(-t.sin(), 0.0, t.cos());
+        let mut positions = vec![DVec3::ZERO];
+        let mut normals = vec![DVec3::ZERO];
+        let triangles = vec![
+            wedge(wide, 150f64.to_radians(), &mut positions, &mut normals),
+            wedge(narrow, 10f64.to_radians(), &mut positions, &mut normals),
+        ];
+        let angle_normal = (150.0 * wide + 10.0 * narrow).normalize();
+        normals[0] = angle_normal;
+        let face_normals: Vec<DVec3> = triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|i| positions[i as usize]);
+                (p[1] - p[0]).cross(p[2] - p[0]).normalize()
+            })
+            .collect();
+        // Precondition: the angle-weighted normal is below the narrow triangle.
+        assert!(angle_normal.dot(face_normals[1]) < 0.0);
+        let replaced = repair_normals(&positions, &triangles, &mut normals);
+        assert_eq!(replaced, 1);
+        let n = normals[0];
+        // Unit length up to rounding of normalize().
+        assert!((n.length() - 1.0).abs() < 1e-12);
+        for f in &face_normals {
+            assert!(
+                n.dot(*f) >= above::ABOVE_MARGIN,
+                "{n} · {f} = {}",
+                n.dot(*f)
+            );
+        }
+        // The other corners were already above their only triangle: untouched.
+        assert_eq!(&normals[1..], &[wide, wide, narrow, narrow]);
+    }
+
+    /// Triangles wrapping round more than a hemisphere: no normal is above all of them, so the
+    /// normal is left for the hull build to report (never a silently wrong surface).
+    #[test]
+    fn no_above_face_normal_leaves_the_normal() {
+        let mut positions = vec![DVec3::ZERO];
+        let mut normals = vec![DVec3::Z];
+        let triangles: Vec<[u32; 3]> = [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y]
+            .iter()
+            .map(|&n| wedge(n, 1.0, &mut positions, &mut normals))
+            .collect();
+        assert_eq!(repair_normals(&positions, &triangles, &mut normals), 0);
+        assert_eq!(normals[0], DVec3::Z);
+    }
 }
 
 #[allow(clippy::too_many_lines)]
