@@ -64,9 +64,12 @@
 //! [`RationalBuild::promoted_faces`].
 //!
 //! Fallback for bad normals: a vertex normal that is not strictly above one of its triangles
-//! (Loop limit normals at sharp creases) is replaced by the angle-weighted normal of its
-//! triangles when that one is above all of them (counted in
-//! [`RationalBuild::replaced_normals`]); otherwise the build fails naming the triangle.
+//! (Loop limit normals at sharp creases, angle normals at saddle corners of coarse cages) is
+//! replaced by the angle-weighted normal of its triangles when that one is above all of them,
+//! else by the "above-face" normal (the angle normal rotated towards the direction maximising
+//! min n · n_f over its triangles, [`crate::hull::inner::above::make_above`]); both are counted
+//! in [`RationalBuild::replaced_normals`]. Only when no direction is above all its triangles
+//! does the build fail naming the triangle.
 
 pub mod bound;
 pub mod certify;
