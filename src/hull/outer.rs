@@ -18,6 +18,7 @@ pub mod refine;
 
 use crate::error::{Error, Result};
 use glam::DVec3;
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// No face: marks the missing second face of a boundary edge.
@@ -245,8 +246,10 @@ pub fn build(
 ) -> Result<OuterHull> {
     validate_normals(positions, normals)?;
     let (raw_edges, face_edges) = edge_map(positions.len(), triangles)?;
+    // Per edge and per face independent work: in parallel (indexed, so the order and the
+    // results are those of the sequential loop on any number of threads).
     let edges: Vec<Edge> = raw_edges
-        .iter()
+        .par_iter()
         .map(|&(v, faces)| {
             let (a, b) = (v[0] as usize, v[1] as usize);
             Edge {
@@ -256,11 +259,16 @@ pub fn build(
             }
         })
         .collect();
-    let mut faces = Vec::with_capacity(triangles.len());
-    for (t, tri) in triangles.iter().enumerate() {
-        let class = face_convexity(face_edges[t].map(|e| edges[e as usize].class));
-        faces.push(face_hull(t, positions, tri, normals, class, opts)?);
-    }
+    let faces: Vec<Result<FaceHull>> = triangles
+        .par_iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let class = face_convexity(face_edges[t].map(|e| edges[e as usize].class));
+            face_hull(t, positions, tri, normals, class, opts)
+        })
+        .collect();
+    // The first error in triangle order, as the sequential loop would report it.
+    let faces = faces.into_iter().collect::<Result<Vec<FaceHull>>>()?;
     Ok(OuterHull {
         faces,
         edges,
@@ -470,10 +478,10 @@ impl OuterHull {
     /// degenerate (§3.1: these edges are refined).
     #[must_use]
     pub fn bad_edges(&self, positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<u32> {
-        let mut bad = Vec::new();
-        for (e, edge) in self.edges.iter().enumerate() {
+        // In parallel; `filter_map` + `collect` keeps the edge order.
+        let bad_edge = |edge: &Edge| -> bool {
             if edge.is_boundary() {
-                continue;
+                return false;
             }
             let [f0, f1] = edge.faces.map(|f| f as usize);
             let scale = (positions[edge.v[1] as usize] - positions[edge.v[0] as usize]).length();
@@ -500,11 +508,13 @@ impl OuterHull {
                     is_bad = true;
                 }
             }
-            if is_bad {
-                bad.push(e as u32);
-            }
-        }
-        bad
+            is_bad
+        };
+        self.edges
+            .par_iter()
+            .enumerate()
+            .filter_map(|(e, edge)| bad_edge(edge).then_some(e as u32))
+            .collect()
     }
 }
 
