@@ -849,7 +849,8 @@ fn assemble(
             })
         })
         .collect();
-    let etet = |&(ei, s): &(u32, u8)| -> Option<EdgeTet> {
+    // The frame of a pair (None: degenerate), then its edge tetrahedron.
+    let frame_of = |&(ei, s): &(u32, u8)| -> Option<(EdgeFrame, [usize; 2])> {
         let e = &hull.edges[ei as usize];
         let s = s as usize;
         let [fa, fb] = e.faces.map(|f| f as usize);
@@ -861,28 +862,33 @@ fn assemble(
             positions[e.v[0] as usize],
             positions[e.v[1] as usize],
         )?;
-        Some(EdgeTet {
+        Some((frame, [ka, kb]))
+    };
+    let etet = |p: &(u32, u8)| -> EdgeTet {
+        let (frame, [ka, kb]) = frame_of(p).expect("checked before");
+        let (ei, s) = (p.0, p.1 as usize);
+        let [fa, fb] = hull.edges[ei as usize].faces.map(|f| f as usize);
+        let (sa, sb) = (&faces[fa].sides[s], &faces[fb].sides[s]);
+        let (sa, sb) = (sa.as_ref().expect("side"), sb.as_ref().expect("side"));
+        EdgeTet {
             edge: ei,
             faces: [fa, fb],
             side: s,
             piece: [ka, kb],
             dw: frame.weights(&sa.pieces[ka].dw, &sb.pieces[kb].dw),
             frame,
-        })
+        }
     };
-    let etets: Vec<Option<EdgeTet>> = pairs.par_iter().map(etet).collect();
-    // The first degenerate one in edge order, as the sequential loop reported it.
-    if let Some(i) = etets.iter().position(Option::is_none) {
+    // The first degenerate one in edge order (as the sequential loop reported it), then all of
+    // them straight into their vector.
+    if let Some(i) = pairs.par_iter().position_first(|p| frame_of(p).is_none()) {
         let e = hull.edges[pairs[i].0 as usize];
         return Err(Error::Invalid(format!(
             "edge {} (vertices {}, {}): degenerate face tetrahedron",
             pairs[i].0, e.v[0], e.v[1]
         )));
     }
-    let etets: Vec<EdgeTet> = etets
-        .into_par_iter()
-        .map(|et| et.expect("checked above"))
-        .collect();
+    let etets: Vec<EdgeTet> = pairs.par_iter().map(etet).collect();
     stage_time("etets", tt);
     let mut faces = faces;
     // Edge bounds (Step 6, second part) along f_A = σ(B_A + b), f_B = σ(B_B + b); only
