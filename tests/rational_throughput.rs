@@ -6,6 +6,9 @@
 //! process CPU time of the build (from `/proc/self/stat`, Linux only): on a shared, loaded
 //! machine the wall time mostly measures the other processes, CPU time / threads does not.
 //! `APATCH_TORUS=n` builds only the n × n torus (peak memory at several sizes).
+//! `APATCH_STAGE_TIMES=1` makes the build print the cumulative time at the end of each stage
+//! (hull, intersection test, faces, edge tetrahedra, edge bounds, free values, final edge
+//! check, patch emission), to find the serial ones.
 
 #[path = "rational_support.rs"]
 mod support;

@@ -18,6 +18,7 @@ pub mod refine;
 
 use crate::error::{Error, Result};
 use glam::DVec3;
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// No face: marks the missing second face of a boundary edge.
@@ -168,7 +169,8 @@ pub type RawEdge = ([u32; 2], [u32; 2]);
 /// The unique edges of a triangle list and each triangle's edge indices (numbering as in the
 /// module docs). Errors on an edge shared by more than two triangles, or a degenerate index.
 pub fn edge_map(nverts: usize, triangles: &[[u32; 3]]) -> Result<(Vec<RawEdge>, Vec<[u32; 3]>)> {
-    let mut map: HashMap<(u32, u32), u32> = HashMap::with_capacity(triangles.len() * 2);
+    let mut map: HashMap<u64, u32, EdgeKeyHash> =
+        HashMap::with_capacity_and_hasher(triangles.len() * 2, EdgeKeyHash);
     let mut edges: Vec<RawEdge> = Vec::with_capacity(triangles.len() * 3 / 2 + 3);
     let mut face_edges = Vec::with_capacity(triangles.len());
     for (t, tri) in triangles.iter().enumerate() {
@@ -187,7 +189,7 @@ pub fn edge_map(nverts: usize, triangles: &[[u32; 3]]) -> Result<(Vec<RawEdge>, 
         let mut fe = [0u32; 3];
         for c in 0..3 {
             let (a, b) = (tri[c], tri[(c + 1) % 3]);
-            let key = (a.min(b), a.max(b));
+            let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
             let id = *map.entry(key).or_insert_with(|| {
                 edges.push(([a, b], [t as u32, NO_FACE]));
                 (edges.len() - 1) as u32
@@ -207,6 +209,37 @@ pub fn edge_map(nverts: usize, triangles: &[[u32; 3]]) -> Result<(Vec<RawEdge>, 
         face_edges.push(fe);
     }
     Ok((edges, face_edges))
+}
+
+/// A fast, deterministic hash for the packed vertex pair keys of [`edge_map`] (the default
+/// SipHash was a visible serial cost on 100k-triangle meshes; the keys are not adversarial).
+#[derive(Clone, Copy, Default)]
+struct EdgeKeyHash;
+
+impl std::hash::BuildHasher for EdgeKeyHash {
+    type Hasher = EdgeKeyHasher;
+    fn build_hasher(&self) -> EdgeKeyHasher {
+        EdgeKeyHasher(0)
+    }
+}
+
+/// The hasher of [`EdgeKeyHash`]: a multiplicative mix of one u64 (high and low bits folded,
+/// since the table uses both).
+struct EdgeKeyHasher(u64);
+
+impl std::hash::Hasher for EdgeKeyHasher {
+    fn finish(&self) -> u64 {
+        let h = self.0.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        h ^ (h >> 29)
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x100_0000_01B3);
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 ^= x;
+    }
 }
 
 /// Checks that every normal is finite and of unit length (within 1e-6).
@@ -245,8 +278,10 @@ pub fn build(
 ) -> Result<OuterHull> {
     validate_normals(positions, normals)?;
     let (raw_edges, face_edges) = edge_map(positions.len(), triangles)?;
+    // Per edge and per face independent work: in parallel (indexed, so the order and the
+    // results are those of the sequential loop on any number of threads).
     let edges: Vec<Edge> = raw_edges
-        .iter()
+        .par_iter()
         .map(|&(v, faces)| {
             let (a, b) = (v[0] as usize, v[1] as usize);
             Edge {
@@ -256,11 +291,16 @@ pub fn build(
             }
         })
         .collect();
-    let mut faces = Vec::with_capacity(triangles.len());
-    for (t, tri) in triangles.iter().enumerate() {
-        let class = face_convexity(face_edges[t].map(|e| edges[e as usize].class));
-        faces.push(face_hull(t, positions, tri, normals, class, opts)?);
-    }
+    let faces: Vec<Result<FaceHull>> = triangles
+        .par_iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let class = face_convexity(face_edges[t].map(|e| edges[e as usize].class));
+            face_hull(t, positions, tri, normals, class, opts)
+        })
+        .collect();
+    // The first error in triangle order, as the sequential loop would report it.
+    let faces = faces.into_iter().collect::<Result<Vec<FaceHull>>>()?;
     Ok(OuterHull {
         faces,
         edges,
@@ -470,10 +510,10 @@ impl OuterHull {
     /// degenerate (§3.1: these edges are refined).
     #[must_use]
     pub fn bad_edges(&self, positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<u32> {
-        let mut bad = Vec::new();
-        for (e, edge) in self.edges.iter().enumerate() {
+        // In parallel; `filter_map` + `collect` keeps the edge order.
+        let bad_edge = |edge: &Edge| -> bool {
             if edge.is_boundary() {
-                continue;
+                return false;
             }
             let [f0, f1] = edge.faces.map(|f| f as usize);
             let scale = (positions[edge.v[1] as usize] - positions[edge.v[0] as usize]).length();
@@ -500,11 +540,13 @@ impl OuterHull {
                     is_bad = true;
                 }
             }
-            if is_bad {
-                bad.push(e as u32);
-            }
-        }
-        bad
+            is_bad
+        };
+        self.edges
+            .par_iter()
+            .enumerate()
+            .filter_map(|(e, edge)| bad_edge(edge).then_some(e as u32))
+            .collect()
     }
 }
 

@@ -526,6 +526,7 @@ pub fn build(
     // §3.1: build, refine where adjacent face tetrahedra intersect, repeat. Butterfly splits
     // first (the paper's rule); when they do not converge within the bound, start again with
     // midpoint splits, which make no new folds (see `outer::refine`).
+    let t0 = std::time::Instant::now();
     let (mesh, hull, refined, replaced_normals) = match refine_hull(
         positions,
         triangles,
@@ -555,11 +556,25 @@ pub fn build(
         triangles,
         origin,
     } = mesh;
+    stage_time("refine_hull", t0);
     let mut b = assemble(
         &positions, &triangles, &normals, &origin, &hull, refined, opts,
     )?;
+    stage_time("total", t0);
     b.replaced_normals = replaced_normals;
     Ok(b)
+}
+
+/// Prints the time since `since` for a build stage to stderr when the environment variable
+/// `APATCH_STAGE_TIMES` is set (profiling aid: which stages are serial, see
+/// `tests/rational_throughput.rs`); nothing otherwise.
+fn stage_time(name: &str, since: std::time::Instant) {
+    if std::env::var_os("APATCH_STAGE_TIMES").is_some() {
+        eprintln!(
+            "stage {name}: {:.1} ms",
+            since.elapsed().as_secs_f64() * 1e3
+        );
+    }
 }
 
 /// Start of the error [`refine_hull`] gives when the round bound is reached.
@@ -583,8 +598,11 @@ fn refine_hull(
     };
     let mut refined = 0;
     let mut rounds = 0;
+    let t0 = std::time::Instant::now();
     let mut replaced_normals = repair_normals(&mesh.positions, &mesh.triangles, &mut mesh.normals);
+    stage_time("repair", t0);
     let hull = loop {
+        let t0 = std::time::Instant::now();
         let hull = outer::build(&mesh.positions, &mesh.triangles, &mesh.normals, hopts)
             .map_err(|e| {
                 if rounds == 0 {
@@ -595,7 +613,10 @@ fn refine_hull(
                     ))
                 }
             })?;
+        stage_time("outer::build", t0);
+        let t0 = std::time::Instant::now();
         let bad = hull.bad_edges(&mesh.positions, &mesh.triangles);
+        stage_time("bad_edges", t0);
         if bad.is_empty() {
             break hull;
         }
@@ -791,6 +812,7 @@ fn assemble(
     opts: &RationalOptions,
 ) -> Result<RationalBuild> {
     let nf = triangles.len();
+    let tt = std::time::Instant::now();
     let grid = tri_grid(opts.bound_samples);
     let ftab = Tab::face(&grid);
     let fit = if opts.free == Free::Quadric || opts.face_free.iter().any(|f| f.1 == Free::Quadric) {
@@ -889,6 +911,7 @@ fn assemble(
         })
         .collect();
 
+    stage_time("faces", tt);
     // Edge tetrahedra: frames and the b-derivative of their shooting cubics.
     let egrid: Vec<(f64, f64)> = {
         let n = opts.bound_samples;
@@ -909,39 +932,64 @@ fn assemble(
             })
             .unwrap_or(0)
     };
-    let mut etets: Vec<EdgeTet> = Vec::new();
-    for (ei, e) in hull.edges.iter().enumerate() {
-        if e.faces[1] == NO_FACE || e.class == Convexity::Zero {
-            continue;
-        }
+    // The (edge, side) pairs with an edge tetrahedron, in edge order (cheap, sequential), then
+    // their frames in parallel (indexed: the order of the sequential loop on any thread count).
+    let faces_ref = &faces;
+    let pairs: Vec<(u32, u8)> = hull
+        .edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.faces[1] != NO_FACE && e.class != Convexity::Zero)
+        .flat_map(|(ei, e)| {
+            let [fa, fb] = e.faces.map(|f| f as usize);
+            (0..2u8).filter_map(move |s| {
+                let s_ = s as usize;
+                (faces_ref[fa].sides[s_].is_some() && faces_ref[fb].sides[s_].is_some())
+                    .then_some((ei as u32, s))
+            })
+        })
+        .collect();
+    // The frame of a pair (None: degenerate), then its edge tetrahedron.
+    let frame_of = |&(ei, s): &(u32, u8)| -> Option<(EdgeFrame, [usize; 2])> {
+        let e = &hull.edges[ei as usize];
+        let s = s as usize;
         let [fa, fb] = e.faces.map(|f| f as usize);
-        for s in 0..2 {
-            let (Some(sa), Some(sb)) = (&faces[fa].sides[s], &faces[fb].sides[s]) else {
-                continue;
-            };
-            let (ka, kb) = (piece_at(fa, sa, e), piece_at(fb, sb, e));
-            let frame = EdgeFrame::new(
-                &sa.pieces[ka],
-                &sb.pieces[kb],
-                positions[e.v[0] as usize],
-                positions[e.v[1] as usize],
-            )
-            .ok_or_else(|| {
-                Error::Invalid(format!(
-                    "edge {ei} (vertices {}, {}): degenerate face tetrahedron",
-                    e.v[0], e.v[1]
-                ))
-            })?;
-            etets.push(EdgeTet {
-                edge: ei as u32,
-                faces: [fa, fb],
-                side: s,
-                piece: [ka, kb],
-                dw: frame.weights(&sa.pieces[ka].dw, &sb.pieces[kb].dw),
-                frame,
-            });
+        let (sa, sb) = (faces[fa].sides[s].as_ref()?, faces[fb].sides[s].as_ref()?);
+        let (ka, kb) = (piece_at(fa, sa, e), piece_at(fb, sb, e));
+        let frame = EdgeFrame::new(
+            &sa.pieces[ka],
+            &sb.pieces[kb],
+            positions[e.v[0] as usize],
+            positions[e.v[1] as usize],
+        )?;
+        Some((frame, [ka, kb]))
+    };
+    let etet = |p: &(u32, u8)| -> EdgeTet {
+        let (frame, [ka, kb]) = frame_of(p).expect("checked before");
+        let (ei, s) = (p.0, p.1 as usize);
+        let [fa, fb] = hull.edges[ei as usize].faces.map(|f| f as usize);
+        let (sa, sb) = (&faces[fa].sides[s], &faces[fb].sides[s]);
+        let (sa, sb) = (sa.as_ref().expect("side"), sb.as_ref().expect("side"));
+        EdgeTet {
+            edge: ei,
+            faces: [fa, fb],
+            side: s,
+            piece: [ka, kb],
+            dw: frame.weights(&sa.pieces[ka].dw, &sb.pieces[kb].dw),
+            frame,
         }
+    };
+    // The first degenerate one in edge order (as the sequential loop reported it), then all of
+    // them straight into their vector.
+    if let Some(i) = pairs.par_iter().position_first(|p| frame_of(p).is_none()) {
+        let e = hull.edges[pairs[i].0 as usize];
+        return Err(Error::Invalid(format!(
+            "edge {} (vertices {}, {}): degenerate face tetrahedron",
+            pairs[i].0, e.v[0], e.v[1]
+        )));
     }
+    let etets: Vec<EdgeTet> = pairs.par_iter().map(etet).collect();
+    stage_time("etets", tt);
     let mut faces = faces;
     // Edge bounds (Step 6, second part) along f_A = σ(B_A + b), f_B = σ(B_B + b); only
     // positive ones are used, so the floor is 0 and the top-layer certificate at b = 0 skips
@@ -1009,6 +1057,7 @@ fn assemble(
             }
         }
     }
+    stage_time("edge_bounds", tt);
     // Choose the free parameters (Step 8 / §5.3).
     faces.par_iter_mut().enumerate().for_each(|(t, fo)| {
         let free = free_of(t);
@@ -1029,6 +1078,7 @@ fn assemble(
             s.f = s.sigma * target.max(s.bound + s.margin);
         }
     });
+    stage_time("free", tt);
     // Final edge check with the chosen values; raise both faces where needed.
     let mut raised = vec![[false; 2]; nf];
     for _round in 0..4 {
@@ -1098,6 +1148,7 @@ fn assemble(
         }
     }
 
+    stage_time("final_check", tt);
     // Emit patches (in parallel; the order is the sequential one: faces, then edges).
     let mut complex = PatchComplex::new("rational-c1");
     complex.continuity = Some(1);
@@ -1119,59 +1170,53 @@ fn assemble(
             }
         }
     }
-    let face_patches = |t: usize, fo: &FaceOut| -> Vec<Patch> {
-        if fo.class == Convexity::Zero {
-            let fh = &hull.faces[t];
-            let tri = triangles[t];
-            let apex = fh.centroid + fh.epsilon * fh.normal;
-            return vec![Patch {
-                tet: [
-                    positions[tri[0] as usize].to_array(),
-                    positions[tri[1] as usize].to_array(),
-                    positions[tri[2] as usize].to_array(),
-                    apex.to_array(),
-                ],
-                degree: 1,
-                weights: vec![0.0, 0.0, 0.0, fh.epsilon],
-                rational: Vec::new(),
-                sheet: SheetRule::Any,
-                role: Role::Planar,
-                element: t as u32,
-                jvertex: None,
-                jedge: None,
-            }];
+    let zero_patch = |t: usize| -> Patch {
+        let fh = &hull.faces[t];
+        let tri = triangles[t];
+        let apex = fh.centroid + fh.epsilon * fh.normal;
+        Patch {
+            tet: [
+                positions[tri[0] as usize].to_array(),
+                positions[tri[1] as usize].to_array(),
+                positions[tri[2] as usize].to_array(),
+                apex.to_array(),
+            ],
+            degree: 1,
+            weights: vec![0.0, 0.0, 0.0, fh.epsilon],
+            rational: Vec::new(),
+            sheet: SheetRule::Any,
+            role: Role::Planar,
+            element: t as u32,
+            jvertex: None,
+            jedge: None,
         }
-        let mut out = Vec::with_capacity(6);
-        for side in fo.sides.iter().flatten() {
-            for pc in &side.pieces {
-                let w = pc.weights(side.f);
-                let rational = pc
-                    .rat
-                    .map(|r| {
-                        vec![RationalTerm {
-                            index: [1, 1, 1, 0],
-                            terms: vec![
-                                (r[0], [0, 1, 1, 0]),
-                                (r[1], [1, 0, 1, 0]),
-                                (r[2], [1, 1, 0, 0]),
-                            ],
-                        }]
-                    })
-                    .unwrap_or_default();
-                out.push(Patch {
-                    tet: pc.pts.map(|p| p.to_array()),
-                    degree: 3,
-                    weights: w.to_vec(),
-                    rational,
-                    sheet: face_sheet.clone(),
-                    role: Role::Face,
-                    element: t as u32,
-                    jvertex: None,
-                    jedge: None,
-                });
-            }
+    };
+    let face_piece_patch = |t: usize, side: &Side, pc: &Piece| -> Patch {
+        let w = pc.weights(side.f);
+        let rational = pc
+            .rat
+            .map(|r| {
+                vec![RationalTerm {
+                    index: [1, 1, 1, 0],
+                    terms: vec![
+                        (r[0], [0, 1, 1, 0]),
+                        (r[1], [1, 0, 1, 0]),
+                        (r[2], [1, 1, 0, 0]),
+                    ],
+                }]
+            })
+            .unwrap_or_default();
+        Patch {
+            tet: pc.pts.map(|p| p.to_array()),
+            degree: 3,
+            weights: w.to_vec(),
+            rational,
+            sheet: face_sheet.clone(),
+            role: Role::Face,
+            element: t as u32,
+            jvertex: None,
+            jedge: None,
         }
-        out
     };
     let edge_patch = |et: &EdgeTet| -> Patch {
         let sa = faces[et.faces[0]].sides[et.side]
@@ -1212,25 +1257,42 @@ fn assemble(
             jedge: None,
         }
     };
-    // Straight into the complex (rayon keeps the sequential order), no per-face vectors.
-    let face_count: usize = faces
-        .iter()
-        .map(|fo| {
-            if fo.class == Convexity::Zero {
-                1
-            } else {
-                fo.sides.iter().flatten().map(|s| s.pieces.len()).sum()
-            }
-        })
-        .sum();
-    complex.patches.reserve_exact(face_count + etets.len());
+    // Straight into the complex, no per-face vectors: one slot per face patch (its face and
+    // its index among the face's patches), then an indexed parallel iterator over the slots and
+    // the edge tetrahedra, which rayon writes in place into the reserved vector (the order of
+    // the sequential loops: faces, then edges).
+    let mut slots: Vec<(u32, u8)> = Vec::with_capacity(nf * 2);
+    for (t, fo) in faces.iter().enumerate() {
+        let n = if fo.class == Convexity::Zero {
+            1
+        } else {
+            fo.sides.iter().flatten().map(|s| s.pieces.len()).sum()
+        };
+        slots.extend((0..n as u8).map(|k| (t as u32, k)));
+    }
+    let face_patch = |&(t, k): &(u32, u8)| -> Patch {
+        let t = t as usize;
+        let fo = &faces[t];
+        if fo.class == Convexity::Zero {
+            return zero_patch(t);
+        }
+        let (side, pc) = fo
+            .sides
+            .iter()
+            .flatten()
+            .flat_map(|s| s.pieces.iter().map(move |pc| (s, pc)))
+            .nth(k as usize)
+            .expect("slot within the face's patches");
+        face_piece_patch(t, side, pc)
+    };
+    complex.patches.reserve_exact(slots.len() + etets.len());
     complex.patches.par_extend(
-        faces
+        slots
             .par_iter()
-            .enumerate()
-            .flat_map_iter(|(t, fo)| face_patches(t, fo)),
+            .map(face_patch)
+            .chain(etets.par_iter().map(edge_patch)),
     );
-    complex.patches.par_extend(etets.par_iter().map(edge_patch));
+    stage_time("emit", tt);
     let mut edges_by_class = [0; 4];
     for e in &hull.edges {
         edges_by_class[class_index(e.class)] += 1;

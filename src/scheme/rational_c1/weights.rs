@@ -379,6 +379,63 @@ pub fn bary(t: &[DVec3; 4], x: DVec3) -> Option<[f64; 4]> {
     Some([1.0 - y.x - y.y - y.z, y.x, y.y, y.z])
 }
 
+/// Index tables of an [`EdgeFrame`] (the gather `copy` and the first-layer indices `c1`).
+type FrameTables = ([(u8, u8); N3], [[u8; 4]; 6]);
+
+/// The index tables of an [`EdgeFrame`] for the local positions `[i, j, 3]` of p_i, p_j in
+/// pieces A and B: they depend on (i, j) of each piece only, so all 9 × 9 are computed once
+/// and looked up (building them per edge tetrahedron was a visible cost on large meshes).
+fn frame_tables(a_loc: [usize; 3], b_loc: [usize; 3]) -> FrameTables {
+    static TABLES: OnceLock<Vec<FrameTables>> = OnceLock::new();
+    let key = |loc: [usize; 3]| loc[0] * 3 + loc[1];
+    let all = TABLES.get_or_init(|| {
+        let locs: Vec<[usize; 3]> = (0..9).map(|k| [k / 3, k % 3, 3]).collect();
+        locs.iter()
+            .flat_map(|&a| locs.iter().map(move |&b| compute_frame_tables(a, b)))
+            .collect()
+    });
+    all[key(a_loc) * 9 + key(b_loc)]
+}
+
+/// Computes the tables of [`frame_tables`] (see [`EdgeFrame::weights`] for their use).
+fn compute_frame_tables(a_loc: [usize; 3], b_loc: [usize; 3]) -> FrameTables {
+    let map = |loc: &[usize; 3], c: [u8; 3]| -> [u8; 4] {
+        let mut l = [0u8; 4];
+        for k in 0..3 {
+            l[loc[k]] += c[k];
+        }
+        l
+    };
+    let mut copy = [(2u8, 0u8); N3];
+    for (k, &l) in cubic_indices().iter().enumerate() {
+        if l[3] == 0 {
+            copy[k] = (0, ix(map(&a_loc, [l[0], l[1], l[2]])) as u8);
+        } else if l[2] == 0 {
+            copy[k] = (1, ix(map(&b_loc, [l[0], l[1], l[3]])) as u8);
+        }
+    }
+    // First layer across the face shared with a piece: w(face multiset + e_r), r = 0..3.
+    let c1 = |loc: &[usize; 3], c: [u8; 3]| -> [u8; 4] {
+        let base = map(loc, c);
+        std::array::from_fn(|r| {
+            let mut l = base;
+            l[r] += 1;
+            ix(l) as u8
+        })
+    };
+    (
+        copy,
+        [
+            c1(&a_loc, [0, 0, 2]),
+            c1(&b_loc, [0, 0, 2]),
+            c1(&a_loc, [1, 0, 1]),
+            c1(&b_loc, [1, 0, 1]),
+            c1(&a_loc, [0, 1, 1]),
+            c1(&b_loc, [0, 1, 1]),
+        ],
+    )
+}
+
 /// How the edge tetrahedron [p_i p_j apexA apexB] sits against its two face pieces.
 #[derive(Clone, Copy, Debug)]
 pub struct EdgeFrame {
@@ -409,44 +466,14 @@ impl EdgeFrame {
             Some([i, j, 3])
         };
         let (a_loc, b_loc) = (loc(a)?, loc(b)?);
-        let map = |loc: &[usize; 3], c: [u8; 3]| -> [u8; 4] {
-            let mut l = [0u8; 4];
-            for k in 0..3 {
-                l[loc[k]] += c[k];
-            }
-            l
-        };
-        let mut copy = [(2u8, 0u8); N3];
-        for (k, &l) in cubic_indices().iter().enumerate() {
-            if l[3] == 0 {
-                copy[k] = (0, ix(map(&a_loc, [l[0], l[1], l[2]])) as u8);
-            } else if l[2] == 0 {
-                copy[k] = (1, ix(map(&b_loc, [l[0], l[1], l[3]])) as u8);
-            }
-        }
-        // First layer across the face shared with a piece: w(face multiset + e_r), r = 0..3.
-        let c1 = |loc: &[usize; 3], c: [u8; 3]| -> [u8; 4] {
-            let base = map(loc, c);
-            std::array::from_fn(|r| {
-                let mut l = base;
-                l[r] += 1;
-                ix(l) as u8
-            })
-        };
+        let (copy, c1) = frame_tables(a_loc, b_loc);
         Some(EdgeFrame {
             a_loc,
             b_loc,
             beta_a: bary(&a.pts, b.pts[3])?,
             beta_b: bary(&b.pts, a.pts[3])?,
             copy,
-            c1: [
-                c1(&a_loc, [0, 0, 2]),
-                c1(&b_loc, [0, 0, 2]),
-                c1(&a_loc, [1, 0, 1]),
-                c1(&b_loc, [1, 0, 1]),
-                c1(&a_loc, [0, 1, 1]),
-                c1(&b_loc, [0, 1, 1]),
-            ],
+            c1,
         })
     }
 
