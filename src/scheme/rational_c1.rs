@@ -1316,15 +1316,16 @@ fn assemble(
 mod tests {
     use super::*;
 
-    struct Rng(u64);
+    /// Xorshift numbers in [−1, 1) for the randomised tests of this module and its children.
+    pub(super) struct Rng(pub(super) u64);
     impl Rng {
-        fn next(&mut self) -> f64 {
+        pub(super) fn next(&mut self) -> f64 {
             self.0 ^= self.0 << 13;
             self.0 ^= self.0 >> 7;
             self.0 ^= self.0 << 17;
             (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         }
-        fn vec(&mut self) -> DVec3 {
+        pub(super) fn vec(&mut self) -> DVec3 {
             DVec3::new(self.next(), self.next(), self.next())
         }
     }

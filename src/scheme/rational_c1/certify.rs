@@ -107,15 +107,7 @@ mod tests {
     use super::super::bound::threshold_at;
     use super::*;
 
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        }
-    }
+    use super::super::tests::Rng;
 
     /// The edge shooting cubic at (x, y) straight from the definition (4.9): Bernstein
     /// products of every weight, independent of the layer bookkeeping above.

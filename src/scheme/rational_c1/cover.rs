@@ -783,15 +783,7 @@ mod tests {
     use super::super::{edge_shooting, face_shooting};
     use super::*;
 
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        }
-    }
+    use super::super::tests::Rng;
 
     /// A reference b_min of one line, from above but much finer in t* than
     /// [`lemma_bound_arg`]: the minimum of the threshold over 1024 values of t*, refined by
