@@ -18,22 +18,9 @@ use apatch::trace::{self, Geometry, Mode, RenderSettings};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-/// CPU seconds used by this process so far (Linux `/proc/self/stat`, 100 ticks/s), or NaN.
-fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    let Some(rest) = stat.rsplit_once(')').map(|r| r.1) else {
-        return f64::NAN;
-    };
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let tick = |i: usize| {
-        f.get(i)
-            .and_then(|x| x.parse::<f64>().ok())
-            .unwrap_or(f64::NAN)
-    };
-    (tick(11) + tick(12)) / 100.0
-}
+#[path = "support/cpu.rs"]
+mod cpu;
+use cpu::cpu_seconds;
 
 /// Settings of one measurement: 512×512, 1 spp, 1 thread, `mode`.
 fn bench_settings(settings: &RenderSettings, mode: Mode) -> RenderSettings {

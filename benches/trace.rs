@@ -26,24 +26,9 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-/// CPU seconds used by this process so far (Linux `/proc/self/stat`, 100 ticks/s), or NaN:
-/// the machine is shared, so rays per CPU-second is the figure that does not depend on load.
-fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    let Some(rest) = stat.rsplit_once(')').map(|r| r.1) else {
-        return f64::NAN;
-    };
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let tick = |i: usize| {
-        f.get(i)
-            .and_then(|x| x.parse::<f64>().ok())
-            .unwrap_or(f64::NAN)
-    };
-    // Fields 14 and 15 (utime, stime) are at 11 and 12 after the command name.
-    (tick(11) + tick(12)) / 100.0
-}
+#[path = "support/cpu.rs"]
+mod cpu;
+use cpu::cpu_seconds;
 
 /// The comparison tracer: the tessellation of the same complex (`export::tessellate`) as f32
 /// triangles in an obvhs CwBvh (its fastest traversal layout), Möller–Trumbore hits, vertex
