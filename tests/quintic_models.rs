@@ -6,6 +6,17 @@ use apatch::mesh::{self, NormalMethod};
 use apatch::scheme::quintic_c2::{build_with_stats, QuinticOptions};
 use std::path::Path;
 
+/// The scheme's defaults, with `LIFT=x` in the environment overriding the lift (to explore).
+fn options() -> QuinticOptions {
+    QuinticOptions {
+        lift: std::env::var("LIFT")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(apatch::scheme::quintic_c2::LIFT),
+        ..QuinticOptions::default()
+    }
+}
+
 fn run(name: &str) -> Result<String, String> {
     let path = Path::new("scenes/models").join(name);
     let (m, report) = mesh::load(&path).map_err(|e| e.to_string())?;
@@ -14,17 +25,7 @@ fn run(name: &str) -> Result<String, String> {
         mesh::vertex_normals(&m, NormalMethod::default_for(&m)).map_err(|e| e.to_string())?;
     let hull = inner::build(&m, &normals, &InnerOptions::default()).map_err(|e| e.to_string())?;
     let t = std::time::Instant::now();
-    let (c, stats) = build_with_stats(
-        &hull,
-        &QuinticOptions {
-            lift: std::env::var("LIFT")
-                .ok()
-                .and_then(|x| x.parse().ok())
-                .unwrap_or(apatch::scheme::quintic_c2::LIFT),
-            ..QuinticOptions::default()
-        },
-    )
-    .map_err(|e| e.to_string())?;
+    let (c, stats) = build_with_stats(&hull, &options()).map_err(|e| e.to_string())?;
     let secs = t.elapsed().as_secs_f64();
     let r = check(&c, &CheckOptions::default());
     Ok(format!(
@@ -84,17 +85,7 @@ fn inner_hull_models_are_c2() {
         let (m, _) = mesh::load(&path).unwrap();
         let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
         let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
-        let (c, stats) = build_with_stats(
-            &hull,
-            &QuinticOptions {
-                lift: std::env::var("LIFT")
-                    .ok()
-                    .and_then(|x| x.parse().ok())
-                    .unwrap_or(apatch::scheme::quintic_c2::LIFT),
-                ..QuinticOptions::default()
-            },
-        )
-        .unwrap();
+        let (c, stats) = build_with_stats(&hull, &options()).unwrap();
         // Relative residual of the solved equations: rounding of short sums.
         assert!(stats.max_residual < 1e-12, "{name}: {stats:?}");
         let r = check(&c, &CheckOptions::default());
