@@ -5,6 +5,8 @@
 //! [model]
 //! file = "models/teapot.obj"      # a mesh, built with [scheme] …
 //! normals = "loop"                # angle | area | loop | file
+//! # subdivide = { rule = "loop", levels = 2 }   # opt-in pre-subdivision (rational-c1 only):
+//! #                               # the surface then interpolates the subdivided mesh, not the file
 //! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
 //!
 //! [scheme]
@@ -71,6 +73,10 @@ pub enum Model {
         normals: String,
         /// The `[scheme]` table, validated by the scheme.
         scheme: toml::Table,
+        /// Optional approximating pre-subdivision of the triangulated mesh (`model.subdivide`,
+        /// rational-c1 only, see [`crate::mesh::subdivide`]): the surface then interpolates
+        /// the subdivided mesh, not the file's.
+        subdivide: Option<mesh::Subdivision>,
     },
     /// A patch complex JSON file (resolved).
     Patches(PathBuf),
@@ -111,6 +117,20 @@ struct ModelSection {
     file: Option<String>,
     normals: Option<String>,
     patches: Option<String>,
+    subdivide: Option<SubdivideSection>,
+}
+
+/// `model.subdivide = { rule = "loop", levels = N }`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SubdivideSection {
+    #[serde(default = "default_subdivision_rule")]
+    rule: String,
+    levels: u32,
+}
+
+fn default_subdivision_rule() -> String {
+    "loop".into()
 }
 
 #[derive(Deserialize)]
@@ -294,6 +314,12 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
             if file.scheme.is_some() {
                 return Err(bad("scheme", "only applies with `model.file`".into()));
             }
+            if m.subdivide.is_some() {
+                return Err(bad(
+                    "model.subdivide",
+                    "only applies with `model.file`".into(),
+                ));
+            }
             Model::Patches(dir.join(p))
         }
         (Some(f), None) => {
@@ -310,10 +336,45 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     "a [scheme] table is required with `model.file`".into(),
                 )
             })?;
+            let subdivide = match &m.subdivide {
+                None => None,
+                Some(sd) => {
+                    if sd.rule != "loop" {
+                        return Err(bad(
+                            "model.subdivide.rule",
+                            format!("`{}` is not supported (only `loop`)", sd.rule),
+                        ));
+                    }
+                    if sd.levels > mesh::Subdivision::MAX_LEVELS {
+                        return Err(bad(
+                            "model.subdivide.levels",
+                            format!(
+                                "{} is more than {}",
+                                sd.levels,
+                                mesh::Subdivision::MAX_LEVELS
+                            ),
+                        ));
+                    }
+                    let ty = scheme.get("type").and_then(|v| v.as_str());
+                    if ty != Some("rational-c1") {
+                        return Err(bad(
+                            "model.subdivide",
+                            "only applies to `scheme.type = \"rational-c1\"` (the 1994 \
+                             schemes are measured against the input polyhedron)"
+                                .into(),
+                        ));
+                    }
+                    Some(mesh::Subdivision {
+                        rule: mesh::SubdivisionRule::Loop,
+                        levels: sd.levels,
+                    })
+                }
+            };
             Model::Mesh {
                 file: dir.join(f),
                 normals,
                 scheme,
+                subdivide,
             }
         }
     };
@@ -500,6 +561,7 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
             file,
             normals,
             scheme,
+            subdivide,
         } => {
             let ty = scheme.get("type").and_then(|v| v.as_str()).ok_or_else(|| {
                 anyhow!(
@@ -515,8 +577,15 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                     })?;
                     let (m, report) = mesh::load(file)?;
                     report.require(false)?;
-                    let tri = mesh::triangulate(&m);
-                    let vn = mesh::vertex_normals(&m, method)?;
+                    let mut tri = mesh::triangulate(&m);
+                    let vn = match subdivide {
+                        Some(sd) => {
+                            tri = mesh::subdivide(&tri, *sd)
+                                .with_context(|| format!("{}", file.display()))?;
+                            mesh::vertex_normals(&tri, method)?
+                        }
+                        None => mesh::vertex_normals(&m, method)?,
+                    };
                     let triangles: Vec<[u32; 3]> =
                         tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
                     let built = rational_c1::build(&tri.positions, &triangles, &vn, &opts)
@@ -560,6 +629,7 @@ pub fn inner_hull(
         file,
         normals,
         scheme,
+        ..
     } = &scene.model
     else {
         return Ok(None);

@@ -158,3 +158,99 @@ fn paper1994_polyhedra_pass_check() {
         assert!(r.passed(), "{name}:\n{r}");
     }
 }
+
+/// Survey (not a proof, prints a table): every model of `scenes/models` under the 2001 scheme
+/// with 0..=`APATCH_SURVEY_LEVELS` (default 3) levels of Loop pre-subdivision and the normals
+/// in `APATCH_SURVEY_NORMALS` (default angle): triangles, fold angles (max / median / count
+/// ≥ 90°), whether it builds and passes `check`, refined edges, seconds.
+/// `APATCH_SURVEY_MODELS` (comma-separated stems) restricts the models.
+/// Run: `cargo test --release --test rational_models -- --ignored --nocapture survey`.
+#[test]
+#[ignore = "survey of every model and level (minutes); prints a table"]
+fn survey_pre_subdivision() {
+    use apatch::check::{check, CheckOptions};
+    use apatch::mesh::{self, subdivide::fold_angles, NormalMethod, Subdivision, SubdivisionRule};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models");
+    let max_levels: u32 = std::env::var("APATCH_SURVEY_LEVELS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3);
+    let method: NormalMethod = std::env::var("APATCH_SURVEY_NORMALS")
+        .unwrap_or_else(|_| "angle".into())
+        .parse()
+        .unwrap();
+    let only: Option<Vec<String>> = std::env::var("APATCH_SURVEY_MODELS")
+        .ok()
+        .map(|s| s.split(',').map(str::to_string).collect());
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            (p.extension()? == "obj").then(|| p.file_stem()?.to_str().map(str::to_string))?
+        })
+        .collect();
+    names.sort();
+    for name in names {
+        if only.as_ref().is_some_and(|o| !o.contains(&name)) {
+            continue;
+        }
+        let (m, report) = mesh::load(&dir.join(format!("{name}.obj"))).unwrap();
+        if report.require(false).is_err() {
+            eprintln!("{name}: rejected by load");
+            continue;
+        }
+        let tri = mesh::triangulate(&m);
+        for levels in 0..=max_levels {
+            let t0 = std::time::Instant::now();
+            let s = mesh::subdivide(
+                &tri,
+                Subdivision {
+                    rule: SubdivisionRule::Loop,
+                    levels,
+                },
+            )
+            .unwrap();
+            let mut folds = fold_angles(&s);
+            folds.sort_by(f64::total_cmp);
+            let (max, med) = (
+                folds.last().copied().unwrap_or(0.0),
+                folds.get(folds.len() / 2).copied().unwrap_or(0.0),
+            );
+            let over90 = folds.iter().filter(|&&a| a >= 90.0).count();
+            let normals = if levels == 0 && method != NormalMethod::Loop {
+                mesh::vertex_normals(&m, method)
+            } else {
+                mesh::vertex_normals(&s, method)
+            };
+            let tris: Vec<[u32; 3]> = s.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+            let result = normals.map_err(|e| e.to_string()).and_then(|n| {
+                apatch::scheme::rational_c1::build(
+                    &s.positions,
+                    &tris,
+                    &n,
+                    &RationalOptions::default(),
+                )
+                .map_err(|e| e.to_string())
+            });
+            let verdict = match &result {
+                Err(e) => format!("FAIL build: {}", &e[..e.len().min(160)]),
+                Ok(b) => {
+                    let r = check(&b.complex, &CheckOptions::default());
+                    if r.passed() {
+                        format!("ok, refined {}", b.refined_edges)
+                    } else {
+                        format!("FAIL check: {:?}", r.failures())
+                    }
+                }
+            };
+            eprintln!(
+                "{name} L{levels} {method}: {} tris, folds max {max:.1} med {med:.1} ≥90: {over90}; {verdict}; {:.1} s",
+                s.faces.len(),
+                t0.elapsed().as_secs_f64()
+            );
+            if result.is_ok() && levels > 0 {
+                break;
+            }
+        }
+    }
+}
