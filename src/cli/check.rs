@@ -100,6 +100,21 @@ fn scene_1994(
     Ok(Some(apatch::scene::load(input)?))
 }
 
+/// The scene's opt-in pre-subdivision (`model.subdivide`) when `input` is such a scene: the
+/// surface then interpolates the subdivided mesh, not the input, and the report says so.
+fn subdivision(input: &Path) -> Option<apatch::mesh::Subdivision> {
+    let is_toml = input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if !is_toml {
+        return None;
+    }
+    match apatch::scene::load(input).ok()?.model {
+        apatch::scene::Model::Mesh { subdivide, .. } => subdivide.filter(|s| s.levels > 0),
+        apatch::scene::Model::Patches(_) => None,
+    }
+}
+
 /// The distance of the surface to the scene's polyhedron (1994 scenes).
 fn polyhedron_distance(
     scene: &apatch::scene::Scene,
@@ -155,6 +170,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         None => (None, None),
     };
     let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);
+    let subdivided = subdivision(&args.input);
     let passed = report.passed() && hull_valid;
     if args.json {
         // The verdict first, then every measure.
@@ -167,6 +183,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let Some(d) = &distance {
             out.insert("distance".into(), serde_json::to_value(d)?);
         }
+        if let Some(sd) = &subdivided {
+            out.insert("subdivision".into(), serde_json::to_value(sd)?);
+        }
         if let Some(v) = &hull {
             let list: Vec<String> = v.iter().map(violation_line).collect();
             out.insert(
@@ -177,6 +196,15 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         print!("{report}");
+        if let Some(sd) = &subdivided {
+            println!(
+                "subdivision      {} levels of `{}` before the hull: the surface interpolates the \
+                 subdivided, locally refined mesh ({} vertices), not the input mesh  info",
+                sd.levels,
+                sd.rule,
+                complex.vertices.len()
+            );
+        }
         if let Some(d) = &distance {
             println!(
                 "distance         max {:.4e}, mean {:.4e} of the bounding-box diagonal {:.4} \
