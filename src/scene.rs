@@ -711,6 +711,65 @@ irradiance = 2.0
     }
 
     #[test]
+    fn subdivide_key_is_parsed_and_checked() {
+        let with = |model: &str, scheme: &str| {
+            MINIMAL.replace(
+                "patches = \"sphere.json\"",
+                &format!("file = \"m.obj\"\n{model}\n[scheme]\ntype = \"{scheme}\""),
+            )
+        };
+        let ok = with("subdivide = { rule = \"loop\", levels = 2 }", "rational-c1");
+        let s = parse(&ok, Path::new("s.toml")).unwrap();
+        let Model::Mesh { subdivide, .. } = s.model else {
+            panic!("mesh scene expected");
+        };
+        assert_eq!(
+            subdivide,
+            Some(mesh::Subdivision {
+                rule: mesh::SubdivisionRule::Loop,
+                levels: 2
+            })
+        );
+        // `rule` defaults to loop.
+        let s = parse(
+            &with("subdivide = { levels = 1 }", "rational-c1"),
+            Path::new("s.toml"),
+        );
+        assert!(s.is_ok());
+        for (model, scheme, key) in [
+            (
+                "subdivide = { rule = \"catmull\", levels = 1 }",
+                "rational-c1",
+                "model.subdivide.rule",
+            ),
+            (
+                "subdivide = { levels = 9 }",
+                "rational-c1",
+                "model.subdivide.levels",
+            ),
+            (
+                "subdivide = { levels = 1, sharp = true }",
+                "rational-c1",
+                "sharp",
+            ),
+            ("subdivide = { levels = 1 }", "cubic-c1", "model.subdivide"),
+            ("subdivide = 2", "rational-c1", "subdivide"),
+        ] {
+            let e = format!(
+                "{:#}",
+                parse(&with(model, scheme), Path::new("a/b.toml")).unwrap_err()
+            );
+            assert!(e.contains("a/b.toml") && e.contains(key), "{model}: {e}");
+        }
+        let patches = MINIMAL.replace(
+            "patches = \"sphere.json\"",
+            "patches = \"p.json\"\nsubdivide = { levels = 1 }",
+        );
+        let e = format!("{:#}", parse(&patches, Path::new("s.toml")).unwrap_err());
+        assert!(e.contains("model.subdivide"), "{e}");
+    }
+
+    #[test]
     fn schemes_dispatch_with_clear_errors() {
         let text = MINIMAL.replace(
             "patches = \"sphere.json\"",
