@@ -4,7 +4,8 @@
 //! ```toml
 //! [model]
 //! file = "models/teapot.obj"      # a mesh, built with [scheme] …
-//! normals = "loop"                # angle | area | loop | file
+//! normals = "loop"                # angle | area | loop | file (rational-c1: loop on a polygon
+//!                                 # mesh uses its triangulation)
 //! # subdivide = { rule = "loop", levels = 2 }   # opt-in pre-subdivision (rational-c1 only):
 //! #                               # the surface then interpolates the subdivided mesh, not the file
 //! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
@@ -582,6 +583,11 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                         Some(sd) => {
                             tri = mesh::subdivide(&tri, *sd)
                                 .with_context(|| format!("{}", file.display()))?;
+                            mesh::vertex_normals(&tri, method)?
+                        }
+                        // Loop-limit normals need triangles: on a polygon mesh they are
+                        // taken on its triangulation (the triangles the hull is built on).
+                        None if method == NormalMethod::Loop && !m.is_triangle_mesh() => {
                             mesh::vertex_normals(&tri, method)?
                         }
                         None => mesh::vertex_normals(&m, method)?,

@@ -195,7 +195,6 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        print!("{report}");
         if let Some(sd) = &subdivided {
             println!(
                 "subdivision      {} levels of `{}` before the hull: the surface interpolates the \
@@ -205,6 +204,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 complex.vertices.len()
             );
         }
+        print!("{report}");
         if let Some(d) = &distance {
             println!(
                 "distance         max {:.4e}, mean {:.4e} of the bounding-box diagonal {:.4} \
