@@ -8,6 +8,8 @@
 //!                                 # mesh uses its triangulation)
 //! # subdivide = { rule = "loop", levels = 2 }   # opt-in pre-subdivision (rational-c1 only):
 //! #                               # the surface then interpolates the subdivided mesh, not the file
+//! # weld = 1e-3                   # opt-in (rational-c1 only): weld vertices closer than this ×
+//! #                               # the bounding-box diagonal (modelling slop, see mesh::weld)
 //! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
 //!
 //! [scheme]
@@ -78,6 +80,9 @@ pub enum Model {
         /// rational-c1 only, see [`crate::mesh::subdivide`]): the surface then interpolates
         /// the subdivided mesh, not the file's.
         subdivide: Option<mesh::Subdivision>,
+        /// Optional weld tolerance relative to the bounding-box diagonal (`model.weld`,
+        /// rational-c1 only, see [`crate::mesh::weld`]), applied before triangulation.
+        weld: Option<f64>,
     },
     /// A patch complex JSON file (resolved).
     Patches(PathBuf),
@@ -119,6 +124,7 @@ struct ModelSection {
     normals: Option<String>,
     patches: Option<String>,
     subdivide: Option<SubdivideSection>,
+    weld: Option<f64>,
 }
 
 /// `model.subdivide = { rule = "loop", levels = N }`.
@@ -315,9 +321,9 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
             if file.scheme.is_some() {
                 return Err(bad("scheme", "only applies with `model.file`".into()));
             }
-            if m.subdivide.is_some() {
+            if m.subdivide.is_some() || m.weld.is_some() {
                 return Err(bad(
-                    "model.subdivide",
+                    "model.subdivide/weld",
                     "only applies with `model.file`".into(),
                 ));
             }
@@ -371,11 +377,29 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     })
                 }
             };
+            if let Some(w) = m.weld {
+                if !(0.0..=mesh::weld::MAX_WELD_TOLERANCE).contains(&w) {
+                    return Err(bad(
+                        "model.weld",
+                        format!(
+                            "{w} is not in [0, {}] (relative to the bounding-box diagonal)",
+                            mesh::weld::MAX_WELD_TOLERANCE
+                        ),
+                    ));
+                }
+                if scheme.get("type").and_then(|v| v.as_str()) != Some("rational-c1") {
+                    return Err(bad(
+                        "model.weld",
+                        "only applies to `scheme.type = \"rational-c1\"`".into(),
+                    ));
+                }
+            }
             Model::Mesh {
                 file: dir.join(f),
                 normals,
                 scheme,
                 subdivide,
+                weld: m.weld,
             }
         }
     };
@@ -563,6 +587,7 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
             normals,
             scheme,
             subdivide,
+            weld,
         } => {
             let ty = scheme.get("type").and_then(|v| v.as_str()).ok_or_else(|| {
                 anyhow!(
@@ -576,8 +601,16 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                     let method: NormalMethod = normals.parse().map_err(|e: String| {
                         anyhow!("{}: `model.normals`: {e}", scene.path.display())
                     })?;
-                    let (m, report) = mesh::load(file)?;
+                    let (mut m, report) = mesh::load(file)?;
                     report.require(false)?;
+                    if let Some(w) = weld {
+                        let (welded, report, _) = mesh::weld(&m, *w)
+                            .with_context(|| format!("{}: `model.weld`", file.display()))?;
+                        report
+                            .require(false)
+                            .with_context(|| format!("{}: after `model.weld`", file.display()))?;
+                        m = welded;
+                    }
                     let mut tri = mesh::triangulate(&m);
                     let vn = match subdivide {
                         Some(sd) => {
@@ -766,6 +799,18 @@ irradiance = 2.0
                 parse(&with(model, scheme), Path::new("a/b.toml")).unwrap_err()
             );
             assert!(e.contains("a/b.toml") && e.contains(key), "{model}: {e}");
+        }
+        let s = parse(&with("weld = 1e-3", "rational-c1"), Path::new("s.toml")).unwrap();
+        assert!(matches!(s.model, Model::Mesh { weld: Some(w), .. } if w == 1e-3));
+        for (model, scheme) in [("weld = 0.5", "rational-c1"), ("weld = 1e-3", "quintic-c2")] {
+            let e = format!(
+                "{:#}",
+                parse(&with(model, scheme), Path::new("a/b.toml")).unwrap_err()
+            );
+            assert!(
+                e.contains("a/b.toml") && e.contains("model.weld"),
+                "{model}: {e}"
+            );
         }
         let patches = MINIMAL.replace(
             "patches = \"sphere.json\"",

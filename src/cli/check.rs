@@ -102,16 +102,22 @@ fn scene_1994(
 
 /// The scene's opt-in pre-subdivision (`model.subdivide`) when `input` is such a scene: the
 /// surface then interpolates the subdivided mesh, not the input, and the report says so.
-fn subdivision(input: &Path) -> Option<apatch::mesh::Subdivision> {
+/// Also the scene's weld tolerance (`model.weld`), which changes the mesh the same way.
+fn mesh_repairs(input: &Path) -> (Option<apatch::mesh::Subdivision>, Option<f64>) {
     let is_toml = input
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
     if !is_toml {
-        return None;
+        return (None, None);
     }
-    match apatch::scene::load(input).ok()?.model {
-        apatch::scene::Model::Mesh { subdivide, .. } => subdivide.filter(|s| s.levels > 0),
-        apatch::scene::Model::Patches(_) => None,
+    match apatch::scene::load(input).map(|s| s.model) {
+        Ok(apatch::scene::Model::Mesh {
+            subdivide, weld, ..
+        }) => (
+            subdivide.filter(|s| s.levels > 0),
+            weld.filter(|w| *w > 0.0),
+        ),
+        _ => (None, None),
     }
 }
 
@@ -170,7 +176,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         None => (None, None),
     };
     let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);
-    let subdivided = subdivision(&args.input);
+    let (subdivided, welded) = mesh_repairs(&args.input);
     let passed = report.passed() && hull_valid;
     if args.json {
         // The verdict first, then every measure.
@@ -186,6 +192,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let Some(sd) = &subdivided {
             out.insert("subdivision".into(), serde_json::to_value(sd)?);
         }
+        if let Some(w) = welded {
+            out.insert("weld".into(), w.into());
+        }
         if let Some(v) = &hull {
             let list: Vec<String> = v.iter().map(violation_line).collect();
             out.insert(
@@ -195,6 +204,12 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
+        if let Some(w) = welded {
+            println!(
+                "weld             vertices closer than {w:e} of the bounding-box diagonal were \
+                 welded before the hull: the surface interpolates the welded mesh  info"
+            );
+        }
         if let Some(sd) = &subdivided {
             println!(
                 "subdivision      {} levels of `{}` before the hull: the surface interpolates the \

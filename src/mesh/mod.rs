@@ -57,6 +57,7 @@ mod summary;
 pub mod topology;
 mod triangulate;
 mod validate;
+pub mod weld;
 
 pub use load::{from_polygons, load, load_bytes, Format};
 pub use normals::{above_face_failures, loop_limit_normal, vertex_normals, NormalMethod};
@@ -67,6 +68,7 @@ pub use summary::{summary, ClassCounts, Summary};
 pub use topology::{Fan, Topology};
 pub use triangulate::{ear_clip, triangulate};
 pub use validate::{PLANARITY_TOL, ZERO_AREA_TOL};
+pub use weld::weld;
 
 use glam::DVec3;
 
