@@ -220,7 +220,9 @@ fn paper1994_folded_polyhedra_pass_check_with_loop_pre_subdivision() {
 /// with 0..=`APATCH_SURVEY_LEVELS` (default 3) levels of Loop pre-subdivision and the normals
 /// in `APATCH_SURVEY_NORMALS` (default angle): triangles, fold angles (max / median / count
 /// ≥ 90°), whether it builds and passes `check`, refined edges, seconds.
-/// `APATCH_SURVEY_MODELS` (comma-separated stems) restricts the models.
+/// `APATCH_SURVEY_MODELS` (comma-separated stems) restricts the models; `APATCH_SURVEY_WELD`
+/// welds first (`mesh::weld`, relative tolerance); `APATCH_SURVEY_ROUNDS`, `APATCH_SURVEY_EPSILON`
+/// set `refine_rounds` and `epsilon`; `APATCH_SURVEY_WORST` lists the folds of 90° or more.
 /// Run: `cargo test --release --test rational_models -- --ignored --nocapture survey`.
 #[test]
 #[ignore = "survey of every model and level (minutes); prints a table"]
@@ -251,10 +253,18 @@ fn survey_pre_subdivision() {
         if only.as_ref().is_some_and(|o| !o.contains(&name)) {
             continue;
         }
-        let (m, report) = mesh::load(&dir.join(format!("{name}.obj"))).unwrap();
+        let (mut m, report) = mesh::load(&dir.join(format!("{name}.obj"))).unwrap();
         if report.require(false).is_err() {
             eprintln!("{name}: rejected by load");
             continue;
+        }
+        if let Some(w) = std::env::var("APATCH_SURVEY_WELD")
+            .ok()
+            .and_then(|s| s.parse().ok())
+        {
+            let (welded, _, moved) = mesh::weld(&m, w).unwrap();
+            eprintln!("{name}: weld {w}: {moved} vertices moved");
+            m = welded;
         }
         let tri = mesh::triangulate(&m);
         for levels in 0..=max_levels {
