@@ -3,7 +3,9 @@
 //! [`load`] reads OBJ or OFF (polygon faces kept), welds exactly coincident vertices, removes
 //! degenerate faces, makes the orientation consistent and outward, and validates. [`triangulate`]
 //! ear-clips polygons for the 2001 scheme; [`vertex_normals`] estimates the normals the schemes
-//! interpolate; [`convexity`] classifies edges and faces.
+//! interpolate; [`convexity`] classifies edges and faces. Opt-in repairs for coarse, folded
+//! meshes under the 2001 scheme: [`subdivide()`] (Loop's approximating subdivision) and
+//! [`weld()`] (vertices closer than a tolerance merged).
 //!
 //! ```
 //! use apatch::mesh::{self, NormalMethod};
