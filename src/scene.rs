@@ -77,11 +77,11 @@ pub enum Model {
         /// The `[scheme]` table, validated by the scheme.
         scheme: toml::Table,
         /// Optional approximating pre-subdivision of the triangulated mesh (`model.subdivide`,
-        /// rational-c1 only, see [`crate::mesh::subdivide`]): the surface then interpolates
+        /// rational-c1 only, see [`mod@crate::mesh::subdivide`]): the surface then interpolates
         /// the subdivided mesh, not the file's.
         subdivide: Option<mesh::Subdivision>,
         /// Optional weld tolerance relative to the bounding-box diagonal (`model.weld`,
-        /// rational-c1 only, see [`crate::mesh::weld`]), applied before triangulation.
+        /// rational-c1 only, see [`mod@crate::mesh::weld`]), applied before triangulation.
         weld: Option<f64>,
     },
     /// A patch complex JSON file (resolved).
