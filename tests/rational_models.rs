@@ -353,3 +353,43 @@ fn survey_pre_subdivision() {
         }
     }
 }
+
+/// `apatch check` on a pre-subdivided scene says that the surface interpolates the subdivided
+/// mesh, not the input (text and JSON), and passes.
+#[test]
+fn check_cli_reports_the_pre_subdivision() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_apatch"))
+            .args(args)
+            .current_dir(root)
+            .output()
+            .unwrap()
+    };
+    let out = run(&["check", "scenes/corner.toml"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("2 levels of `loop`") && text.contains("not the input mesh"),
+        "{text}"
+    );
+    // The same scene with a weld (it moves no vertex of this model), as JSON.
+    let dir = std::env::temp_dir().join(format!("apatch-folds-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = std::fs::read_to_string(root.join("scenes/corner.toml"))
+        .unwrap()
+        .replace(
+            "file = \"models/",
+            &format!("weld = 1e-4\nfile = \"{}/scenes/models/", root.display()),
+        );
+    let path = dir.join("corner_weld.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = run(&["check", path.to_str().unwrap(), "--json"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
+    assert_eq!(json["passed"], true);
+    assert_eq!(json["subdivision"]["levels"], 2);
+    assert_eq!(json["subdivision"]["rule"], "loop");
+    assert_eq!(json["weld"], 1e-4);
+}

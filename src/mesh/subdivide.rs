@@ -415,6 +415,40 @@ mod tests {
     }
 
     #[test]
+    fn non_manifold_and_inconsistent_input_does_not_panic() {
+        // Three triangles on one edge (0-1), one of them oriented against the others, an
+        // unused vertex and a lone triangle: the rules fall back (edge midpoints, fixed
+        // vertices where more than two non-manifold or boundary edges meet) without a panic,
+        // and every new position is finite.
+        let m = Mesh::new(
+            vec![
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::Y,
+                DVec3::Z,
+                DVec3::new(0.5, -1.0, 0.0),
+                DVec3::splat(7.0),
+                DVec3::new(3.0, 0.0, 0.0),
+                DVec3::new(4.0, 0.0, 0.0),
+                DVec3::new(3.0, 1.0, 0.0),
+            ],
+            vec![vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4], vec![6, 7, 8]],
+        );
+        let s = subdivide(
+            &m,
+            Subdivision {
+                rule: SubdivisionRule::Loop,
+                levels: 2,
+            },
+        )
+        .unwrap();
+        assert_eq!(s.faces.len(), 64);
+        assert!(s.positions.iter().all(|p| p.is_finite()));
+        // The unused vertex stays where it was.
+        assert_eq!(s.positions[5], DVec3::splat(7.0));
+    }
+
+    #[test]
     fn polygons_and_too_many_levels_are_errors() {
         let quad = Mesh::new(
             vec![DVec3::ZERO, DVec3::X, DVec3::ONE, DVec3::Y],
