@@ -580,8 +580,33 @@ pub fn check_output(path: &Path) -> Result<(), String> {
 /// # Errors
 /// Unreadable or invalid inputs, unknown or unavailable schemes, each naming the file.
 pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
+    Ok(build_complex_with_info(scene)?.0)
+}
+
+/// What the 2001 scheme's mesh pipeline did to the input before and during the build, for
+/// reports (`apatch check`).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct MeshBuildInfo {
+    /// Triangles of the input after triangulation (and the weld, if any).
+    pub input_triangles: usize,
+    /// Vertices moved onto another by `model.weld` (0 without it).
+    pub welded_vertices: usize,
+    /// Triangles after `model.subdivide` (= `input_triangles` without it).
+    pub subdivided_triangles: usize,
+    /// Edges split by the hull's local refinement (§3.1) because adjacent face tetrahedra
+    /// intersected.
+    pub refined_edges: usize,
+}
+
+/// [`build_complex`], plus [`MeshBuildInfo`] for `rational-c1` mesh scenes (`None` otherwise).
+///
+/// # Errors
+/// As [`build_complex`].
+pub fn build_complex_with_info(
+    scene: &Scene,
+) -> anyhow::Result<(PatchComplex, Option<MeshBuildInfo>)> {
     match &scene.model {
-        Model::Patches(p) => read_patches(p),
+        Model::Patches(p) => Ok((read_patches(p)?, None)),
         Model::Mesh {
             file,
             normals,
@@ -603,15 +628,18 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                     })?;
                     let (mut m, report) = mesh::load(file)?;
                     report.require(false)?;
+                    let mut welded_vertices = 0;
                     if let Some(w) = weld {
-                        let (welded, report, _) = mesh::weld(&m, *w)
+                        let (welded, report, moved) = mesh::weld(&m, *w)
                             .with_context(|| format!("{}: `model.weld`", file.display()))?;
                         report
                             .require(false)
                             .with_context(|| format!("{}: after `model.weld`", file.display()))?;
                         m = welded;
+                        welded_vertices = moved;
                     }
                     let mut tri = mesh::triangulate(&m);
+                    let input_triangles = tri.faces.len();
                     let vn = match subdivide {
                         Some(sd) => {
                             tri = mesh::subdivide(&tri, *sd)
@@ -629,7 +657,13 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                         tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
                     let built = rational_c1::build(&tri.positions, &triangles, &vn, &opts)
                         .with_context(|| format!("{}", file.display()))?;
-                    Ok(built.complex)
+                    let info = MeshBuildInfo {
+                        input_triangles,
+                        welded_vertices,
+                        subdivided_triangles: triangles.len(),
+                        refined_edges: built.refined_edges,
+                    };
+                    Ok((built.complex, Some(info)))
                 }
                 "cubic-c1" | "quintic-c2" => {
                     let method: NormalMethod = normals.parse().map_err(|e: String| {
@@ -643,8 +677,11 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                     } else {
                         crate::scheme::quintic_c2::build_from_scene
                     };
-                    build(&m, &vn, scheme, &scene.path)
-                        .with_context(|| format!("{}", file.display()))
+                    Ok((
+                        build(&m, &vn, scheme, &scene.path)
+                            .with_context(|| format!("{}", file.display()))?,
+                        None,
+                    ))
                 }
                 _ => bail!(
                     "{}: `scheme.type`: `{ty}` is not one of rational-c1, cubic-c1, quintic-c2",

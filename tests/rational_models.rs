@@ -373,6 +373,10 @@ fn check_cli_reports_the_pre_subdivision() {
         text.contains("2 levels of `loop`") && text.contains("not the input mesh"),
         "{text}"
     );
+    assert!(
+        text.contains("20 triangles, 320 after subdivision") && text.contains("edges refined"),
+        "{text}"
+    );
     // The same scene with a weld (it moves no vertex of this model), as JSON.
     let dir = std::env::temp_dir().join(format!("apatch-folds-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -392,4 +396,14 @@ fn check_cli_reports_the_pre_subdivision() {
     assert_eq!(json["subdivision"]["levels"], 2);
     assert_eq!(json["subdivision"]["rule"], "loop");
     assert_eq!(json["weld"], 1e-4);
+    // The mesh pipeline's counts: corner_poly's 20 triangles, 16 × 20 after two levels, and
+    // the refined edges (none or a few: the count the build reports, at most all edges).
+    let mb = &json["mesh_build"];
+    assert_eq!(mb["input_triangles"], 20);
+    assert_eq!(mb["subdivided_triangles"], 320);
+    assert_eq!(mb["welded_vertices"], 0);
+    assert!(
+        mb["refined_edges"].as_u64().is_some_and(|r| r <= 480),
+        "{mb}"
+    );
 }

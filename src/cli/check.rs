@@ -51,22 +51,33 @@ fn tolerance(s: &str) -> Result<f64, String> {
 /// # Errors
 /// A missing or unreadable file, invalid data, or an input kind not supported yet.
 pub fn load_complex(path: &Path) -> anyhow::Result<PatchComplex> {
+    Ok(load_complex_with_info(path)?.0)
+}
+
+/// [`load_complex`], plus what the 2001 scheme's mesh pipeline did (weld, subdivision,
+/// refined edges) when `path` is a `rational-c1` mesh scene.
+///
+/// # Errors
+/// As [`load_complex`].
+pub fn load_complex_with_info(
+    path: &Path,
+) -> anyhow::Result<(PatchComplex, Option<apatch::scene::MeshBuildInfo>)> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
     match ext.as_str() {
-        "json" => Ok(apatch::complex_io::read_json_file(path)?),
+        "json" => Ok((apatch::complex_io::read_json_file(path)?, None)),
         "toml" => {
             let scene = apatch::scene::load(path)?;
             if let apatch::scene::Model::Patches(json) = &scene.model {
-                return Ok(apatch::complex_io::read_json_file(json)?);
+                return Ok((apatch::complex_io::read_json_file(json)?, None));
             }
-            let complex = apatch::scene::build_complex(&scene)?;
+            let (complex, info) = apatch::scene::build_complex_with_info(&scene)?;
             apatch::complex_io::validate(&complex)
                 .map_err(|m| anyhow::anyhow!("{}: {m}", path.display()))?;
-            Ok(complex)
+            Ok((complex, info))
         }
         "obj" | "off" => {
             if !path.exists() {
@@ -158,7 +169,7 @@ fn violation_line(v: &apatch::hull::inner::HullViolation) -> String {
 
 /// Runs `apatch check`.
 pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
-    let complex = load_complex(&args.input)?;
+    let (complex, build_info) = load_complex_with_info(&args.input)?;
     let opts = CheckOptions {
         continuity: args.continuity,
         jump_tolerance: args.jump_tolerance,
@@ -195,6 +206,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let Some(w) = welded {
             out.insert("weld".into(), w.into());
         }
+        if let Some(info) = &build_info {
+            out.insert("mesh_build".into(), serde_json::to_value(info)?);
+        }
         if let Some(v) = &hull {
             let list: Vec<String> = v.iter().map(violation_line).collect();
             out.insert(
@@ -217,6 +231,24 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 sd.levels,
                 sd.rule,
                 complex.vertices.len()
+            );
+        }
+        if let Some(info) = &build_info {
+            println!(
+                "mesh             {} triangles{}{}; {} edges refined because adjacent face \
+                 tetrahedra intersected (§3.1)  info",
+                info.input_triangles,
+                if info.welded_vertices > 0 {
+                    format!(" ({} vertices welded)", info.welded_vertices)
+                } else {
+                    String::new()
+                },
+                if info.subdivided_triangles != info.input_triangles {
+                    format!(", {} after subdivision", info.subdivided_triangles)
+                } else {
+                    String::new()
+                },
+                info.refined_edges
             );
         }
         print!("{report}");
