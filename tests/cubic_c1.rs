@@ -172,3 +172,74 @@ fn jvertex_json_roundtrip() {
     let bad = text.replacen("\"jvertex\":3", "\"jvertex\":7", 1);
     assert!(apatch::complex_io::from_json_str(&bad, Path::new("x.json")).is_err());
 }
+
+/// Exploration: single-sided face tetrahedra of torus_quad12x8 whose base triangle on T sees
+/// F with the apex's sign, and their base weights.
+#[test]
+#[ignore = "exploration"]
+fn explore_torus_base() {
+    use apatch::hull::inner::{self, InnerOptions};
+    use apatch::hull::simplicial::Side;
+    let (m, _) = apatch::mesh::load(Path::new("scenes/models/torus_quad12x8.obj")).unwrap();
+    let vn = apatch::mesh::vertex_normals(&m, apatch::mesh::NormalMethod::Angle).unwrap();
+    let hull = inner::build(&m, &vn, &InnerOptions::default()).unwrap();
+    let b = build_full(&hull, &CubicOptions::default()).unwrap();
+    let mut k = 0;
+    for (t, a) in hull.apexes.iter().enumerate() {
+        for side in Side::BOTH {
+            if a[side as usize].is_none() {
+                continue;
+            }
+            let p = &b.complex.patches[k];
+            k += 1;
+            if a[0].is_some() && a[1].is_some() {
+                continue;
+            }
+            let w = &p.weights;
+            let base: Vec<f64> = apatch::bb::multi_indices(3)
+                .iter()
+                .zip(w)
+                .filter(|(l, _)| l[3] == 0)
+                .map(|(_, &x)| x)
+                .collect();
+            let apex = w[apatch::bb::index_of([0, 0, 0, 3])];
+            let mut worst = 0.0f64;
+            let n = 30;
+            for i in 0..=n {
+                for j in 0..=n - i {
+                    let al = [
+                        i as f64 / n as f64,
+                        j as f64 / n as f64,
+                        (n - i - j) as f64 / n as f64,
+                        0.0,
+                    ];
+                    let f = apatch::bb::poly::eval(3, w, al);
+                    if f * apex > 0.0 {
+                        worst = worst.max(f.abs());
+                    }
+                }
+            }
+            if worst > 0.0 {
+                let tri = hull.triangles[t];
+                for &v in &tri {
+                    eprintln!(
+                        "  pt {v} {:?} n {:?} origin {:?}",
+                        hull.points[v as usize], hull.normals[v as usize], hull.origins[v as usize]
+                    );
+                }
+                eprintln!("  apex {:?}", a);
+                for (u, tu) in hull.triangles.iter().enumerate() {
+                    let shared = tu.iter().filter(|x| tri.contains(x)).count();
+                    if shared == 2 && u != t {
+                        eprintln!(
+                            "  nb tri {u} {:?} apexes {:?}",
+                            tu,
+                            hull.apexes[u].map(|x| x.is_some())
+                        );
+                    }
+                }
+                eprintln!("tri {t} {:?} side {side:?} elem {} apex {apex:.3e} worst {worst:.3e} base {:?}", hull.triangles[t], hull.element[t], base.iter().map(|x| format!("{x:.3e}")).collect::<Vec<_>>());
+            }
+        }
+    }
+}
