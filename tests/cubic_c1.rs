@@ -345,3 +345,68 @@ fn convex_triangles_stay_single_sided() {
         assert!(changed.is_empty(), "{name}: {changed:?}");
     }
 }
+
+/// Exploration for the quintic scheme (owned elsewhere): the same completion under
+/// `quintic_c2::build` on the torus.
+#[test]
+#[ignore = "exploration"]
+fn explore_quintic_on_completed_hull() {
+    let (sc, hull, _, _) = torus_complexes();
+    let (completed, changed) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+    for (name, h) in [("original", &hull), ("completed", &completed)] {
+        let c = apatch::scheme::quintic_c2::build(
+            h,
+            &apatch::scheme::quintic_c2::QuinticOptions::default(),
+        )
+        .unwrap();
+        let r = check(&c, &CheckOptions::default());
+        eprintln!(
+            "quintic {name} ({} changed): back-facing {} escapes {} of 4000\n{r}",
+            changed.len(),
+            back_facing_hits(&sc, &c),
+            escapes(&c, 4000)
+        );
+    }
+}
+
+/// Exploration: the quintic's crossed boundary faces on the completed torus hull, their
+/// coefficients by level.
+#[test]
+#[ignore = "exploration"]
+fn explore_quintic_crossings() {
+    let (_, hull, _, _) = torus_complexes();
+    let (completed, _) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+    let c = apatch::scheme::quintic_c2::build(
+        &completed,
+        &apatch::scheme::quintic_c2::QuinticOptions::default(),
+    )
+    .unwrap();
+    let idx = apatch::bb::multi_indices(5);
+    let mut shown = 0;
+    for (k, p) in c.patches.iter().enumerate() {
+        if p.role != apatch::complex::Role::Edge || shown >= 3 {
+            continue;
+        }
+        for opp in [0usize, 1] {
+            let face: Vec<(String, f64)> = idx
+                .iter()
+                .zip(&p.weights)
+                .filter(|(l, _)| l[opp] == 0)
+                .map(|(l, &w)| (format!("{:?}", l), w))
+                .collect();
+            let pos = face.iter().any(|x| x.1 > 1e-9);
+            let neg = face.iter().any(|x| x.1 < -1e-9);
+            if pos && neg {
+                shown += 1;
+                eprintln!(
+                    "patch {k} edge {} face without vertex {opp}: tet {:?}",
+                    p.element, p.tet
+                );
+                for (l, w) in &face {
+                    eprintln!("   {l} {w:.4e}");
+                }
+                break;
+            }
+        }
+    }
+}

@@ -67,6 +67,8 @@ pub(super) fn measure(evals: &[PatchEval<'_>], boundary: &[(u32, u8)]) -> HoleSt
             let v = face_verdict(e, opp);
             if v.crossing {
                 s.crossing += 1;
+                s.crossing_by_role
+                    .insert(e.patch.role.name().to_string(), 1);
                 s.worst = v.depth;
                 s.crossing_at = Some(Location::new(&[e], v.point, None));
             } else if v.certified {
@@ -86,7 +88,12 @@ fn merge(a: HoleStats, b: HoleStats) -> HoleStats {
     } else {
         (a.worst, a.crossing_at)
     };
+    let mut crossing_by_role = a.crossing_by_role;
+    for (k, v) in b.crossing_by_role {
+        *crossing_by_role.entry(k).or_insert(0) += v;
+    }
     HoleStats {
+        crossing_by_role,
         boundary_faces: a.boundary_faces + b.boundary_faces,
         certified: a.certified + b.certified,
         crossing: a.crossing + b.crossing,

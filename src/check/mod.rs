@@ -266,6 +266,8 @@ pub struct HoleStats {
     /// Faces where F takes both strict signs: the surface reaches the boundary of the hull and
     /// ends there, a hole (a failure).
     pub crossing: usize,
+    /// Crossed faces counted by the hull role of their patch ("face", "edge", …).
+    pub crossing_by_role: std::collections::BTreeMap<String, usize>,
     /// Faces neither certified nor found crossing (information).
     pub uncertified: usize,
     /// Boundary faces of shooting patches, not examined (their surface is the first root only).

@@ -177,10 +177,20 @@ impl fmt::Display for CheckReport {
         if h.boundary_faces > 0 {
             writeln!(
                 f,
-                "holes            {} of {} boundary faces crossed by the surface (depth {:.3e}), \
+                "holes            {} of {} boundary faces crossed by the surface{} (depth {:.3e}), \
                  {} certified one-signed, {} uncertified  {}{}",
                 h.crossing,
                 h.boundary_faces,
+                if h.crossing_by_role.is_empty() {
+                    String::new()
+                } else {
+                    let roles: Vec<String> = h
+                        .crossing_by_role
+                        .iter()
+                        .map(|(r, n)| format!("{n} {r}"))
+                        .collect();
+                    format!(" ({})", roles.join(", "))
+                },
                 h.worst,
                 h.certified,
                 h.uncertified,
