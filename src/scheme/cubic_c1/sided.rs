@@ -100,7 +100,9 @@ pub fn partner_apex(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> Op
 }
 
 /// `hull` with a partner apex on every single-sided triangle that is not convex for its side
-/// ([`convex_for`]), and the triangles changed.
+/// ([`convex_for`]), and the triangles changed. (A triangle convex for the other side only would
+/// be single sided there by Definition 3.6; it gets the partner too and keeps its apex, whose
+/// tetrahedron then has F of the side's sign on its base.)
 #[must_use]
 pub fn complete_lu_pairs(hull: &SimplicialHull) -> (SimplicialHull, Vec<usize>) {
     let mut out = hull.clone();
@@ -121,4 +123,58 @@ pub fn complete_lu_pairs(hull: &SimplicialHull) -> (SimplicialHull, Vec<usize>) 
         }
     }
     (out, changed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hull::simplicial::PointOrigin;
+
+    /// One triangle in z = 0 with an outer apex; normals tilted by `tilt` at the vertices 1
+    /// and 2 (towards each other when positive: the edge [1 2] runs above their tangent planes).
+    fn hull(tilt: f64) -> SimplicialHull {
+        SimplicialHull {
+            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            normals: vec![
+                DVec3::Z,
+                DVec3::new(-tilt, tilt, 1.0).normalize(),
+                DVec3::new(tilt, -tilt, 1.0).normalize(),
+            ],
+            origins: vec![PointOrigin::Other; 3],
+            triangles: vec![[0, 1, 2]],
+            apexes: vec![[Some(DVec3::new(0.3, 0.3, 0.5)), None]],
+            element: vec![0],
+        }
+    }
+
+    #[test]
+    fn convex_triangle_keeps_one_apex() {
+        // tilt −0.3: the edge [1 2] runs below both tangent planes (positively convex).
+        for tilt in [0.0, -0.3] {
+            let h = hull(tilt);
+            assert!(convex_for(&h, 0, Side::Outer));
+            let (out, changed) = complete_lu_pairs(&h);
+            assert!(changed.is_empty());
+            assert_eq!(out.apexes, h.apexes);
+        }
+    }
+
+    #[test]
+    fn nonconvex_triangle_gets_a_partner_beyond_the_tangent_planes() {
+        let h = hull(0.3);
+        assert!(!convex_for(&h, 0, Side::Outer));
+        // Seen from the inner side every edge runs the right way.
+        assert!(convex_for(&h, 0, Side::Inner));
+        let (out, changed) = complete_lu_pairs(&h);
+        assert_eq!(changed, vec![0]);
+        assert_eq!(out.apexes[0][0], h.apexes[0][0]);
+        let q = out.apexes[0][1].expect("partner apex");
+        // Inner side of z = 0, at least as deep as the mirrored apex.
+        assert!(q.z <= -0.5 + 1e-12, "{q}");
+        for (p, n) in h.points.iter().zip(&h.normals) {
+            // Beyond every tangent plane by the margin (up to the last iteration's rounding).
+            let d = (q - *p).dot(*n);
+            assert!(d <= -(TANGENT_MARGIN - 1e-9) * (q - *p).length(), "{q} {d}");
+        }
+    }
 }
