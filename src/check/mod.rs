@@ -1,6 +1,7 @@
 //! Measuring a patch complex against its scheme's promise: continuity across every shared
 //! tetrahedron face, interpolation of the vertices and normals, conformity (faces shared by more
-//! than two patches, T-junctions) and sheet uniqueness.
+//! than two patches, T-junctions), sheet uniqueness and holes (the surface of single-sheeted
+//! patches crossing a face of one patch only, where nothing continues it: [`holes`]).
 //!
 //! [`check`] never fails: it returns a [`CheckReport`] whose [`CheckReport::passed`] compares every
 //! measure with the tolerances of [`CheckOptions`].
