@@ -318,7 +318,11 @@ fn torus_holes_are_found_and_closed() {
         back_facing_hits(&sc, &before.complex),
         back_facing_hits(&sc, &after.complex),
     );
-    eprintln!("torus_quad12x8 cubic: rays from inside escaping {eb} -> {ea} of 4000; camera rays through holes {cb} -> {ca} of 160x160");
+    eprintln!(
+        "torus_quad12x8 cubic: crossed boundary faces {} {:?} -> {}; rays from inside escaping \
+         {eb} -> {ea} of 4000; camera rays through holes {cb} -> {ca} of 160x160",
+        rb.holes.crossing, rb.holes.crossing_by_role, ra.holes.crossing
+    );
     assert!(
         eb > 0 && cb > 0,
         "the holes must be visible to the rays: {eb} {cb}"
