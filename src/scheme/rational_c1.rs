@@ -495,15 +495,45 @@ const COVER_MAX_DEPTH: u32 = 24;
 /// Most sub-domains examined per certified bound.
 const COVER_MAX_NODES: usize = 20_000;
 
-/// An edge tetrahedron under construction.
+/// An edge tetrahedron under construction (kept small: ~300k of them live through the whole
+/// build of a 100k-triangle model; the weights of ∂/∂b are recomputed where needed by
+/// [`EdgeTet::dw`], which is cheaper than storing them).
 struct EdgeTet {
     edge: u32,
-    faces: [usize; 2],
-    side: usize,
-    piece: [usize; 2],
+    faces: [u32; 2],
+    side: u8,
+    piece: [u8; 2],
+    /// False for a degenerate pair (no frame): the build reports the first one.
+    ok: bool,
     frame: EdgeFrame,
+}
+
+impl EdgeTet {
+    /// The face sides A and B and their pieces this edge tetrahedron joins.
+    #[inline]
+    fn sides<'a>(&self, faces: &'a [FaceOut]) -> [(&'a Side, &'a Piece); 2] {
+        let s = usize::from(self.side);
+        [0, 1].map(|k| {
+            let side = faces[self.faces[k] as usize].sides[s]
+                .as_ref()
+                .expect("side exists");
+            (side, &side.pieces[usize::from(self.piece[k])])
+        })
+    }
+
     /// Weights and rational weights of ∂/∂b along f_A = σ(B_A + b), f_B = σ(B_B + b).
-    dw: ([f64; N3], [f64; 4]),
+    #[inline]
+    fn dw(&self, faces: &[FaceOut]) -> ([f64; N3], [f64; 4]) {
+        let [(_, pa), (_, pb)] = self.sides(faces);
+        self.frame.weights(&pa.dw, &pb.dw)
+    }
+}
+
+/// One face of the build: its class and its sides (pieces, bounds, free values).
+struct FaceOut {
+    class: Convexity,
+    promoted: bool,
+    sides: [Option<Side>; 2],
 }
 
 /// Builds the rational C¹ complex (see the module docs).
@@ -571,10 +601,24 @@ pub fn build(
 fn stage_time(name: &str, since: std::time::Instant) {
     if std::env::var_os("APATCH_STAGE_TIMES").is_some() {
         eprintln!(
-            "stage {name}: {:.1} ms",
-            since.elapsed().as_secs_f64() * 1e3
+            "stage {name}: {:.1} ms wall, process CPU {:.1} ms",
+            since.elapsed().as_secs_f64() * 1e3,
+            process_cpu_ns() as f64 * 1e-6
         );
     }
+}
+
+/// CPU time of all threads of this process so far, in nanoseconds (the sum of the first fields
+/// of `/proc/self/task/*/schedstat`; 0 where that is missing). For [`stage_time`] only: on the
+/// shared machine the CPU time of a stage is a steadier measure than its wall time.
+fn process_cpu_ns() -> u64 {
+    let Ok(dir) = std::fs::read_dir("/proc/self/task") else {
+        return 0;
+    };
+    dir.flatten()
+        .filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok())
+        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
+        .sum()
 }
 
 /// Start of the error [`refine_hull`] gives when the round bound is reached.
@@ -830,12 +874,6 @@ fn assemble(
     };
 
     // Faces: pieces, promotion, face bounds (parallel).
-    struct FaceOut {
-        class: Convexity,
-        promoted: bool,
-        sides: [Option<Side>; 2],
-        fd: FaceData,
-    }
     let faces: Vec<FaceOut> = (0..nf)
         .into_par_iter()
         .map(|t| {
@@ -853,7 +891,6 @@ fn assemble(
                     class,
                     promoted,
                     sides: [None, None],
-                    fd,
                 };
             }
             // Promotion: a convex face on which F has the wrong sign is treated as nonconvex.
@@ -906,7 +943,6 @@ fn assemble(
                 class,
                 promoted,
                 sides,
-                fd,
             }
         })
         .collect();
@@ -949,46 +985,44 @@ fn assemble(
             })
         })
         .collect();
-    // The frame of a pair (None: degenerate), then its edge tetrahedron.
-    let frame_of = |&(ei, s): &(u32, u8)| -> Option<(EdgeFrame, [usize; 2])> {
+    // The edge tetrahedron of a pair (`ok` false: degenerate), each frame computed once.
+    let etet = |&(ei, s): &(u32, u8)| -> EdgeTet {
         let e = &hull.edges[ei as usize];
-        let s = s as usize;
-        let [fa, fb] = e.faces.map(|f| f as usize);
-        let (sa, sb) = (faces[fa].sides[s].as_ref()?, faces[fb].sides[s].as_ref()?);
-        let (ka, kb) = (piece_at(fa, sa, e), piece_at(fb, sb, e));
+        let [fa, fb] = e.faces;
+        let (sa, sb) = (
+            faces[fa as usize].sides[usize::from(s)]
+                .as_ref()
+                .expect("pairs have both sides"),
+            faces[fb as usize].sides[usize::from(s)]
+                .as_ref()
+                .expect("pairs have both sides"),
+        );
+        let (ka, kb) = (piece_at(fa as usize, sa, e), piece_at(fb as usize, sb, e));
         let frame = EdgeFrame::new(
             &sa.pieces[ka],
             &sb.pieces[kb],
             positions[e.v[0] as usize],
             positions[e.v[1] as usize],
-        )?;
-        Some((frame, [ka, kb]))
-    };
-    let etet = |p: &(u32, u8)| -> EdgeTet {
-        let (frame, [ka, kb]) = frame_of(p).expect("checked before");
-        let (ei, s) = (p.0, p.1 as usize);
-        let [fa, fb] = hull.edges[ei as usize].faces.map(|f| f as usize);
-        let (sa, sb) = (&faces[fa].sides[s], &faces[fb].sides[s]);
-        let (sa, sb) = (sa.as_ref().expect("side"), sb.as_ref().expect("side"));
+        );
         EdgeTet {
             edge: ei,
             faces: [fa, fb],
             side: s,
-            piece: [ka, kb],
-            dw: frame.weights(&sa.pieces[ka].dw, &sb.pieces[kb].dw),
-            frame,
+            piece: [ka as u8, kb as u8],
+            ok: frame.is_some(),
+            frame: frame.unwrap_or_default(),
         }
     };
-    // The first degenerate one in edge order (as the sequential loop reported it), then all of
-    // them straight into their vector.
-    if let Some(i) = pairs.par_iter().position_first(|p| frame_of(p).is_none()) {
-        let e = hull.edges[pairs[i].0 as usize];
+    // All of them straight into their vector (indexed: in place, in edge order on any thread
+    // count), then the first degenerate one in edge order (as the sequential loop reported it).
+    let etets: Vec<EdgeTet> = pairs.par_iter().map(etet).collect();
+    if let Some(et) = etets.iter().find(|et| !et.ok) {
+        let e = hull.edges[et.edge as usize];
         return Err(Error::Invalid(format!(
             "edge {} (vertices {}, {}): degenerate face tetrahedron",
-            pairs[i].0, e.v[0], e.v[1]
+            et.edge, e.v[0], e.v[1]
         )));
     }
-    let etets: Vec<EdgeTet> = pairs.par_iter().map(etet).collect();
     stage_time("etets", tt);
     let mut faces = faces;
     // Edge bounds (Step 6, second part) along f_A = σ(B_A + b), f_B = σ(B_B + b); only
@@ -997,14 +1031,8 @@ fn assemble(
     let edge_bounds: Vec<f64> = etets
         .par_iter()
         .map(|et| {
-            let sa = faces[et.faces[0]].sides[et.side]
-                .as_ref()
-                .expect("side exists");
-            let sb = faces[et.faces[1]].sides[et.side]
-                .as_ref()
-                .expect("side exists");
-            let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
-            let (dw, drat) = &et.dw;
+            let [(sa, pa), (sb, pb)] = et.sides(&faces);
+            let (dw, drat) = &et.dw(&faces);
             let wa = pa.weights(sa.sigma * sa.bound);
             let wb = pb.weights(sb.sigma * sb.bound);
             let (w0, r0) = et.frame.weights(&wa, &wb);
@@ -1050,7 +1078,7 @@ fn assemble(
     for (et, &be) in etets.iter().zip(&edge_bounds) {
         if be > 0.0 {
             for k in 0..2 {
-                if let Some(s) = faces[et.faces[k]].sides[et.side].as_mut() {
+                if let Some(s) = faces[et.faces[k] as usize].sides[usize::from(et.side)].as_mut() {
                     // Third part of Step 6: B_ijk += B_ijkl (the largest over its edges).
                     s.edge_extra = s.edge_extra.max(be);
                 }
@@ -1061,12 +1089,22 @@ fn assemble(
     // Choose the free parameters (Step 8 / §5.3).
     faces.par_iter_mut().enumerate().for_each(|(t, fo)| {
         let free = free_of(t);
-        let fd = fo.fd;
+        // The face's data again (cheaper than keeping 300 bytes per face through the build).
+        let fd = (free == Free::Default).then(|| {
+            let tri = triangles[t];
+            FaceData::new(
+                tri.map(|i| positions[i as usize]),
+                tri.map(|i| normals[i as usize]),
+            )
+        });
         for s in fo.sides.iter_mut().flatten() {
             s.bound += s.edge_extra;
             let apex = s.pieces[0].pts[3];
             let target = match free {
-                Free::Default => s.sigma * weights::linear_apex_value(&fd, apex),
+                Free::Default => {
+                    s.sigma
+                        * weights::linear_apex_value(fd.as_ref().expect("made for Default"), apex)
+                }
                 Free::Offset(b) => s.bound + b,
                 Free::Quadric => {
                     let q = fit
@@ -1085,15 +1123,9 @@ fn assemble(
         let needs: Vec<f64> = etets
             .par_iter()
             .map(|et| {
-                let sa = faces[et.faces[0]].sides[et.side]
-                    .as_ref()
-                    .expect("side exists");
-                let sb = faces[et.faces[1]].sides[et.side]
-                    .as_ref()
-                    .expect("side exists");
-                let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
+                let [(sa, pa), (sb, pb)] = et.sides(&faces);
                 let margin = sa.margin.max(sb.margin);
-                let (dw, drat) = &et.dw;
+                let (dw, drat) = &et.dw(&faces);
                 // Certificate at b = −margin: then the pruned maximum below is its floor.
                 let shift = -sa.sigma * margin;
                 let (wm, rm) = et
@@ -1135,10 +1167,10 @@ fn assemble(
             if need > 0.0 {
                 any = true;
                 for k in 0..2 {
-                    let f = et.faces[k];
-                    if let Some(s) = faces[f].sides[et.side].as_mut() {
+                    let f = et.faces[k] as usize;
+                    if let Some(s) = faces[f].sides[usize::from(et.side)].as_mut() {
                         s.f += s.sigma * need;
-                        raised[f][et.side] = true;
+                        raised[f][usize::from(et.side)] = true;
                     }
                 }
             }
@@ -1219,13 +1251,7 @@ fn assemble(
         }
     };
     let edge_patch = |et: &EdgeTet| -> Patch {
-        let sa = faces[et.faces[0]].sides[et.side]
-            .as_ref()
-            .expect("side exists");
-        let sb = faces[et.faces[1]].sides[et.side]
-            .as_ref()
-            .expect("side exists");
-        let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
+        let [(sa, pa), (sb, pb)] = et.sides(&faces);
         let (w, r) = et.frame.weights(&pa.weights(sa.f), &pb.weights(sb.f));
         let e = hull.edges[et.edge as usize];
         Patch {

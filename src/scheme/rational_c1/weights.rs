@@ -437,7 +437,7 @@ fn compute_frame_tables(a_loc: [usize; 3], b_loc: [usize; 3]) -> FrameTables {
 }
 
 /// How the edge tetrahedron [p_i p_j apexA apexB] sits against its two face pieces.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct EdgeFrame {
     /// Local indices in piece A of p_i, p_j and A's apex.
     pub a_loc: [usize; 3],
