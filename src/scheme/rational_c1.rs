@@ -1187,8 +1187,8 @@ fn assemble(
     complex.vertices = positions.iter().map(|p| p.to_array()).collect();
     complex.normals = normals.iter().map(|n| n.to_array()).collect();
     let face_sheet = SheetRule::Shooting {
-        base: vec![0, 1, 2],
-        top: vec![3],
+        base: [0, 1, 2].into(),
+        top: [3].into(),
     };
     let mut faces_by_class = [0; 4];
     let mut lower_bounds = vec![[f64::NAN; 2]; nf];
@@ -1230,11 +1230,12 @@ fn assemble(
             .map(|r| {
                 vec![RationalTerm {
                     index: [1, 1, 1, 0],
-                    terms: vec![
+                    terms: [
                         (r[0], [0, 1, 1, 0]),
                         (r[1], [1, 0, 1, 0]),
                         (r[2], [1, 1, 0, 0]),
-                    ],
+                    ]
+                    .into(),
                 }]
             })
             .unwrap_or_default();
@@ -1266,16 +1267,16 @@ fn assemble(
             rational: vec![
                 RationalTerm {
                     index: [1, 0, 1, 1],
-                    terms: vec![(r[0], [0, 0, 1, 0]), (r[1], [0, 0, 0, 1])],
+                    terms: [(r[0], [0, 0, 1, 0]), (r[1], [0, 0, 0, 1])].into(),
                 },
                 RationalTerm {
                     index: [0, 1, 1, 1],
-                    terms: vec![(r[2], [0, 0, 1, 0]), (r[3], [0, 0, 0, 1])],
+                    terms: [(r[2], [0, 0, 1, 0]), (r[3], [0, 0, 0, 1])].into(),
                 },
             ],
             sheet: SheetRule::Shooting {
-                base: vec![0, 1],
-                top: vec![2, 3],
+                base: [0, 1].into(),
+                top: [2, 3].into(),
             },
             role: Role::Edge,
             element: et.edge,
