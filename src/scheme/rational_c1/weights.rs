@@ -483,14 +483,16 @@ impl EdgeFrame {
     /// rational ones by (2.3)) and Step 9 (number 7 weights by (2.3)).
     #[must_use]
     pub fn weights(&self, wa: &[f64; N3], wb: &[f64; N3]) -> ([f64; N3], [f64; 4]) {
-        let mut e = [0.0; N3];
-        for (ek, &(src, i)) in e.iter_mut().zip(&self.copy) {
-            match src {
-                0 => *ek = wa[usize::from(i)],
-                1 => *ek = wb[usize::from(i)],
-                _ => {}
-            }
-        }
+        // A branch-free gather (the sources differ from frame to frame, so a `match` on
+        // them mispredicted): source 2 reads the zero of the number 5 weights, or a value
+        // that the blends below overwrite.
+        let zero = [0.0; N3];
+        let src = [wa, wb, &zero];
+        let e: [f64; N3] = std::array::from_fn(|k| {
+            let (s, i) = self.copy[k];
+            src[usize::from(s)][usize::from(i)]
+        });
+        let mut e = e;
         // Σ_r β_r w(face multiset + e_r), alternating A and B.
         let blend = |k: usize| -> f64 {
             let (w, beta) = if k.is_multiple_of(2) {
