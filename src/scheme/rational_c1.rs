@@ -1052,7 +1052,7 @@ fn assemble(
     // All of them straight into their vector (indexed: in place, in edge order on any thread
     // count), then the first degenerate one in edge order (as the sequential loop reported it).
     let etets: Vec<EdgeTet> = pairs.par_iter().map(etet).collect();
-    if let Some(et) = etets.iter().find(|et| !et.ok) {
+    if let Some(et) = etets.par_iter().find_first(|et| !et.ok) {
         let e = hull.edges[et.edge as usize];
         return Err(Error::Invalid(format!(
             "edge {} (vertices {}, {}): degenerate face tetrahedron",
@@ -1111,8 +1111,10 @@ fn assemble(
             }
         })
         .collect();
-    for (et, &be) in etets.iter().zip(&edge_bounds) {
+    // (The bounds first: most are 0, and the edge tetrahedra are only read where they are not.)
+    for (i, &be) in edge_bounds.iter().enumerate() {
         if be > 0.0 {
+            let et = &etets[i];
             for k in 0..2 {
                 if let Some(s) = faces[et.faces[k] as usize].sides[usize::from(et.side)].as_mut() {
                     // Third part of Step 6: B_ijk += B_ijkl (the largest over its edges).
