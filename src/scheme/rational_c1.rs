@@ -930,10 +930,13 @@ fn assemble(
                 };
             }
             // Promotion: a convex face on which F has the wrong sign is treated as nonconvex.
+            // (The piece it tests is kept for its side when the face stays convex.)
+            let mut tested: Option<(DVec3, Piece)> = None;
             if class != Convexity::Nonconvex {
                 let top = class == Convexity::Positive;
                 let t_apex = if top { fh.t_max } else { fh.t_min };
-                let pc = convex_piece(&fd, fh.centroid + t_apex * fh.normal);
+                let apex = fh.centroid + t_apex * fh.normal;
+                let pc = convex_piece(&fd, apex);
                 let sigma = if top { 1.0 } else { -1.0 };
                 let scale = pc.w0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
                 // The layer-0 certificate settles most faces without sampling (half the
@@ -945,6 +948,8 @@ fn assemble(
                 {
                     class = Convexity::Nonconvex;
                     promoted = true;
+                } else {
+                    tested = Some((apex, pc));
                 }
             }
             let mut sides: [Option<Side>; 2] = [None, None];
@@ -962,7 +967,11 @@ fn assemble(
                 let pieces: Vec<SidePiece> = if class == Convexity::Nonconvex {
                     nonconvex_pieces(&fd, apex).map(SidePiece::from).to_vec()
                 } else {
-                    vec![convex_piece(&fd, apex).into()]
+                    let pc = match tested.take() {
+                        Some((a, pc)) if a == apex => pc,
+                        _ => convex_piece(&fd, apex),
+                    };
+                    vec![pc.into()]
                 };
                 let mut side = Side {
                     sigma,
