@@ -641,8 +641,8 @@ mod tests {
 
     fn shooting() -> SheetRule {
         SheetRule::Shooting {
-            base: vec![0, 1, 2],
-            top: vec![3],
+            base: [0, 1, 2].into(),
+            top: [3].into(),
         }
     }
 
