@@ -16,7 +16,8 @@
 //! quadrilateral G_1G_3G_4G_2, cut by the diagonal G_2G_3 into [G_1G_3G_2] and [G_3G_4G_2];
 //! their apexes H_0, H_1 lie halfway between the midpoint M of V_1V_2 and the apexes of the
 //! face tetrahedra sharing G_1G_3 (V_1's) and G_2G_4 (V_2's). When G_1 = G_2 (or G_3 = G_4) the
-//! cell is one triangle with apex M. The guard net of a region is the set of guard pairs these
+//! cell is one triangle with apex M, moved slightly out of the polyhedron ([`CELL_LIFT`]: with
+//! M itself the edge tetrahedra over a net edge, between two such cells, are flat). The guard net of a region is the set of guard pairs these
 //! cells use; T is a closed manifold when every pair is walked once in each direction round
 //! the region's boundary loops, which the guard assignment ([`GuardNet::build`]) searches for.
 //!
@@ -37,10 +38,10 @@ use std::collections::HashMap;
 /// backtracking prunes by the pair counts; letter_P's caps need a few hundred).
 pub const SEARCH_BUDGET: usize = 200_000;
 
-/// How far the apex of a one-triangle cell moves from the edge midpoint M away from the single
-/// guard (fraction of the guard's distance from the edge line); see
+/// How far the apex of a one-triangle cell moves from the edge midpoint M out of the polyhedron
+/// (fraction of the single guard's distance from the edge line); see
 /// [`GuardNet::add_edge_cells`].
-pub const CELL_LIFT: f64 = 0.2;
+pub const CELL_LIFT: f64 = 0.05;
 
 /// A step (5') cell: region edge V_1V_2 and its four guards (points of T).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -379,16 +380,17 @@ impl GuardNet {
                 hull.element.push(cell.v[0]);
             };
             let half = |qs: &[DVec3]| -> Vec<DVec3> { qs.iter().map(|&q| 0.5 * (q + m)).collect() };
-            // One triangle: apex M, moved in the single-guard face's plane away from its guard
-            // (out of the polyhedron, beyond the edge) by CELL_LIFT of the guard's distance
-            // from the edge. That plane is the guard's tangent plane, and the other two
-            // vertices' tangent plane holds two of the tetrahedron's points, so it stays
-            // tangent-containing; with M itself the edge tetrahedra between two such cells
-            // over one net edge are flat, and moved inwards they fold over the cells.
+            // One triangle: apex M, moved out of the polyhedron along the bisector of the two
+            // faces' normals by CELL_LIFT of the single guard's distance from the edge. M lies
+            // in both face planes (the guards' tangent planes); moved outwards it stays
+            // tangent-containing (the triangle's points are on the planes' inner sides or on
+            // them). With M itself, the edge tetrahedra between two such cells over one net
+            // edge are flat (all in the face plane); moved inwards, they fold over the cells.
             let e = (positions[cell.v[1] as usize] - m).normalize_or_zero();
+            let out = (hull.normals[g1 as usize] + hull.normals[g3 as usize]).normalize_or_zero();
             let lifted = |g: u32| -> DVec3 {
                 let d = hull.points[g as usize] - m;
-                m - CELL_LIFT * (d - d.dot(e) * e)
+                m + CELL_LIFT * (d - d.dot(e) * e).length() * out
             };
             if g1 == g2 {
                 push([g1, g3, g4], vec![lifted(g1)]);
