@@ -71,6 +71,8 @@ pub struct GuardNet {
     pub nets: Vec<(u32, usize, usize)>,
     /// Regions where no guard assignment was found and the pieces stay separate faces.
     pub fallback: Vec<u32>,
+    /// Those regions' groups (first original piece), for the second pass of [`GuardNet::build`].
+    failed: Vec<usize>,
 }
 
 /// One boundary corner of a region.
@@ -87,8 +89,23 @@ struct RegionCorner {
 impl GuardNet {
     /// Regions of `pieces` (pieces of one split polygon, or coplanar edge-adjacent pieces),
     /// coplanar regions re-merged into convex pieces, and a guard per region corner.
+    /// A region without a guard assignment keeps its original pieces (not re-merged) as
+    /// separate faces, as before guard nets.
     #[must_use]
-    pub fn build(mesh: &Mesh, mut pieces: Pieces) -> GuardNet {
+    pub fn build(mesh: &Mesh, pieces: Pieces) -> GuardNet {
+        let first = GuardNet::build_skipping(mesh, pieces.clone(), &[]);
+        if first.failed.is_empty() {
+            return first;
+        }
+        let failed = first.failed.clone();
+        let mut second = GuardNet::build_skipping(mesh, pieces, &failed);
+        second.fallback = first.fallback;
+        second
+    }
+
+    /// [`GuardNet::build`] with the groups whose first original piece is in `skip` left as
+    /// separate faces.
+    fn build_skipping(mesh: &Mesh, mut pieces: Pieces, skip: &[usize]) -> GuardNet {
         let nv = mesh.positions.len();
         let pos = &mesh.positions;
         // 1. Regions by union-find.
@@ -146,16 +163,18 @@ impl GuardNet {
             let multi_parent = members
                 .iter()
                 .any(|&p| pieces.parent[p] != pieces.parent[first]);
-            let polys: Vec<Vec<u32>> =
-                if multi_parent && members.iter().all(|&p| !is_star_only(&pieces, p)) {
-                    merge_convex(
-                        pos,
-                        pieces.normal[first],
-                        members.iter().map(|&p| pieces.faces[p].clone()).collect(),
-                    )
-                } else {
-                    members.iter().map(|&p| pieces.faces[p].clone()).collect()
-                };
+            let polys: Vec<Vec<u32>> = if multi_parent
+                && !skip.contains(&first)
+                && members.iter().all(|&p| !is_star_only(&pieces, p))
+            {
+                merge_convex(
+                    pos,
+                    pieces.normal[first],
+                    members.iter().map(|&p| pieces.faces[p].clone()).collect(),
+                )
+            } else {
+                members.iter().map(|&p| pieces.faces[p].clone()).collect()
+            };
             let merged = polys.len() != members.len();
             for (k, poly) in polys.into_iter().enumerate() {
                 let src = if merged { first } else { members[k] };
@@ -215,12 +234,13 @@ impl GuardNet {
         let mut guard_of: HashMap<(u32, u32), u32> = HashMap::new();
         let mut nets = Vec::new();
         let mut fallback = Vec::new();
+        let mut failed = Vec::new();
         let mut next_region = nr as u32;
         for r in 0..nr {
             if region_pieces[r].len() < 2 {
                 continue;
             }
-            let found = if pinched[r] || corners[r].is_empty() {
+            let found = if pinched[r] || corners[r].is_empty() || skip.contains(&groups[r][0]) {
                 None
             } else {
                 assign(pos, &pieces, &region_pieces[r], &corners[r])
@@ -250,6 +270,9 @@ impl GuardNet {
                     ));
                 }
                 None => {
+                    if !skip.contains(&groups[r][0]) {
+                        failed.push(groups[r][0]);
+                    }
                     fallback.push(pieces.parent[region_pieces[r][0] as usize]);
                     for &p in &region_pieces[r] {
                         region[p as usize] = next_region;
@@ -328,6 +351,7 @@ impl GuardNet {
             cells,
             nets,
             fallback,
+            failed,
         }
     }
 
