@@ -34,8 +34,8 @@ use crate::mesh::{Fan, Mesh, Topology};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 
-/// Largest number of complete guard assignments tried per region before giving up (the
-/// backtracking prunes by the pair counts; letter_P's caps need a few hundred).
+/// Largest number of complete guard assignments visited per region (the backtracking prunes
+/// by the pair counts); the best valid one found by then is used.
 pub const SEARCH_BUDGET: usize = 200_000;
 
 /// How far the apex of a one-triangle cell moves from the edge midpoint M out of the polyhedron
@@ -566,9 +566,9 @@ fn assign(
         pick: vec![u32::MAX; corners.len()],
         pairs: HashMap::new(),
         leaves: 0,
-        result: None,
+        best: None,
     };
-    let mut check = |pick: &[u32]| -> Option<Vec<(u32, DVec3)>> {
+    let mut check = |pick: &[u32]| -> Option<(Vec<(u32, DVec3)>, f64)> {
         let mut out = Vec::new();
         let mut guard: HashMap<u32, DVec2> = HashMap::new();
         for &p in members {
@@ -610,21 +610,28 @@ fn assign(
                 }
             }
         }
+        let mut length2 = 0.0;
         for (i, &g) in pick.iter().enumerate() {
             let h = pick[next[i]];
-            if g != h && crosses_boundary(guard[&g], guard[&h], &boundary) {
-                return None;
+            if g != h {
+                if crosses_boundary(guard[&g], guard[&h], &boundary) {
+                    return None;
+                }
+                length2 += (guard[&g] - guard[&h]).length_squared();
             }
         }
-        Some(out)
+        Some((out, length2))
     };
     st.run(0, &mut check);
-    let pick = st.pick_final();
-    st.result.map(|centers| (pick, centers))
+    st.best.map(|(_, pick, centers)| (pick, centers))
 }
 
-/// The geometric test of a complete assignment: guard positions of the pieces used, or `None`.
-type GuardCheck<'c> = dyn FnMut(&[u32]) -> Option<Vec<(u32, DVec3)>> + 'c;
+/// The geometric test of a complete assignment: guard positions of the pieces used and the
+/// assignment's cost (the sum of the squared net edge lengths), or `None`.
+type GuardCheck<'c> = dyn FnMut(&[u32]) -> Option<(Vec<(u32, DVec3)>, f64)> + 'c;
+
+/// The best assignment so far: cost, guard per corner, guard positions.
+type Best = (f64, Vec<u32>, Vec<(u32, DVec3)>);
 
 /// Backtracking state of [`assign`].
 struct Search<'a> {
@@ -635,16 +642,15 @@ struct Search<'a> {
     pick: Vec<u32>,
     pairs: HashMap<(u32, u32), u32>,
     leaves: usize,
-    result: Option<Vec<(u32, DVec3)>>,
+    best: Option<Best>,
 }
 
 impl Search<'_> {
-    fn pick_final(&self) -> Vec<u32> {
-        self.pick.clone()
-    }
-
+    /// Visits every assignment (up to [`SEARCH_BUDGET`] complete ones) and keeps the valid one
+    /// with the shortest net: short net edges keep the step (5') cells and the edge
+    /// tetrahedra over net edges small and well shaped.
     fn run(&mut self, depth: usize, check: &mut GuardCheck) {
-        if self.result.is_some() || self.leaves >= SEARCH_BUDGET {
+        if self.leaves >= SEARCH_BUDGET {
             return;
         }
         if depth == self.order.len() {
@@ -655,8 +661,10 @@ impl Search<'_> {
                 .iter()
                 .all(|(&(a, b), &n)| n == 1 && self.pairs.get(&(b, a)) == Some(&1))
             {
-                if let Some(r) = check(&self.pick) {
-                    self.result = Some(r);
+                if let Some((r, cost)) = check(&self.pick) {
+                    if self.best.as_ref().is_none_or(|b| cost < b.0) {
+                        self.best = Some((cost, self.pick.clone(), r));
+                    }
                 }
             }
             return;
@@ -692,9 +700,6 @@ impl Search<'_> {
                         self.pairs.remove(&key);
                     }
                 }
-            }
-            if self.result.is_some() {
-                return;
             }
             self.pick[c] = u32::MAX;
         }
