@@ -16,9 +16,12 @@
 //! quadrilateral G_1G_3G_4G_2, cut by the diagonal G_2G_3 into [G_1G_3G_2] and [G_3G_4G_2];
 //! their apexes H_0, H_1 lie halfway between the midpoint M of V_1V_2 and the apexes of the
 //! face tetrahedra sharing G_1G_3 (V_1's) and G_2G_4 (V_2's). When G_1 = G_2 (or G_3 = G_4) the
-//! cell is one triangle with apex M, moved slightly out of the polyhedron ([`CELL_LIFT`]: with
-//! M itself the edge tetrahedra over a net edge, between two such cells, are flat). The guard net of a region is the set of guard pairs these
-//! cells use; T is a closed manifold when every pair is walked once in each direction round
+//! cell is one triangle with apex M. Beyond the paper: that apex is moved out of the
+//! polyhedron ([`CELL_LIFT`]; with M itself the edge tetrahedra over a net edge, between two
+//! such cells, are flat) and slid along V_1V_2 so that the midpoint s of the two apexes over a
+//! net edge lies over that edge (else the cubic scheme cannot make those edge tetrahedra single
+//! sheeted: letter_P showed a spurious sheet). The guard net of a region is the set of guard
+//! pairs these cells use; T is a closed manifold when every pair is walked once in each direction round
 //! the region's boundary loops, which the guard assignment ([`GuardNet::build`]) searches for.
 //!
 //! Guards are placed (Appendix B's corner guard circles: any point of a region works) at the
@@ -38,10 +41,11 @@ use std::collections::HashMap;
 /// by the pair counts); the best valid one found by then is used.
 pub const SEARCH_BUDGET: usize = 200_000;
 
-/// How far the apex of a one-triangle cell moves from the edge midpoint M out of the polyhedron
-/// (fraction of the single guard's distance from the edge line); see
-/// [`GuardNet::add_edge_cells`].
-pub const CELL_LIFT: f64 = 0.05;
+/// How far the apex of a one-triangle cell moves out of the polyhedron, as a fraction of the
+/// single guard's distance from the edge line (see [`GuardNet::add_edge_cells`]). On letter_P,
+/// 0.05 left six edge tetrahedra over net edges with weights of both signs even with the apexes
+/// slid; 0.2 leaves none (`tests/inner_guardnet.rs`).
+pub const CELL_LIFT: f64 = 0.2;
 
 /// A step (5') cell: region edge V_1V_2 and its four guards (points of T).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -379,7 +383,8 @@ impl GuardNet {
                 owner.insert((tri[k], tri[(k + 1) % 3]), t);
             }
         }
-        for cell in &self.cells {
+        let slide = self.cell_slides(hull, positions);
+        for (ci, cell) in self.cells.iter().enumerate() {
             let [g1, g2, g3, g4] = cell.g;
             let m = 0.5 * (positions[cell.v[0] as usize] + positions[cell.v[1] as usize]);
             let apexes_of = |key: (u32, u32)| -> Vec<DVec3> {
@@ -391,6 +396,18 @@ impl GuardNet {
             // V_1's triangle holds G_3 → G_1, V_2's holds G_2 → G_4.
             let q1 = apexes_of((g3, g1));
             let q2 = apexes_of((g2, g4));
+            let lifted = |g: u32| -> DVec3 {
+                let v1 = positions[cell.v[0] as usize];
+                v1 + slide[ci] * (positions[cell.v[1] as usize] - v1)
+                    + cell_lift(hull, positions, cell, g)
+            };
+            let single = if g1 == g2 {
+                Some(lifted(g1))
+            } else if g3 == g4 {
+                Some(lifted(g3))
+            } else {
+                None
+            };
             let mut push = |tri: [u32; 3], apexes: Vec<DVec3>| {
                 let [a, b, c] = tri.map(|i| hull.points[i as usize]);
                 let mut slot = [None, None];
@@ -404,28 +421,101 @@ impl GuardNet {
                 hull.element.push(cell.v[0]);
             };
             let half = |qs: &[DVec3]| -> Vec<DVec3> { qs.iter().map(|&q| 0.5 * (q + m)).collect() };
-            // One triangle: apex M, moved out of the polyhedron along the bisector of the two
-            // faces' normals by CELL_LIFT of the single guard's distance from the edge. M lies
-            // in both face planes (the guards' tangent planes); moved outwards it stays
-            // tangent-containing (the triangle's points are on the planes' inner sides or on
+            // One triangle: apex on V_1V_2 (M, or where `cell_slides` puts it), moved out of
+            // the polyhedron along the bisector of the two faces' normals by CELL_LIFT of the
+            // single guard's distance from the edge. The edge lies in both face planes (the
+            // guards' tangent planes); moved outwards the apex stays tangent-containing (the triangle's points are on the planes' inner sides or on
             // them). With M itself, the edge tetrahedra between two such cells over one net
             // edge are flat (all in the face plane); moved inwards, they fold over the cells.
-            let e = (positions[cell.v[1] as usize] - m).normalize_or_zero();
-            let out = (hull.normals[g1 as usize] + hull.normals[g3 as usize]).normalize_or_zero();
-            let lifted = |g: u32| -> DVec3 {
-                let d = hull.points[g as usize] - m;
-                m + CELL_LIFT * (d - d.dot(e) * e).length() * out
-            };
             if g1 == g2 {
-                push([g1, g3, g4], vec![lifted(g1)]);
+                push([g1, g3, g4], single.into_iter().collect());
             } else if g3 == g4 {
-                push([g1, g3, g2], vec![lifted(g3)]);
+                push([g1, g3, g2], single.into_iter().collect());
             } else {
                 push([g1, g3, g2], half(&q1));
                 push([g3, g4, g2], half(&q2));
             }
         }
     }
+}
+
+impl GuardNet {
+    /// Where along its edge V_1V_2 (parameter from V_1) each one-triangle cell's apex sits.
+    /// The two one-triangle cells on either side of a net edge G_aG_b give the edge tetrahedra
+    /// over it their midpoint s. The cubic scheme can make those tetrahedra single sheeted only
+    /// when s lies on the apex's side of each cell's triangle (its barycentric β_q > 0), which
+    /// holds when s lies over the net edge itself; with both apexes over their edges' midpoints
+    /// s can fall far beside it (letter_P: beside the hole's right corner). So the pair is slid
+    /// along its edges (within [¼, ¾]) to bring s over the line G_aG_b, as near its middle as
+    /// the edges allow (least squares, then clamped). Other cells keep ½.
+    fn cell_slides(&self, hull: &SimplicialHull, positions: &[DVec3]) -> Vec<f64> {
+        let mut slide = vec![0.5; self.cells.len()];
+        let mut by_pair: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+        for (ci, c) in self.cells.iter().enumerate() {
+            let [g1, g2, g3, g4] = c.g;
+            let pair = if g1 == g2 {
+                (g3, g4)
+            } else if g3 == g4 {
+                (g1, g2)
+            } else {
+                continue;
+            };
+            by_pair
+                .entry((pair.0.min(pair.1), pair.0.max(pair.1)))
+                .or_default()
+                .push(ci);
+        }
+        for (&(ga, gb), cs) in &by_pair {
+            let [c1, c2] = cs[..] else { continue };
+            let start = |ci: usize| {
+                let c = &self.cells[ci];
+                let single = if c.g[0] == c.g[1] { c.g[0] } else { c.g[2] };
+                let v1 = positions[c.v[0] as usize];
+                (
+                    v1 + cell_lift(hull, positions, c, single),
+                    positions[c.v[1] as usize] - v1,
+                )
+            };
+            let ((a1, d1), (a2, d2)) = (start(c1), start(c2));
+            let (pa, pb) = (hull.points[ga as usize], hull.points[gb as usize]);
+            // Weighted least squares: the component of 2s − (G_a + G_b) across the net edge
+            // (in its face's plane) counts WEIGHT times more than the one along it.
+            let along = (pb - pa).normalize_or_zero();
+            let n = hull.normals[ga as usize];
+            let across = n.cross(along);
+            let r = pa + pb - a1 - a2;
+            let proj = |x: DVec3| DVec2::new(SLIDE_ACROSS_WEIGHT * x.dot(across), x.dot(along));
+            let (e1, e2, rr) = (proj(d1), proj(d2), proj(r));
+            let (m11, m12, m22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+            let det = m11 * m22 - m12 * m12;
+            let u0 = if det > 1e-12 * m11 * m22 {
+                (m11 * e2.dot(rr) - m12 * e1.dot(rr)) / det
+            } else {
+                0.5
+            };
+            let clamp = |x: f64| x.clamp(0.25, 0.75);
+            let t = clamp((e1.dot(rr) - m12 * clamp(u0)) / m11.max(1e-300));
+            let u = clamp((e2.dot(rr) - m12 * t) / m22.max(1e-300));
+            slide[c1] = t;
+            slide[c2] = u;
+        }
+        slide
+    }
+}
+
+/// How much more the offset of s across a net edge counts than along it when the cells' apexes
+/// are slid ([`GuardNet::add_edge_cells`]).
+const SLIDE_ACROSS_WEIGHT: f64 = 10.0;
+
+/// The outward move of a one-triangle cell's apex off its edge: along the bisector of the two
+/// faces' normals, [`CELL_LIFT`] of the single guard `g`'s distance from the edge line.
+fn cell_lift(hull: &SimplicialHull, positions: &[DVec3], cell: &EdgeCell, g: u32) -> DVec3 {
+    let (v1, v2) = (positions[cell.v[0] as usize], positions[cell.v[1] as usize]);
+    let e = (v2 - v1).normalize_or_zero();
+    let out =
+        (hull.normals[cell.g[0] as usize] + hull.normals[cell.g[2] as usize]).normalize_or_zero();
+    let d = hull.points[g as usize] - v1;
+    CELL_LIFT * (d - d.dot(e) * e).length() * out
 }
 
 /// True for a star-shaped non-convex piece (kept whole with its kernel guard).
