@@ -154,11 +154,12 @@ fn bench<M: Measurement + 'static>(c: &mut Criterion<M>) {
     w[apatch::bb::index_of([1, 1, 1, 0])] = 0.0;
     let face = [RationalTerm {
         index: [1, 1, 1, 0],
-        terms: vec![
+        terms: [
             (0.2, [0, 1, 1, 0]),
             (-0.1, [1, 0, 1, 0]),
             (0.05, [1, 1, 0, 0]),
-        ],
+        ]
+        .into(),
     }];
     let mut out = [0.0; 16];
     let len = rational::segment_poly(3, &w, &face, a0, a1, &mut out);

@@ -89,7 +89,148 @@ pub struct RationalTerm {
     /// κ, the multi-index of the Bernstein polynomial the blended weight multiplies.
     pub index: [u8; 4],
     /// (w_m, μ_m) pairs: the weights blended by the monomials α^μm.
-    pub terms: Vec<(f64, [u8; 4])>,
+    pub terms: Blend,
+}
+
+/// The (w_m, μ_m) pairs of a [`RationalTerm`]: up to [`Blend::INLINE`] stored inline (the 2001
+/// scheme's terms have two or three; a build of a 100k-triangle model writes ~500k of them),
+/// more on the heap. Dereferences to `[(f64, [u8; 4])]`; its JSON form is an array of pairs,
+/// exactly as a `Vec<(f64, [u8; 4])>`'s. Made with `.into()` from a `Vec` or an array.
+#[derive(Clone)]
+pub struct Blend(BlendRepr);
+
+#[derive(Clone)]
+enum BlendRepr {
+    Inline {
+        len: u8,
+        items: [(f64, [u8; 4]); Blend::INLINE],
+    },
+    Heap(Vec<(f64, [u8; 4])>),
+}
+
+impl Blend {
+    /// How many pairs are stored without a heap allocation.
+    pub const INLINE: usize = 3;
+
+    /// Appends a pair (moving to the heap past [`Blend::INLINE`]).
+    pub fn push(&mut self, t: (f64, [u8; 4])) {
+        match &mut self.0 {
+            BlendRepr::Inline { len, items } if usize::from(*len) < Blend::INLINE => {
+                items[usize::from(*len)] = t;
+                *len += 1;
+            }
+            BlendRepr::Inline { len, items } => {
+                let mut v = items[..usize::from(*len)].to_vec();
+                v.push(t);
+                self.0 = BlendRepr::Heap(v);
+            }
+            BlendRepr::Heap(v) => v.push(t),
+        }
+    }
+}
+
+impl Default for Blend {
+    fn default() -> Self {
+        Blend(BlendRepr::Inline {
+            len: 0,
+            items: [(0.0, [0; 4]); Blend::INLINE],
+        })
+    }
+}
+
+impl std::ops::Deref for Blend {
+    type Target = [(f64, [u8; 4])];
+    fn deref(&self) -> &Self::Target {
+        match &self.0 {
+            BlendRepr::Inline { len, items } => &items[..usize::from(*len)],
+            BlendRepr::Heap(v) => v,
+        }
+    }
+}
+
+impl std::ops::DerefMut for Blend {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        match &mut self.0 {
+            BlendRepr::Inline { len, items } => &mut items[..usize::from(*len)],
+            BlendRepr::Heap(v) => v,
+        }
+    }
+}
+
+impl From<Vec<(f64, [u8; 4])>> for Blend {
+    fn from(v: Vec<(f64, [u8; 4])>) -> Self {
+        if v.len() > Blend::INLINE {
+            return Blend(BlendRepr::Heap(v));
+        }
+        let mut b = Blend::default();
+        for t in v {
+            b.push(t);
+        }
+        b
+    }
+}
+
+impl<const N: usize> From<[(f64, [u8; 4]); N]> for Blend {
+    fn from(a: [(f64, [u8; 4]); N]) -> Self {
+        if N > Blend::INLINE {
+            return Blend(BlendRepr::Heap(a.to_vec()));
+        }
+        let mut b = Blend::default();
+        for t in a {
+            b.push(t);
+        }
+        b
+    }
+}
+
+impl<'a> IntoIterator for &'a Blend {
+    type Item = &'a (f64, [u8; 4]);
+    type IntoIter = std::slice::Iter<'a, (f64, [u8; 4])>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
+impl PartialEq for Blend {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl std::fmt::Debug for Blend {
+    /// As the slice of pairs.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        (**self).fmt(f)
+    }
+}
+
+impl Serialize for Blend {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.collect_seq(self.iter())
+    }
+}
+
+impl<'de> Deserialize<'de> for Blend {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Blend;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "an array of [weight, [m1, m2, m3, m4]] pairs")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> std::result::Result<Blend, A::Error> {
+                let mut b = Blend::default();
+                while let Some(t) = seq.next_element::<(f64, [u8; 4])>()? {
+                    b.push(t);
+                }
+                Ok(b)
+            }
+        }
+        d.deserialize_seq(V)
+    }
 }
 
 /// How to pick the surface among the zeros of F inside a tetrahedron.
@@ -107,10 +248,116 @@ pub enum SheetRule {
     /// weights of one patch share their sign: > 0 on the positive side, < 0 on the negative).
     Shooting {
         /// Tetrahedron-local vertex indices spanning the base (a face: 3, an edge: 2).
-        base: Vec<u8>,
+        base: TetVerts,
         /// Tetrahedron-local vertex indices spanning the top (a vertex: 1, an edge: 2).
-        top: Vec<u8>,
+        top: TetVerts,
     },
+}
+
+/// At most four tetrahedron-local vertex indices, stored inline (no heap allocation: a build
+/// of a 100k-triangle model writes ~600k sheet rules). Dereferences to `[u8]`; its JSON form is
+/// an array of numbers, exactly as a `Vec<u8>`'s.
+#[derive(Clone, Copy, Default, Eq)]
+pub struct TetVerts {
+    len: u8,
+    ix: [u8; 4],
+}
+
+impl TetVerts {
+    /// Most indices a [`TetVerts`] holds.
+    pub const CAPACITY: usize = 4;
+
+    /// The indices of `s`; `None` when there are more than [`TetVerts::CAPACITY`].
+    #[must_use]
+    pub fn from_slice(s: &[u8]) -> Option<Self> {
+        if s.len() > Self::CAPACITY {
+            return None;
+        }
+        let mut ix = [0; 4];
+        ix[..s.len()].copy_from_slice(s);
+        Some(TetVerts {
+            len: s.len() as u8,
+            ix,
+        })
+    }
+}
+
+impl<const N: usize> From<[u8; N]> for TetVerts {
+    /// # Panics
+    /// When N > [`TetVerts::CAPACITY`] (a programming error: a tetrahedron has four vertices).
+    fn from(a: [u8; N]) -> Self {
+        TetVerts::from_slice(&a).expect("at most four tetrahedron vertices")
+    }
+}
+
+impl std::ops::Deref for TetVerts {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        &self.ix[..usize::from(self.len)]
+    }
+}
+
+impl<'a> IntoIterator for &'a TetVerts {
+    type Item = &'a u8;
+    type IntoIter = std::slice::Iter<'a, u8>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
+impl PartialEq for TetVerts {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl std::hash::Hash for TetVerts {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        (**self).hash(h);
+    }
+}
+
+impl std::fmt::Debug for TetVerts {
+    /// As the slice (`[0, 1, 2]`), which is how error messages show it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        (**self).fmt(f)
+    }
+}
+
+impl Serialize for TetVerts {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.collect_seq(self.iter())
+    }
+}
+
+impl<'de> Deserialize<'de> for TetVerts {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = TetVerts;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "an array of at most 4 tetrahedron vertex indices")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> std::result::Result<TetVerts, A::Error> {
+                let mut v = TetVerts::default();
+                while let Some(k) = seq.next_element::<u8>()? {
+                    if usize::from(v.len) == TetVerts::CAPACITY {
+                        return Err(serde::de::Error::invalid_length(
+                            TetVerts::CAPACITY + 1,
+                            &self,
+                        ));
+                    }
+                    v.ix[usize::from(v.len)] = k;
+                    v.len += 1;
+                }
+                Ok(v)
+            }
+        }
+        d.deserialize_seq(V)
+    }
 }
 
 impl SheetRule {

@@ -4,7 +4,12 @@
 //! ```toml
 //! [model]
 //! file = "models/teapot.obj"      # a mesh, built with [scheme] …
-//! normals = "loop"                # angle | area | loop | file
+//! normals = "loop"                # angle | area | loop | file (rational-c1: loop on a polygon
+//!                                 # mesh uses its triangulation)
+//! # subdivide = { rule = "loop", levels = 2 }   # opt-in pre-subdivision (rational-c1 only):
+//! #                               # the surface then interpolates the subdivided mesh, not the file
+//! # weld = 1e-3                   # opt-in (rational-c1 only): weld vertices closer than this ×
+//! #                               # the bounding-box diagonal (modelling slop, see mesh::weld)
 //! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
 //!
 //! [scheme]
@@ -71,6 +76,13 @@ pub enum Model {
         normals: String,
         /// The `[scheme]` table, validated by the scheme.
         scheme: toml::Table,
+        /// Optional approximating pre-subdivision of the triangulated mesh (`model.subdivide`,
+        /// rational-c1 only, see [`mod@crate::mesh::subdivide`]): the surface then interpolates
+        /// the subdivided mesh, not the file's.
+        subdivide: Option<mesh::Subdivision>,
+        /// Optional weld tolerance relative to the bounding-box diagonal (`model.weld`,
+        /// rational-c1 only, see [`mod@crate::mesh::weld`]), applied before triangulation.
+        weld: Option<f64>,
     },
     /// A patch complex JSON file (resolved).
     Patches(PathBuf),
@@ -111,6 +123,21 @@ struct ModelSection {
     file: Option<String>,
     normals: Option<String>,
     patches: Option<String>,
+    subdivide: Option<SubdivideSection>,
+    weld: Option<f64>,
+}
+
+/// `model.subdivide = { rule = "loop", levels = N }`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SubdivideSection {
+    #[serde(default = "default_subdivision_rule")]
+    rule: String,
+    levels: u32,
+}
+
+fn default_subdivision_rule() -> String {
+    "loop".into()
 }
 
 #[derive(Deserialize)]
@@ -294,6 +321,12 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
             if file.scheme.is_some() {
                 return Err(bad("scheme", "only applies with `model.file`".into()));
             }
+            if m.subdivide.is_some() || m.weld.is_some() {
+                return Err(bad(
+                    "model.subdivide/weld",
+                    "only applies with `model.file`".into(),
+                ));
+            }
             Model::Patches(dir.join(p))
         }
         (Some(f), None) => {
@@ -310,10 +343,63 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     "a [scheme] table is required with `model.file`".into(),
                 )
             })?;
+            let subdivide = match &m.subdivide {
+                None => None,
+                Some(sd) => {
+                    if sd.rule != "loop" {
+                        return Err(bad(
+                            "model.subdivide.rule",
+                            format!("`{}` is not supported (only `loop`)", sd.rule),
+                        ));
+                    }
+                    if sd.levels > mesh::Subdivision::MAX_LEVELS {
+                        return Err(bad(
+                            "model.subdivide.levels",
+                            format!(
+                                "{} is more than {}",
+                                sd.levels,
+                                mesh::Subdivision::MAX_LEVELS
+                            ),
+                        ));
+                    }
+                    let ty = scheme.get("type").and_then(|v| v.as_str());
+                    if ty != Some("rational-c1") {
+                        return Err(bad(
+                            "model.subdivide",
+                            "only applies to `scheme.type = \"rational-c1\"` (the 1994 \
+                             schemes are measured against the input polyhedron)"
+                                .into(),
+                        ));
+                    }
+                    Some(mesh::Subdivision {
+                        rule: mesh::SubdivisionRule::Loop,
+                        levels: sd.levels,
+                    })
+                }
+            };
+            if let Some(w) = m.weld {
+                if !(0.0..=mesh::weld::MAX_WELD_TOLERANCE).contains(&w) {
+                    return Err(bad(
+                        "model.weld",
+                        format!(
+                            "{w} is not in [0, {}] (relative to the bounding-box diagonal)",
+                            mesh::weld::MAX_WELD_TOLERANCE
+                        ),
+                    ));
+                }
+                if scheme.get("type").and_then(|v| v.as_str()) != Some("rational-c1") {
+                    return Err(bad(
+                        "model.weld",
+                        "only applies to `scheme.type = \"rational-c1\"`".into(),
+                    ));
+                }
+            }
             Model::Mesh {
                 file: dir.join(f),
                 normals,
                 scheme,
+                subdivide,
+                weld: m.weld,
             }
         }
     };
@@ -500,6 +586,8 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
             file,
             normals,
             scheme,
+            subdivide,
+            weld,
         } => {
             let ty = scheme.get("type").and_then(|v| v.as_str()).ok_or_else(|| {
                 anyhow!(
@@ -513,10 +601,30 @@ pub fn build_complex(scene: &Scene) -> anyhow::Result<PatchComplex> {
                     let method: NormalMethod = normals.parse().map_err(|e: String| {
                         anyhow!("{}: `model.normals`: {e}", scene.path.display())
                     })?;
-                    let (m, report) = mesh::load(file)?;
+                    let (mut m, report) = mesh::load(file)?;
                     report.require(false)?;
-                    let tri = mesh::triangulate(&m);
-                    let vn = mesh::vertex_normals(&m, method)?;
+                    if let Some(w) = weld {
+                        let (welded, report, _) = mesh::weld(&m, *w)
+                            .with_context(|| format!("{}: `model.weld`", file.display()))?;
+                        report
+                            .require(false)
+                            .with_context(|| format!("{}: after `model.weld`", file.display()))?;
+                        m = welded;
+                    }
+                    let mut tri = mesh::triangulate(&m);
+                    let vn = match subdivide {
+                        Some(sd) => {
+                            tri = mesh::subdivide(&tri, *sd)
+                                .with_context(|| format!("{}", file.display()))?;
+                            mesh::vertex_normals(&tri, method)?
+                        }
+                        // Loop-limit normals need triangles: on a polygon mesh they are
+                        // taken on its triangulation (the triangles the hull is built on).
+                        None if method == NormalMethod::Loop && !m.is_triangle_mesh() => {
+                            mesh::vertex_normals(&tri, method)?
+                        }
+                        None => mesh::vertex_normals(&m, method)?,
+                    };
                     let triangles: Vec<[u32; 3]> =
                         tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
                     let built = rational_c1::build(&tri.positions, &triangles, &vn, &opts)
@@ -560,6 +668,7 @@ pub fn inner_hull(
         file,
         normals,
         scheme,
+        ..
     } = &scene.model
     else {
         return Ok(None);
@@ -638,6 +747,77 @@ irradiance = 2.0
         let text = MINIMAL.replace("type = \"directional\"", "type = \"spot\"");
         let e = format!("{:#}", parse(&text, Path::new("a/b.toml")).unwrap_err());
         assert!(e.contains("spot"), "{e}");
+    }
+
+    #[test]
+    fn subdivide_key_is_parsed_and_checked() {
+        let with = |model: &str, scheme: &str| {
+            MINIMAL.replace(
+                "patches = \"sphere.json\"",
+                &format!("file = \"m.obj\"\n{model}\n[scheme]\ntype = \"{scheme}\""),
+            )
+        };
+        let ok = with("subdivide = { rule = \"loop\", levels = 2 }", "rational-c1");
+        let s = parse(&ok, Path::new("s.toml")).unwrap();
+        let Model::Mesh { subdivide, .. } = s.model else {
+            panic!("mesh scene expected");
+        };
+        assert_eq!(
+            subdivide,
+            Some(mesh::Subdivision {
+                rule: mesh::SubdivisionRule::Loop,
+                levels: 2
+            })
+        );
+        // `rule` defaults to loop.
+        let s = parse(
+            &with("subdivide = { levels = 1 }", "rational-c1"),
+            Path::new("s.toml"),
+        );
+        assert!(s.is_ok());
+        for (model, scheme, key) in [
+            (
+                "subdivide = { rule = \"catmull\", levels = 1 }",
+                "rational-c1",
+                "model.subdivide.rule",
+            ),
+            (
+                "subdivide = { levels = 9 }",
+                "rational-c1",
+                "model.subdivide.levels",
+            ),
+            (
+                "subdivide = { levels = 1, sharp = true }",
+                "rational-c1",
+                "sharp",
+            ),
+            ("subdivide = { levels = 1 }", "cubic-c1", "model.subdivide"),
+            ("subdivide = 2", "rational-c1", "subdivide"),
+        ] {
+            let e = format!(
+                "{:#}",
+                parse(&with(model, scheme), Path::new("a/b.toml")).unwrap_err()
+            );
+            assert!(e.contains("a/b.toml") && e.contains(key), "{model}: {e}");
+        }
+        let s = parse(&with("weld = 1e-3", "rational-c1"), Path::new("s.toml")).unwrap();
+        assert!(matches!(s.model, Model::Mesh { weld: Some(w), .. } if w == 1e-3));
+        for (model, scheme) in [("weld = 0.5", "rational-c1"), ("weld = 1e-3", "quintic-c2")] {
+            let e = format!(
+                "{:#}",
+                parse(&with(model, scheme), Path::new("a/b.toml")).unwrap_err()
+            );
+            assert!(
+                e.contains("a/b.toml") && e.contains("model.weld"),
+                "{model}: {e}"
+            );
+        }
+        let patches = MINIMAL.replace(
+            "patches = \"sphere.json\"",
+            "patches = \"p.json\"\nsubdivide = { levels = 1 }",
+        );
+        let e = format!("{:#}", parse(&patches, Path::new("s.toml")).unwrap_err());
+        assert!(e.contains("model.subdivide"), "{e}");
     }
 
     #[test]

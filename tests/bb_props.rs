@@ -346,11 +346,12 @@ proptest! {
 fn face_term(w: [f64; 3]) -> RationalTerm {
     RationalTerm {
         index: [1, 1, 1, 0],
-        terms: vec![
+        terms: [
             (w[0], [0, 1, 1, 0]),
             (w[1], [1, 0, 1, 0]),
             (w[2], [1, 1, 0, 0]),
-        ],
+        ]
+        .into(),
     }
 }
 
@@ -358,11 +359,11 @@ fn edge_terms(w: [f64; 4]) -> [RationalTerm; 2] {
     [
         RationalTerm {
             index: [1, 1, 0, 1],
-            terms: vec![(w[0], [1, 0, 0, 0]), (w[1], [0, 0, 0, 1])],
+            terms: [(w[0], [1, 0, 0, 0]), (w[1], [0, 0, 0, 1])].into(),
         },
         RationalTerm {
             index: [1, 0, 1, 1],
-            terms: vec![(w[2], [1, 0, 0, 0]), (w[3], [0, 0, 0, 1])],
+            terms: [(w[2], [1, 0, 0, 0]), (w[3], [0, 0, 0, 1])].into(),
         },
     ]
 }

@@ -97,6 +97,56 @@ fn broken_complex_fails_with_the_jump_named() {
     assert!(patches.iter().any(|p| p == 9), "{v}");
 }
 
+/// A sphere complex with one patch on the sphere removed has a hole: exit 1, the text names the
+/// failure "holes" with the patch and point, the JSON report carries the same.
+#[test]
+fn holed_complex_fails_with_the_hole_located() {
+    let q = Quadric::sphere(DVec3::ZERO, 0.7);
+    let mut c = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 3, 3);
+    let k = c
+        .patches
+        .iter()
+        .position(|p| {
+            let a = p.tet().unwrap().bary(DVec3::new(0.7, 0.01, 0.02));
+            a.iter().all(|&x| x > 0.0)
+        })
+        .unwrap();
+    c.patches.remove(k);
+    let path = tmp("holed.json");
+    write_json_file(&c, &path).unwrap();
+    let o = apatch(&["check", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
+    let out = stdout(&o);
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("holes"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        line.contains("FAIL") && line.contains("worst: patch "),
+        "{line}"
+    );
+    assert!(out.contains("FAILED: holes"), "{out}");
+
+    let o = apatch(&["check", path.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["passed"], false);
+    assert!(
+        v["failures"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f == "holes"),
+        "{v}"
+    );
+    assert!(v["holes"]["crossing"].as_u64().unwrap() > 0, "{v}");
+    let at = &v["holes"]["crossing_at"];
+    assert_eq!(at["patches"].as_array().unwrap().len(), 1, "{v}");
+    assert_eq!(at["point"].as_array().unwrap().len(), 3, "{v}");
+    // Every other measure still passes: the hole is the only failure.
+    assert_eq!(v["failures"].as_array().unwrap().len(), 1, "{v}");
+}
+
 /// Runs `apatch check` on `text` written to `name` and returns stderr (exit 2 required).
 fn bad_input(name: &str, text: &str) -> String {
     let path = tmp(name);

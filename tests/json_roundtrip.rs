@@ -50,15 +50,16 @@ fn awkward_complex() -> PatchComplex {
         weights: a.clone(),
         rational: vec![RationalTerm {
             index: [1, 1, 1, 0],
-            terms: vec![
+            terms: [
                 (a[0], [0, 1, 1, 0]),
                 (a[3], [1, 0, 1, 0]),
                 (a[6], [1, 1, 0, 0]),
-            ],
+            ]
+            .into(),
         }],
         sheet: SheetRule::Shooting {
-            base: vec![0, 1, 2],
-            top: vec![3],
+            base: [0, 1, 2].into(),
+            top: [3].into(),
         },
         role: Role::Face,
         element: 7,

@@ -6,9 +6,10 @@
 //! process CPU time of the build (from `/proc/self/stat`, Linux only): on a shared, loaded
 //! machine the wall time mostly measures the other processes, CPU time / threads does not.
 //! `APATCH_TORUS=n` builds only the n × n torus (peak memory at several sizes).
-//! `APATCH_STAGE_TIMES=1` makes the build print the cumulative time at the end of each stage
-//! (hull, intersection test, faces, edge tetrahedra, edge bounds, free values, final edge
-//! check, patch emission), to find the serial ones.
+//! `APATCH_STAGE_TIMES=1` makes the build print the cumulative wall time and the process CPU
+//! time (all threads) at the end of each stage (hull, intersection test, faces, edge
+//! tetrahedra, edge bounds, free values, final edge check, patch emission, freeing), to find
+//! the costly and the serial ones. The load average is printed before and after.
 
 #[path = "rational_support.rs"]
 mod support;
@@ -52,6 +53,12 @@ fn build_throughput() {
         Some(n) => vec![n],
         None => vec![1, 2],
     };
+    let load = || {
+        std::fs::read_to_string("/proc/loadavg")
+            .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+            .unwrap_or_else(|_| "?".into())
+    };
+    eprintln!("load average before: {}", load());
     for m in models {
         for &n in &threads {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -86,4 +93,5 @@ fn build_throughput() {
             drop(b);
         }
     }
+    eprintln!("load average after: {}", load());
 }

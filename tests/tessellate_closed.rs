@@ -252,3 +252,39 @@ fn spot_scene_is_a_sphere() {
 fn knot_scene_has_genus_one() {
     check_scene("knot.toml", 2, 1);
 }
+
+/// The Euler characteristic of a scene's input mesh file (as loaded: polygons, welded, and
+/// welded within `model.weld` when the scene asks for it).
+fn input_euler(scene: &str) -> i64 {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{scene}"));
+    let s = apatch::scene::load(&path).expect("scene loads");
+    let apatch::scene::Model::Mesh { file, weld, .. } = &s.model else {
+        panic!("{scene}: not a mesh scene");
+    };
+    let (mut m, _) = apatch::mesh::load(file).expect("mesh loads");
+    if let Some(w) = weld {
+        // The welded mesh is the input the scheme sees (`model.weld`).
+        m = apatch::mesh::weld(&m, *w).expect("welds").0;
+    }
+    let t = apatch::mesh::Topology::new(m.positions.len(), &m.faces);
+    m.positions.len() as i64 - t.edges.len() as i64 + m.faces.len() as i64
+}
+
+/// The coarse, folded models that build with Loop pre-subdivision (`model.subdivide`): their
+/// tessellations are closed, oriented 2-manifolds with the input's Euler characteristic
+/// (subdivision keeps the topology), outward, through every interpolated vertex.
+#[test]
+fn pre_subdivided_scenes_keep_the_input_genus() {
+    for (name, genus) in [
+        ("corner.toml", 0),
+        ("letter_p.toml", 1),
+        ("torus_quad.toml", 1),
+        ("double_torus.toml", 2),
+        ("spot_cage.toml", 0),
+        ("fandisk.toml", 0),
+        ("mpi.toml", 1),
+    ] {
+        assert_eq!(input_euler(name), 2 - 2 * genus, "{name}: input genus");
+        check_scene(name, 1, genus);
+    }
+}

@@ -435,15 +435,16 @@ mod tests {
         let mut p = patch(tet, 3, (0..20).map(|k| (k as f64 * 0.37).sin()).collect());
         p.rational.push(RationalTerm {
             index: [1, 1, 1, 0],
-            terms: vec![
+            terms: [
                 (0.7, [0, 1, 1, 0]),
                 (-0.4, [1, 0, 1, 0]),
                 (1.3, [1, 1, 0, 0]),
-            ],
+            ]
+            .into(),
         });
         p.rational.push(RationalTerm {
             index: [1, 1, 0, 1],
-            terms: vec![(0.5, [1, 0, 0, 0]), (-0.9, [0, 0, 0, 1])],
+            terms: [(0.5, [1, 0, 0, 0]), (-0.9, [0, 0, 0, 1])].into(),
         });
         let e = PatchEval::new(&p, 0);
         let x0 = DVec3::new(0.35, 0.3, 0.25);

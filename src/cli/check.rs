@@ -100,6 +100,27 @@ fn scene_1994(
     Ok(Some(apatch::scene::load(input)?))
 }
 
+/// The scene's opt-in pre-subdivision (`model.subdivide`) when `input` is such a scene: the
+/// surface then interpolates the subdivided mesh, not the input, and the report says so.
+/// Also the scene's weld tolerance (`model.weld`), which changes the mesh the same way.
+fn mesh_repairs(input: &Path) -> (Option<apatch::mesh::Subdivision>, Option<f64>) {
+    let is_toml = input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if !is_toml {
+        return (None, None);
+    }
+    match apatch::scene::load(input).map(|s| s.model) {
+        Ok(apatch::scene::Model::Mesh {
+            subdivide, weld, ..
+        }) => (
+            subdivide.filter(|s| s.levels > 0),
+            weld.filter(|w| *w > 0.0),
+        ),
+        _ => (None, None),
+    }
+}
+
 /// The distance of the surface to the scene's polyhedron (1994 scenes).
 fn polyhedron_distance(
     scene: &apatch::scene::Scene,
@@ -155,6 +176,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         None => (None, None),
     };
     let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);
+    let (subdivided, welded) = mesh_repairs(&args.input);
     let passed = report.passed() && hull_valid;
     if args.json {
         // The verdict first, then every measure.
@@ -167,6 +189,12 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let Some(d) = &distance {
             out.insert("distance".into(), serde_json::to_value(d)?);
         }
+        if let Some(sd) = &subdivided {
+            out.insert("subdivision".into(), serde_json::to_value(sd)?);
+        }
+        if let Some(w) = welded {
+            out.insert("weld".into(), w.into());
+        }
         if let Some(v) = &hull {
             let list: Vec<String> = v.iter().map(violation_line).collect();
             out.insert(
@@ -176,6 +204,21 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
+        if let Some(w) = welded {
+            println!(
+                "weld             vertices closer than {w:e} of the bounding-box diagonal were \
+                 welded before the hull: the surface interpolates the welded mesh  info"
+            );
+        }
+        if let Some(sd) = &subdivided {
+            println!(
+                "subdivision      {} levels of `{}` before the hull: the surface interpolates the \
+                 subdivided, locally refined mesh ({} vertices), not the input mesh  info",
+                sd.levels,
+                sd.rule,
+                complex.vertices.len()
+            );
+        }
         print!("{report}");
         if let Some(d) = &distance {
             println!(

@@ -227,12 +227,12 @@ pub fn tessellate(complex: &PatchComplex, resolution: usize) -> anyhow::Result<T
         );
     }
     let face_rule = SheetRule::Shooting {
-        base: vec![0, 1, 2],
-        top: vec![3],
+        base: [0, 1, 2].into(),
+        top: [3].into(),
     };
     let edge_rule = SheetRule::Shooting {
-        base: vec![0, 1],
-        top: vec![2, 3],
+        base: [0, 1].into(),
+        top: [2, 3].into(),
     };
     let mut faces: Vec<usize> = Vec::new();
     let mut edges: Vec<usize> = Vec::new();

@@ -3,7 +3,9 @@
 //! [`load`] reads OBJ or OFF (polygon faces kept), welds exactly coincident vertices, removes
 //! degenerate faces, makes the orientation consistent and outward, and validates. [`triangulate`]
 //! ear-clips polygons for the 2001 scheme; [`vertex_normals`] estimates the normals the schemes
-//! interpolate; [`convexity`] classifies edges and faces.
+//! interpolate; [`convexity`] classifies edges and faces. Opt-in repairs for coarse, folded
+//! meshes under the 2001 scheme: [`subdivide()`] (Loop's approximating subdivision) and
+//! [`weld()`] (vertices closer than a tolerance merged).
 //!
 //! ```
 //! use apatch::mesh::{self, NormalMethod};
@@ -52,19 +54,23 @@ mod orient;
 pub mod raw;
 mod report;
 mod split;
+pub mod subdivide;
 mod summary;
 pub mod topology;
 mod triangulate;
 mod validate;
+pub mod weld;
 
 pub use load::{from_polygons, load, load_bytes, Format};
 pub use normals::{above_face_failures, loop_limit_normal, vertex_normals, NormalMethod};
 pub use orient::signed_volume;
 pub use report::{Element, Finding, FindingKind, Report, Severity, LISTED_ELEMENTS};
+pub use subdivide::{subdivide, Subdivision, SubdivisionRule};
 pub use summary::{summary, ClassCounts, Summary};
 pub use topology::{Fan, Topology};
 pub use triangulate::{ear_clip, triangulate};
 pub use validate::{PLANARITY_TOL, ZERO_AREA_TOL};
+pub use weld::weld;
 
 use glam::DVec3;
 

@@ -277,11 +277,47 @@ fn class_index(c: Convexity) -> usize {
     }
 }
 
+/// A face piece as the build keeps it: a [`Piece`] without `dw`, which is the same for every
+/// piece ([`weights::piece_dw`]): 288 instead of 448 bytes, for the ~350k pieces of a
+/// 100k-triangle model that every later stage reads.
+#[derive(Clone, Debug)]
+struct SidePiece {
+    pts: [DVec3; 4],
+    w0: [f64; N3],
+    rat: Option<[f64; 3]>,
+}
+
+impl SidePiece {
+    /// ∂ weights / ∂ f_0003 ([`Piece::dw`]).
+    #[inline]
+    fn dw(&self) -> &'static [f64; N3] {
+        weights::piece_dw()
+    }
+
+    /// The weights for a given f_0003 ([`Piece::weights`], the same arithmetic).
+    #[inline]
+    fn weights(&self, f: f64) -> [f64; N3] {
+        let dw = self.dw();
+        std::array::from_fn(|k| self.w0[k] + f * dw[k])
+    }
+}
+
+impl From<Piece> for SidePiece {
+    fn from(p: Piece) -> Self {
+        debug_assert!(p.dw == *weights::piece_dw(), "every piece has the same dw");
+        SidePiece {
+            pts: p.pts,
+            w0: p.w0,
+            rat: p.rat,
+        }
+    }
+}
+
 /// One side of one face: its pieces and free parameter.
 #[derive(Clone, Debug)]
 struct Side {
     sigma: f64,
-    pieces: Vec<Piece>,
+    pieces: Vec<SidePiece>,
     bound: f64,
     f: f64,
     margin: f64,
@@ -450,7 +486,7 @@ fn face_bound(side: &Side, tab: &Tab, cover_opts: &cover::CoverOptions) -> f64 {
     const D: [f64; 4] = [0.0, 0.0, 1.0 / 3.0, 1.0];
     let mut best = 0.0f64;
     for pc in &side.pieces {
-        if certify::face_top(&pc.w0, &pc.dw, side.sigma) {
+        if certify::face_top(&pc.w0, pc.dw(), side.sigma) {
             continue;
         }
         // The seed sampling is only a head start for the subdivision's lower estimate; the
@@ -495,15 +531,45 @@ const COVER_MAX_DEPTH: u32 = 24;
 /// Most sub-domains examined per certified bound.
 const COVER_MAX_NODES: usize = 20_000;
 
-/// An edge tetrahedron under construction.
+/// An edge tetrahedron under construction (kept small: ~300k of them live through the whole
+/// build of a 100k-triangle model; the weights of ∂/∂b are recomputed where needed by
+/// [`EdgeTet::dw`], which is cheaper than storing them).
 struct EdgeTet {
     edge: u32,
-    faces: [usize; 2],
-    side: usize,
-    piece: [usize; 2],
+    faces: [u32; 2],
+    side: u8,
+    piece: [u8; 2],
+    /// False for a degenerate pair (no frame): the build reports the first one.
+    ok: bool,
     frame: EdgeFrame,
+}
+
+impl EdgeTet {
+    /// The face sides A and B and their pieces this edge tetrahedron joins.
+    #[inline]
+    fn sides<'a>(&self, faces: &'a [FaceOut]) -> [(&'a Side, &'a SidePiece); 2] {
+        let s = usize::from(self.side);
+        [0, 1].map(|k| {
+            let side = faces[self.faces[k] as usize].sides[s]
+                .as_ref()
+                .expect("side exists");
+            (side, &side.pieces[usize::from(self.piece[k])])
+        })
+    }
+
     /// Weights and rational weights of ∂/∂b along f_A = σ(B_A + b), f_B = σ(B_B + b).
-    dw: ([f64; N3], [f64; 4]),
+    #[inline]
+    fn dw(&self, faces: &[FaceOut]) -> ([f64; N3], [f64; 4]) {
+        let [(_, pa), (_, pb)] = self.sides(faces);
+        self.frame.weights(pa.dw(), pb.dw())
+    }
+}
+
+/// One face of the build: its class and its sides (pieces, bounds, free values).
+struct FaceOut {
+    class: Convexity,
+    promoted: bool,
+    sides: [Option<Side>; 2],
 }
 
 /// Builds the rational C¹ complex (see the module docs).
@@ -571,10 +637,24 @@ pub fn build(
 fn stage_time(name: &str, since: std::time::Instant) {
     if std::env::var_os("APATCH_STAGE_TIMES").is_some() {
         eprintln!(
-            "stage {name}: {:.1} ms",
-            since.elapsed().as_secs_f64() * 1e3
+            "stage {name}: {:.1} ms wall, process CPU {:.1} ms",
+            since.elapsed().as_secs_f64() * 1e3,
+            process_cpu_ns() as f64 * 1e-6
         );
     }
+}
+
+/// CPU time of all threads of this process so far, in nanoseconds (the sum of the first fields
+/// of `/proc/self/task/*/schedstat`; 0 where that is missing). For [`stage_time`] only: on the
+/// shared machine the CPU time of a stage is a steadier measure than its wall time.
+fn process_cpu_ns() -> u64 {
+    let Ok(dir) = std::fs::read_dir("/proc/self/task") else {
+        return 0;
+    };
+    dir.flatten()
+        .filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok())
+        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
+        .sum()
 }
 
 /// Start of the error [`refine_hull`] gives when the round bound is reached.
@@ -830,12 +910,6 @@ fn assemble(
     };
 
     // Faces: pieces, promotion, face bounds (parallel).
-    struct FaceOut {
-        class: Convexity,
-        promoted: bool,
-        sides: [Option<Side>; 2],
-        fd: FaceData,
-    }
     let faces: Vec<FaceOut> = (0..nf)
         .into_par_iter()
         .map(|t| {
@@ -853,14 +927,16 @@ fn assemble(
                     class,
                     promoted,
                     sides: [None, None],
-                    fd,
                 };
             }
             // Promotion: a convex face on which F has the wrong sign is treated as nonconvex.
+            // (The piece it tests is kept for its side when the face stays convex.)
+            let mut tested: Option<(DVec3, Piece)> = None;
             if class != Convexity::Nonconvex {
                 let top = class == Convexity::Positive;
                 let t_apex = if top { fh.t_max } else { fh.t_min };
-                let pc = convex_piece(&fd, fh.centroid + t_apex * fh.normal);
+                let apex = fh.centroid + t_apex * fh.normal;
+                let pc = convex_piece(&fd, apex);
                 let sigma = if top { 1.0 } else { -1.0 };
                 let scale = pc.w0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
                 // The layer-0 certificate settles most faces without sampling (half the
@@ -872,6 +948,8 @@ fn assemble(
                 {
                     class = Convexity::Nonconvex;
                     promoted = true;
+                } else {
+                    tested = Some((apex, pc));
                 }
             }
             let mut sides: [Option<Side>; 2] = [None, None];
@@ -886,10 +964,14 @@ fn assemble(
                     continue;
                 }
                 let apex = fh.centroid + t_apex * fh.normal;
-                let pieces = if class == Convexity::Nonconvex {
-                    nonconvex_pieces(&fd, apex).to_vec()
+                let pieces: Vec<SidePiece> = if class == Convexity::Nonconvex {
+                    nonconvex_pieces(&fd, apex).map(SidePiece::from).to_vec()
                 } else {
-                    vec![convex_piece(&fd, apex)]
+                    let pc = match tested.take() {
+                        Some((a, pc)) if a == apex => pc,
+                        _ => convex_piece(&fd, apex),
+                    };
+                    vec![pc.into()]
                 };
                 let mut side = Side {
                     sigma,
@@ -906,7 +988,6 @@ fn assemble(
                 class,
                 promoted,
                 sides,
-                fd,
             }
         })
         .collect();
@@ -949,46 +1030,44 @@ fn assemble(
             })
         })
         .collect();
-    // The frame of a pair (None: degenerate), then its edge tetrahedron.
-    let frame_of = |&(ei, s): &(u32, u8)| -> Option<(EdgeFrame, [usize; 2])> {
+    // The edge tetrahedron of a pair (`ok` false: degenerate), each frame computed once.
+    let etet = |&(ei, s): &(u32, u8)| -> EdgeTet {
         let e = &hull.edges[ei as usize];
-        let s = s as usize;
-        let [fa, fb] = e.faces.map(|f| f as usize);
-        let (sa, sb) = (faces[fa].sides[s].as_ref()?, faces[fb].sides[s].as_ref()?);
-        let (ka, kb) = (piece_at(fa, sa, e), piece_at(fb, sb, e));
-        let frame = EdgeFrame::new(
-            &sa.pieces[ka],
-            &sb.pieces[kb],
+        let [fa, fb] = e.faces;
+        let (sa, sb) = (
+            faces[fa as usize].sides[usize::from(s)]
+                .as_ref()
+                .expect("pairs have both sides"),
+            faces[fb as usize].sides[usize::from(s)]
+                .as_ref()
+                .expect("pairs have both sides"),
+        );
+        let (ka, kb) = (piece_at(fa as usize, sa, e), piece_at(fb as usize, sb, e));
+        let frame = EdgeFrame::from_tets(
+            &sa.pieces[ka].pts,
+            &sb.pieces[kb].pts,
             positions[e.v[0] as usize],
             positions[e.v[1] as usize],
-        )?;
-        Some((frame, [ka, kb]))
-    };
-    let etet = |p: &(u32, u8)| -> EdgeTet {
-        let (frame, [ka, kb]) = frame_of(p).expect("checked before");
-        let (ei, s) = (p.0, p.1 as usize);
-        let [fa, fb] = hull.edges[ei as usize].faces.map(|f| f as usize);
-        let (sa, sb) = (&faces[fa].sides[s], &faces[fb].sides[s]);
-        let (sa, sb) = (sa.as_ref().expect("side"), sb.as_ref().expect("side"));
+        );
         EdgeTet {
             edge: ei,
             faces: [fa, fb],
             side: s,
-            piece: [ka, kb],
-            dw: frame.weights(&sa.pieces[ka].dw, &sb.pieces[kb].dw),
-            frame,
+            piece: [ka as u8, kb as u8],
+            ok: frame.is_some(),
+            frame: frame.unwrap_or_default(),
         }
     };
-    // The first degenerate one in edge order (as the sequential loop reported it), then all of
-    // them straight into their vector.
-    if let Some(i) = pairs.par_iter().position_first(|p| frame_of(p).is_none()) {
-        let e = hull.edges[pairs[i].0 as usize];
+    // All of them straight into their vector (indexed: in place, in edge order on any thread
+    // count), then the first degenerate one in edge order (as the sequential loop reported it).
+    let etets: Vec<EdgeTet> = pairs.par_iter().map(etet).collect();
+    if let Some(et) = etets.par_iter().find_first(|et| !et.ok) {
+        let e = hull.edges[et.edge as usize];
         return Err(Error::Invalid(format!(
             "edge {} (vertices {}, {}): degenerate face tetrahedron",
-            pairs[i].0, e.v[0], e.v[1]
+            et.edge, e.v[0], e.v[1]
         )));
     }
-    let etets: Vec<EdgeTet> = pairs.par_iter().map(etet).collect();
     stage_time("etets", tt);
     let mut faces = faces;
     // Edge bounds (Step 6, second part) along f_A = σ(B_A + b), f_B = σ(B_B + b); only
@@ -997,14 +1076,8 @@ fn assemble(
     let edge_bounds: Vec<f64> = etets
         .par_iter()
         .map(|et| {
-            let sa = faces[et.faces[0]].sides[et.side]
-                .as_ref()
-                .expect("side exists");
-            let sb = faces[et.faces[1]].sides[et.side]
-                .as_ref()
-                .expect("side exists");
-            let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
-            let (dw, drat) = &et.dw;
+            let [(sa, pa), (sb, pb)] = et.sides(&faces);
+            let (dw, drat) = &et.dw(&faces);
             let wa = pa.weights(sa.sigma * sa.bound);
             let wb = pb.weights(sb.sigma * sb.bound);
             let (w0, r0) = et.frame.weights(&wa, &wb);
@@ -1047,10 +1120,12 @@ fn assemble(
             }
         })
         .collect();
-    for (et, &be) in etets.iter().zip(&edge_bounds) {
+    // (The bounds first: most are 0, and the edge tetrahedra are only read where they are not.)
+    for (i, &be) in edge_bounds.iter().enumerate() {
         if be > 0.0 {
+            let et = &etets[i];
             for k in 0..2 {
-                if let Some(s) = faces[et.faces[k]].sides[et.side].as_mut() {
+                if let Some(s) = faces[et.faces[k] as usize].sides[usize::from(et.side)].as_mut() {
                     // Third part of Step 6: B_ijk += B_ijkl (the largest over its edges).
                     s.edge_extra = s.edge_extra.max(be);
                 }
@@ -1061,12 +1136,22 @@ fn assemble(
     // Choose the free parameters (Step 8 / §5.3).
     faces.par_iter_mut().enumerate().for_each(|(t, fo)| {
         let free = free_of(t);
-        let fd = fo.fd;
+        // The face's data again (cheaper than keeping 300 bytes per face through the build).
+        let fd = (free == Free::Default).then(|| {
+            let tri = triangles[t];
+            FaceData::new(
+                tri.map(|i| positions[i as usize]),
+                tri.map(|i| normals[i as usize]),
+            )
+        });
         for s in fo.sides.iter_mut().flatten() {
             s.bound += s.edge_extra;
             let apex = s.pieces[0].pts[3];
             let target = match free {
-                Free::Default => s.sigma * weights::linear_apex_value(&fd, apex),
+                Free::Default => {
+                    s.sigma
+                        * weights::linear_apex_value(fd.as_ref().expect("made for Default"), apex)
+                }
                 Free::Offset(b) => s.bound + b,
                 Free::Quadric => {
                     let q = fit
@@ -1080,20 +1165,21 @@ fn assemble(
     });
     stage_time("free", tt);
     // Final edge check with the chosen values; raise both faces where needed.
+    // After the first round only the edge tetrahedra of a face side raised in the round before
+    // can need more (the others see the same values again, and needed nothing), so each round
+    // checks those only, in edge order: the same raises as checking all of them.
     let mut raised = vec![[false; 2]; nf];
+    let mut active: Vec<u32> = (0..etets.len() as u32).collect();
+    let mut rounds = 0;
     for _round in 0..4 {
-        let needs: Vec<f64> = etets
+        rounds += 1;
+        let needs: Vec<f64> = active
             .par_iter()
-            .map(|et| {
-                let sa = faces[et.faces[0]].sides[et.side]
-                    .as_ref()
-                    .expect("side exists");
-                let sb = faces[et.faces[1]].sides[et.side]
-                    .as_ref()
-                    .expect("side exists");
-                let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
+            .map(|&i| {
+                let et = &etets[i as usize];
+                let [(sa, pa), (sb, pb)] = et.sides(&faces);
                 let margin = sa.margin.max(sb.margin);
-                let (dw, drat) = &et.dw;
+                let (dw, drat) = &et.dw(&faces);
                 // Certificate at b = −margin: then the pruned maximum below is its floor.
                 let shift = -sa.sigma * margin;
                 let (wm, rm) = et
@@ -1131,14 +1217,17 @@ fn assemble(
             })
             .collect();
         let mut any = false;
-        for (et, &need) in etets.iter().zip(&needs) {
+        let mut raised_now = vec![[false; 2]; nf];
+        for (&i, &need) in active.iter().zip(&needs) {
             if need > 0.0 {
+                let et = &etets[i as usize];
                 any = true;
                 for k in 0..2 {
-                    let f = et.faces[k];
-                    if let Some(s) = faces[f].sides[et.side].as_mut() {
+                    let f = et.faces[k] as usize;
+                    if let Some(s) = faces[f].sides[usize::from(et.side)].as_mut() {
                         s.f += s.sigma * need;
-                        raised[f][et.side] = true;
+                        raised[f][usize::from(et.side)] = true;
+                        raised_now[f][usize::from(et.side)] = true;
                     }
                 }
             }
@@ -1146,17 +1235,25 @@ fn assemble(
         if !any {
             break;
         }
+        active = (0..etets.len() as u32)
+            .filter(|&i| {
+                let et = &etets[i as usize];
+                et.faces
+                    .iter()
+                    .any(|&f| raised_now[f as usize][usize::from(et.side)])
+            })
+            .collect();
     }
 
-    stage_time("final_check", tt);
+    stage_time(&format!("final_check ({rounds} rounds)"), tt);
     // Emit patches (in parallel; the order is the sequential one: faces, then edges).
     let mut complex = PatchComplex::new("rational-c1");
     complex.continuity = Some(1);
     complex.vertices = positions.iter().map(|p| p.to_array()).collect();
     complex.normals = normals.iter().map(|n| n.to_array()).collect();
     let face_sheet = SheetRule::Shooting {
-        base: vec![0, 1, 2],
-        top: vec![3],
+        base: [0, 1, 2].into(),
+        top: [3].into(),
     };
     let mut faces_by_class = [0; 4];
     let mut lower_bounds = vec![[f64::NAN; 2]; nf];
@@ -1191,18 +1288,19 @@ fn assemble(
             jedge: None,
         }
     };
-    let face_piece_patch = |t: usize, side: &Side, pc: &Piece| -> Patch {
+    let face_piece_patch = |t: usize, side: &Side, pc: &SidePiece| -> Patch {
         let w = pc.weights(side.f);
         let rational = pc
             .rat
             .map(|r| {
                 vec![RationalTerm {
                     index: [1, 1, 1, 0],
-                    terms: vec![
+                    terms: [
                         (r[0], [0, 1, 1, 0]),
                         (r[1], [1, 0, 1, 0]),
                         (r[2], [1, 1, 0, 0]),
-                    ],
+                    ]
+                    .into(),
                 }]
             })
             .unwrap_or_default();
@@ -1219,13 +1317,7 @@ fn assemble(
         }
     };
     let edge_patch = |et: &EdgeTet| -> Patch {
-        let sa = faces[et.faces[0]].sides[et.side]
-            .as_ref()
-            .expect("side exists");
-        let sb = faces[et.faces[1]].sides[et.side]
-            .as_ref()
-            .expect("side exists");
-        let (pa, pb) = (&sa.pieces[et.piece[0]], &sb.pieces[et.piece[1]]);
+        let [(sa, pa), (sb, pb)] = et.sides(&faces);
         let (w, r) = et.frame.weights(&pa.weights(sa.f), &pb.weights(sb.f));
         let e = hull.edges[et.edge as usize];
         Patch {
@@ -1240,16 +1332,16 @@ fn assemble(
             rational: vec![
                 RationalTerm {
                     index: [1, 0, 1, 1],
-                    terms: vec![(r[0], [0, 0, 1, 0]), (r[1], [0, 0, 0, 1])],
+                    terms: [(r[0], [0, 0, 1, 0]), (r[1], [0, 0, 0, 1])].into(),
                 },
                 RationalTerm {
                     index: [0, 1, 1, 1],
-                    terms: vec![(r[2], [0, 0, 1, 0]), (r[3], [0, 0, 0, 1])],
+                    terms: [(r[2], [0, 0, 1, 0]), (r[3], [0, 0, 0, 1])].into(),
                 },
             ],
             sheet: SheetRule::Shooting {
-                base: vec![0, 1],
-                top: vec![2, 3],
+                base: [0, 1].into(),
+                top: [2, 3].into(),
             },
             role: Role::Edge,
             element: et.edge,
@@ -1297,6 +1389,10 @@ fn assemble(
     for e in &hull.edges {
         edges_by_class[class_index(e.class)] += 1;
     }
+    let promoted_faces = faces.iter().filter(|f| f.promoted).count();
+    // The pieces' ~150k small vectors are freed in parallel (a serial stage otherwise).
+    faces.into_par_iter().for_each(drop);
+    stage_time("free temporaries", tt);
     Ok(RationalBuild {
         complex,
         refined_edges,
@@ -1304,7 +1400,7 @@ fn assemble(
         origin: origin.to_vec(),
         faces_by_class,
         edges_by_class,
-        promoted_faces: faces.iter().filter(|f| f.promoted).count(),
+        promoted_faces,
         lower_bounds,
         free_values,
         raised_faces: raised.iter().flatten().filter(|&&r| r).count(),
@@ -1361,8 +1457,8 @@ mod tests {
             for (sigma, t) in [(1.0, 0.3 * longest), (-1.0, -0.3 * longest)] {
                 let apex = c + t * nf;
                 for pieces in [
-                    vec![convex_piece(&fd, apex)],
-                    nonconvex_pieces(&fd, apex).to_vec(),
+                    vec![convex_piece(&fd, apex).into()],
+                    nonconvex_pieces(&fd, apex).map(SidePiece::from).to_vec(),
                 ] {
                     let side = Side {
                         sigma,
@@ -1409,7 +1505,7 @@ mod tests {
             if c.side
                 .pieces
                 .iter()
-                .all(|pc| certify::face_top(&pc.w0, &pc.dw, c.side.sigma))
+                .all(|pc| certify::face_top(&pc.w0, pc.dw(), c.side.sigma))
             {
                 certified += 1;
                 assert_eq!(c.fast, 0.0);
@@ -1468,7 +1564,7 @@ mod tests {
             // the bound near the zero curve of p_0; the subdivision does not).
             let tol = cover_opts(&opts, c.longest);
             for pc in &c.side.pieces {
-                if certify::face_top(&pc.w0, &pc.dw, c.side.sigma) {
+                if certify::face_top(&pc.w0, pc.dw(), c.side.sigma) {
                     continue;
                 }
                 let (fam, root) = cover::FaceFamily::new(&pc.w0, pc.rat.as_ref(), c.side.sigma);

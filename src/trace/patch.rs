@@ -1160,7 +1160,7 @@ mod tests {
         let mut p = patch(&q, 3);
         p.rational.push(RationalTerm {
             index: [1, 1, 1, 0],
-            terms: vec![(2.0, [2, 0, 0, 0]), (3.0, [0, 2, 0, 0])],
+            terms: [(2.0, [2, 0, 0, 0]), (3.0, [0, 2, 0, 0])].into(),
         });
         let store = compile(&p);
         let c = store.get(0);
@@ -1232,19 +1232,20 @@ mod tests {
         let mut p = patch(&q, 3);
         p.rational.push(RationalTerm {
             index: [1, 0, 1, 1],
-            terms: vec![(0.7, [0, 0, 1, 0]), (-1.3, [0, 0, 0, 1])],
+            terms: [(0.7, [0, 0, 1, 0]), (-1.3, [0, 0, 0, 1])].into(),
         });
         p.rational.push(RationalTerm {
             index: [0, 1, 1, 1],
-            terms: vec![(2.0, [0, 0, 0, 1]), (0.4, [0, 0, 1, 0])],
+            terms: [(2.0, [0, 0, 0, 1]), (0.4, [0, 0, 1, 0])].into(),
         });
         p.rational.push(RationalTerm {
             index: [1, 1, 1, 0],
-            terms: vec![
+            terms: [
                 (0.5, [1, 1, 0, 0]),
                 (-0.2, [1, 0, 1, 0]),
                 (1.1, [0, 1, 1, 0]),
-            ],
+            ]
+            .into(),
         });
         let store = compile(&p);
         let c = store.get(0);

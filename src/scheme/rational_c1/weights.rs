@@ -46,6 +46,22 @@ pub struct Piece {
     pub rat: Option<[f64; 3]>,
 }
 
+/// ∂ weights / ∂ f_0003, the same for every piece of both kinds (Step 5): 1/3 at the number 4
+/// weights f_1002, f_0102, f_0012, 1 at f_0003, 0 elsewhere (`Piece::dw` of each piece; the
+/// build keeps pieces without it).
+#[must_use]
+pub fn piece_dw() -> &'static [f64; N3] {
+    static DW: OnceLock<[f64; N3]> = OnceLock::new();
+    DW.get_or_init(|| {
+        let mut dw = [0.0; N3];
+        for l in [[1, 0, 0, 2], [0, 1, 0, 2], [0, 0, 1, 2]] {
+            dw[ix(l)] = 1.0 / 3.0;
+        }
+        dw[ix([0, 0, 0, 3])] = 1.0;
+        dw
+    })
+}
+
 impl Piece {
     /// The weights for a given f_0003.
     #[must_use]
@@ -437,7 +453,7 @@ fn compute_frame_tables(a_loc: [usize; 3], b_loc: [usize; 3]) -> FrameTables {
 }
 
 /// How the edge tetrahedron [p_i p_j apexA apexB] sits against its two face pieces.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct EdgeFrame {
     /// Local indices in piece A of p_i, p_j and A's apex.
     pub a_loc: [usize; 3],
@@ -460,9 +476,15 @@ impl EdgeFrame {
     /// p_i and p_j.
     #[must_use]
     pub fn new(a: &Piece, b: &Piece, pi: DVec3, pj: DVec3) -> Option<Self> {
-        let loc = |pc: &Piece| -> Option<[usize; 3]> {
-            let i = (0..3).find(|&k| pc.pts[k] == pi)?;
-            let j = (0..3).find(|&k| pc.pts[k] == pj)?;
+        Self::from_tets(&a.pts, &b.pts, pi, pj)
+    }
+
+    /// [`EdgeFrame::new`] from the pieces' tetrahedra (`Piece::pts`) alone.
+    #[must_use]
+    pub fn from_tets(a: &[DVec3; 4], b: &[DVec3; 4], pi: DVec3, pj: DVec3) -> Option<Self> {
+        let loc = |pts: &[DVec3; 4]| -> Option<[usize; 3]> {
+            let i = (0..3).find(|&k| pts[k] == pi)?;
+            let j = (0..3).find(|&k| pts[k] == pj)?;
             Some([i, j, 3])
         };
         let (a_loc, b_loc) = (loc(a)?, loc(b)?);
@@ -470,8 +492,8 @@ impl EdgeFrame {
         Some(EdgeFrame {
             a_loc,
             b_loc,
-            beta_a: bary(&a.pts, b.pts[3])?,
-            beta_b: bary(&b.pts, a.pts[3])?,
+            beta_a: bary(a, b[3])?,
+            beta_b: bary(b, a[3])?,
             copy,
             c1,
         })
@@ -483,14 +505,16 @@ impl EdgeFrame {
     /// rational ones by (2.3)) and Step 9 (number 7 weights by (2.3)).
     #[must_use]
     pub fn weights(&self, wa: &[f64; N3], wb: &[f64; N3]) -> ([f64; N3], [f64; 4]) {
-        let mut e = [0.0; N3];
-        for (ek, &(src, i)) in e.iter_mut().zip(&self.copy) {
-            match src {
-                0 => *ek = wa[usize::from(i)],
-                1 => *ek = wb[usize::from(i)],
-                _ => {}
-            }
-        }
+        // A branch-free gather (the sources differ from frame to frame, so a `match` on
+        // them mispredicted): source 2 reads the zero of the number 5 weights, or a value
+        // that the blends below overwrite.
+        let zero = [0.0; N3];
+        let src = [wa, wb, &zero];
+        let e: [f64; N3] = std::array::from_fn(|k| {
+            let (s, i) = self.copy[k];
+            src[usize::from(s)][usize::from(i)]
+        });
+        let mut e = e;
         // Σ_r β_r w(face multiset + e_r), alternating A and B.
         let blend = |k: usize| -> f64 {
             let (w, beta) = if k.is_multiple_of(2) {
@@ -512,4 +536,39 @@ impl EdgeFrame {
 fn edge_ix() -> (usize, usize) {
     static I: OnceLock<(usize, usize)> = OnceLock::new();
     *I.get_or_init(|| (ix([0, 0, 2, 1]), ix([0, 0, 1, 2])))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every piece, convex or nonconvex, has the `dw` of [`piece_dw`] (the build keeps pieces
+    /// without it), and it is 1/3 at the three number 4 weights, 1 at f_0003, 0 elsewhere.
+    #[test]
+    fn every_piece_has_the_shared_dw() {
+        let dw = piece_dw();
+        let third: Vec<usize> = (0..N3).filter(|&k| dw[k] == 1.0 / 3.0).collect();
+        assert_eq!(third.len(), 3);
+        assert!(third.iter().all(|&k| cubic_indices()[k][3] == 2));
+        assert_eq!(dw[ix([0, 0, 0, 3])], 1.0);
+        assert_eq!(dw.iter().filter(|&&x| x != 0.0).count(), 4);
+        let p = [
+            DVec3::ZERO,
+            DVec3::new(1.0, 0.1, 0.0),
+            DVec3::new(0.2, 0.9, 0.1),
+        ];
+        let n = [
+            DVec3::new(0.1, -0.2, 1.0).normalize(),
+            DVec3::new(0.3, 0.1, 1.0).normalize(),
+            DVec3::new(-0.2, 0.2, 1.0).normalize(),
+        ];
+        let fd = FaceData::new(p, n);
+        let c = (p[0] + p[1] + p[2]) / 3.0;
+        for apex in [c + 0.3 * DVec3::Z, c - 0.3 * DVec3::Z] {
+            assert_eq!(convex_piece(&fd, apex).dw, *dw);
+            for pc in nonconvex_pieces(&fd, apex) {
+                assert_eq!(pc.dw, *dw);
+            }
+        }
+    }
 }
