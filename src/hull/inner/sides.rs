@@ -76,6 +76,11 @@ fn bary(a: DVec3, b: DVec3, c: DVec3, q: DVec3) -> [f64; 3] {
 
 /// Apexes over the base for `required` sides of the triangle `base` with vertex normals
 /// `normals`, or `None` when some vertex's tangent plane cannot be met within [`MAX_HEIGHT`].
+///
+/// The apexes rise from the base's centroid along the mean of the three vertex normals (two of
+/// which the neighbour across each edge shares, so neighbouring apexes rise nearly in parallel
+/// and their midpoints s stay over the shared edge even where T folds), or along the base's
+/// normal where that mean is more than 60° off it or would leave the apex outside the base.
 #[must_use]
 pub fn apexes_over_base(
     base: [DVec3; 3],
@@ -84,9 +89,32 @@ pub fn apexes_over_base(
 ) -> Option<[Option<DVec3>; 2]> {
     let [a, b, c] = base;
     let nn = (b - a).cross(c - a).try_normalize()?;
+    let mean = (normals[0] + normals[1] + normals[2]).normalize_or_zero();
+    if mean.dot(nn) >= 0.5 {
+        if let Some(out) = apexes_along(base, normals, required, mean) {
+            let over = out
+                .iter()
+                .flatten()
+                .all(|&q| bary(a, b, c, q).iter().all(|&l| l >= 0.0));
+            if over {
+                return Some(out);
+            }
+        }
+    }
+    apexes_along(base, normals, required, nn)
+}
+
+/// [`apexes_over_base`] along the unit direction `up` (with up · N > 0).
+fn apexes_along(
+    base: [DVec3; 3],
+    normals: [DVec3; 3],
+    required: [bool; 2],
+    up: DVec3,
+) -> Option<[Option<DVec3>; 2]> {
+    let [a, b, c] = base;
     let g = (a + b + c) / 3.0;
     let len = (b - a).length().max((c - b).length()).max((a - c).length());
-    // Height along +N (outer) or −N (inner) per side.
+    // Distance along +up (outer) or −up (inner) per side.
     let mut h = [MIN_HEIGHT * len; 2];
     for k in 0..3 {
         let (p, n) = (base[k], normals[k]);
@@ -100,15 +128,16 @@ pub fn apexes_over_base(
         // An apex must reach the other side: sign wanted for n·(q − p).
         let want = if hi < 0.0 { 1.0 } else { -1.0 };
         let g0 = want * n.dot(g - p);
-        // Which sides can: q = g ± h N gives want·n·(q − p) = g0 ± h·want·n·N; reach it with a
-        // margin of 5% of the base's depth so the plane cuts the tetrahedron cleanly.
+        // q = g ± h·up gives want·n·(q − p) = g0 ± h·want·n·up; reach a margin of 5% of the
+        // base's depth so the plane cuts the tetrahedron cleanly. Of the sides that can, take
+        // the one that has to rise least beyond its height so far.
         let target = 0.05 * lo.abs().min(hi.abs());
         let mut best: Option<(usize, f64)> = None;
         for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
             if !required[side] {
                 continue;
             }
-            let rate = sign * want * n.dot(nn);
+            let rate = sign * want * n.dot(up);
             let need = if g0 >= target {
                 0.0
             } else if rate > 1e-9 {
@@ -116,7 +145,8 @@ pub fn apexes_over_base(
             } else {
                 continue;
             };
-            if best.is_none_or(|(s, x)| need.max(h[side]) - h[side] < x.max(h[s]) - h[s]) {
+            let extra = (need - h[side]).max(0.0);
+            if best.is_none_or(|(s, x)| extra < (x - h[s]).max(0.0)) {
                 best = Some((side, need));
             }
         }
@@ -129,7 +159,7 @@ pub fn apexes_over_base(
             if h[side] > MAX_HEIGHT * len {
                 return None;
             }
-            out[side] = Some(g + sign * h[side] * nn);
+            out[side] = Some(g + sign * h[side] * up);
         }
     }
     Some(out)
@@ -176,7 +206,7 @@ pub fn settle(hull: &mut SimplicialHull) -> SideCounts {
                     .iter()
                     .any(|&l| l < OVER_BASE)
             });
-        if !missing && !off {
+        if !missing && !off && !step5 {
             continue;
         }
         counts.missing_side += usize::from(missing);
@@ -213,8 +243,8 @@ mod tests {
             assert!(normals[k].dot(q - base[k]) > 0.0);
             assert!(normals[k].dot(base[(k + 1) % 3] - base[k]) < 0.0);
         }
-        // Over the base: its projection is the centroid.
-        assert!((DVec3::new(q.x, q.y, 0.0) - g).length() < 1e-15);
+        // Over the base: its projection lies in the triangle.
+        assert!(bary(base[0], base[1], base[2], q).iter().all(|&l| l > 0.0));
     }
 
     /// A saddle-like triangle needing both sides gets one apex on each side.
