@@ -212,7 +212,7 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
             let h = level_height(level_mean(&w, 0), level_mean(&w, 1), level);
             let base = (tet[0] + tet[1] + tet[2]) / 3.0;
             let h_min = 1e-3 * c * (q - base).length();
-            let h = sigma * (sigma * h).max(h_min);
+            let h = sigma * (sigma * h).max(h_min).max(j_line_height(&w, sigma));
             for k in 0..3 {
                 w[ix(e3(k, 3, 3))] = h;
             }
@@ -368,6 +368,41 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
         })?;
     }
     Ok(out)
+}
+
+/// Smallest σ·h (all level-2 and apex weights = h) for which no line from the apex to a base
+/// lattice point meets F = 0 twice, where the base is not one-signed (an L-U pair's nonconvex
+/// triangle): on the line, F has Bernstein coefficients (F(b), B(b, b, q), h, h); where F(b)
+/// has the apex's sign and B(b, b, q) the other, F/(1 − t) ≥ F(b)(1 − t)² + 3B t(1 − t) +
+/// 3h t², which stays one-signed when h ≥ 0.75 B² / F(b). Base points with |F(b)| below 1% of
+/// the largest base weight (where the surface meets the base) are skipped.
+fn j_line_height(w: &[f64; 20], sigma: f64) -> f64 {
+    const RES: usize = 8;
+    let base_max = (0..3)
+        .flat_map(|k| (0..3).map(move |l| (k, l)))
+        .map(|(k, l)| w[ix(e3(k, k, l))].abs())
+        .fold(w[ix([1, 1, 1, 0])].abs(), f64::max);
+    let mut need: f64 = 0.0;
+    for i in 0..=RES {
+        for j in 0..=RES - i {
+            let b = [i as f64, j as f64, (RES - i - j) as f64].map(|x| x / RES as f64);
+            let mut c0 = 0.0;
+            let mut c1 = 0.0;
+            for k in 0..3 {
+                for l in 0..3 {
+                    for m in 0..3 {
+                        c0 += b[k] * b[l] * b[m] * w[ix(e3(k, l, m))];
+                    }
+                    c1 += b[k] * b[l] * w[ix(e3(k, l, 3))];
+                }
+            }
+            let (c0, c1) = (sigma * c0, sigma * c1);
+            if c0 > 0.01 * base_max && c1 < 0.0 {
+                need = need.max(0.75 * c1 * c1 / c0);
+            }
+        }
+    }
+    need
 }
 
 fn sign(side: Side) -> f64 {

@@ -51,6 +51,8 @@ pub struct SideCounts {
     pub rebuilt: usize,
     /// Triangles flagged but left as they were (no apex height up to [`MAX_HEIGHT`] works).
     pub kept: usize,
+    /// Apex pairs raised so that their midpoint clears both triangles ([`raise_midpoints`]).
+    pub raised: usize,
 }
 
 /// The sides (`[outer, inner]`) a surface crossing the edge (p_a, p_b) of T with normals n_a,
@@ -189,6 +191,7 @@ pub fn settle(hull: &mut SimplicialHull) -> SideCounts {
             }
         }
     }
+    let mut rebuilt = vec![false; hull.triangles.len()];
     for (t, &req) in required.iter().enumerate() {
         if !req[0] && !req[1] {
             continue;
@@ -215,12 +218,92 @@ pub fn settle(hull: &mut SimplicialHull) -> SideCounts {
         match apexes_over_base(base, normals, req) {
             Some(apexes) => {
                 hull.apexes[t] = apexes;
+                rebuilt[t] = true;
                 counts.rebuilt += 1;
             }
             None => counts.kept += 1,
         }
     }
+    counts.raised = raise_midpoints(hull, &edges, &rebuilt);
     counts
+}
+
+/// Smallest distance of an edge tetrahedron's midpoint s from the planes of the two triangles
+/// (on their apexes' side), relative to the edge of T, that [`raise_midpoints`] establishes.
+pub const MIDPOINT_CLEARANCE: f64 = 0.02;
+
+/// Where T folds, the midpoint s of two apexes over their bases can fall on the wrong side of a
+/// triangle (the fold's convex side, when the apexes are low), and the edge tetrahedra then
+/// cross the triangle into the other side's tetrahedra. Raises the rebuilt apexes at such an
+/// edge (both by the same distance, along their own directions from the base centroid) until s
+/// clears both planes by [`MIDPOINT_CLEARANCE`], within [`MAX_HEIGHT`]. Returns the number of
+/// raises.
+fn raise_midpoints(
+    hull: &mut SimplicialHull,
+    edges: &[crate::hull::simplicial::HullEdge],
+    rebuilt: &[bool],
+) -> usize {
+    let mut raised = 0;
+    let plane = |hull: &SimplicialHull, t: usize| {
+        let [a, b, c] = hull.triangles[t].map(|i| hull.points[i as usize]);
+        let len = (b - a).length().max((c - b).length()).max((a - c).length());
+        (
+            (b - a).cross(c - a).normalize_or_zero(),
+            a,
+            (a + b + c) / 3.0,
+            len,
+        )
+    };
+    for _ in 0..6 {
+        let mut changed = false;
+        for e in edges {
+            let [fa, fb] = e.faces.map(|f| f as usize);
+            if e.faces[1] == u32::MAX || !(rebuilt[fa] && rebuilt[fb]) {
+                continue;
+            }
+            let elen = (hull.points[e.v[1] as usize] - hull.points[e.v[0] as usize]).length();
+            for (side, sigma) in [(0usize, 1.0), (1, -1.0)] {
+                let (Some(qa), Some(qb)) = (hull.apexes[fa][side], hull.apexes[fb][side]) else {
+                    continue;
+                };
+                let (na, pa, ga, la) = plane(hull, fa);
+                let (nb, pb, gb, lb) = plane(hull, fb);
+                let (ua, ub) = ((qa - ga).normalize_or_zero(), (qb - gb).normalize_or_zero());
+                let s = 0.5 * (qa + qb);
+                let ds = 0.5 * (ua + ub);
+                let target = MIDPOINT_CLEARANCE * elen;
+                let mut delta: f64 = 0.0;
+                let mut ok = true;
+                for (n, p) in [(na, pa), (nb, pb)] {
+                    let dist = sigma * n.dot(s - p);
+                    if dist < target {
+                        let rate = sigma * n.dot(ds);
+                        if rate > 1e-6 {
+                            delta = delta.max((target - dist) / rate);
+                        } else {
+                            ok = false;
+                        }
+                    }
+                }
+                if !ok || delta <= 0.0 {
+                    continue;
+                }
+                let fits = (qa + delta * ua - ga).length() <= MAX_HEIGHT * la
+                    && (qb + delta * ub - gb).length() <= MAX_HEIGHT * lb;
+                if !fits {
+                    continue;
+                }
+                hull.apexes[fa][side] = Some(qa + delta * ua);
+                hull.apexes[fb][side] = Some(qb + delta * ub);
+                raised += 1;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    raised
 }
 
 #[cfg(test)]
