@@ -337,4 +337,64 @@ mod tests {
         let apexes = apexes_over_base(base, [DVec3::Z; 3], [true, true]).unwrap();
         assert!(apexes[0].unwrap().z > 0.0 && apexes[1].unwrap().z < 0.0);
     }
+
+    /// Edge classes (Definition 3.1) against hand-made configurations: a ridge (each end
+    /// below the other's tangent plane) asks for the outer side, a valley for the inner, a
+    /// twisted edge for both, a flat one for neither.
+    #[test]
+    fn edge_sides_follow_definition_3_1() {
+        let (a, b) = (DVec3::ZERO, DVec3::X);
+        let tilt = |x: f64| DVec3::new(x, 0.0, 1.0).normalize();
+        // Ridge: the normals lean away from each other, so each end is below the other's
+        // tangent plane.
+        assert_eq!(edge_sides(a, tilt(-0.3), b, tilt(0.3)), [true, false]);
+        assert_eq!(edge_sides(a, tilt(0.3), b, tilt(-0.3)), [false, true]);
+        assert_eq!(edge_sides(a, tilt(0.3), b, tilt(0.3)), [true, true]);
+        assert_eq!(edge_sides(a, DVec3::Z, b, DVec3::Z), [false, false]);
+    }
+
+    /// Two triangles folded 60° along their shared edge (a ridge of T) with low outer apexes:
+    /// the apexes' midpoint starts below both planes; after [`raise_midpoints`] it clears both
+    /// by the promised margin, measured directly.
+    #[test]
+    fn folded_pair_midpoint_is_raised_over_both_triangles() {
+        let (c, d) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let p = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(c, 0.5, -d),
+            DVec3::new(-c, 0.5, -d),
+        ];
+        let mut hull = SimplicialHull {
+            points: p.to_vec(),
+            normals: vec![DVec3::Z; 4],
+            origins: vec![PointOrigin::Other; 4],
+            triangles: vec![[0, 2, 1], [0, 1, 3]],
+            apexes: vec![[None, None]; 2],
+            element: vec![0, 1],
+        };
+        for t in 0..2 {
+            let [a, b, c] = hull.triangles[t].map(|i| p[i as usize]);
+            let n = (b - a).cross(c - a).normalize();
+            hull.apexes[t][0] = Some((a + b + c) / 3.0 + 0.02 * n);
+        }
+        let edges = hull.edges().unwrap();
+        let dist = |hull: &SimplicialHull, t: usize| {
+            let [a, b, c] = hull.triangles[t].map(|i| p[i as usize]);
+            let n = (b - a).cross(c - a).normalize();
+            let s = 0.5 * (hull.apexes[0][0].unwrap() + hull.apexes[1][0].unwrap());
+            n.dot(s - a)
+        };
+        assert!(dist(&hull, 0) < 0.0 && dist(&hull, 1) < 0.0);
+        let raised = raise_midpoints(&mut hull, &edges, &[true, true]);
+        assert!(raised > 0);
+        // The shared edge has length 1; rounding of the step is far below 1e-12.
+        for t in 0..2 {
+            assert!(
+                dist(&hull, t) >= MIDPOINT_CLEARANCE - 1e-12,
+                "{}",
+                dist(&hull, t)
+            );
+        }
+    }
 }
