@@ -16,7 +16,13 @@
 //!    for hallway corners (trihedral, one reflex face angle): T and the face tetrahedra; then
 //!    [`corner::spread_hallway_apexes`] moves the hallway corners' outer apexes off the
 //!    concave edge so the edge tetrahedra there are not inverted.
-//! 5. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//! 5. [`sides`]: every triangle gets a face tetrahedron on each side its edges' convexity asks
+//!    for (Definitions 3.1–3.4; the cubic's edge curves put the surface there), and every
+//!    step (5) triangle gets its apexes over its base, rising along the mean vertex normal by
+//!    the least height that keeps it tangent-containing; where T folds, apex pairs are raised
+//!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
+//!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
+//! 6. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
 //!
 //! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
 //!
