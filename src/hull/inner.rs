@@ -16,7 +16,13 @@
 //!    for hallway corners (trihedral, one reflex face angle): T and the face tetrahedra; then
 //!    [`corner::spread_hallway_apexes`] moves the hallway corners' outer apexes off the
 //!    concave edge so the edge tetrahedra there are not inverted.
-//! 5. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//! 5. [`sides`]: every triangle gets a face tetrahedron on each side its edges' convexity asks
+//!    for (Definitions 3.1–3.4; the cubic's edge curves put the surface there), and every
+//!    step (5) triangle gets its apexes over its base, rising along the mean vertex normal by
+//!    the least height that keeps it tangent-containing; where T folds, apex pairs are raised
+//!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
+//!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
+//! 6. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
 //!
 //! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
 //!
@@ -32,6 +38,7 @@ pub mod coplanar;
 pub mod corner;
 pub mod decompose;
 pub mod guardnet;
+pub mod sides;
 pub mod verify;
 
 pub use verify::{verify, HullViolation, ViolationKind};
@@ -137,6 +144,8 @@ pub struct InnerReport {
     pub unseparable: Vec<u32>,
     /// How the face tetrahedra were chosen.
     pub cases: corner::CaseCounts,
+    /// Triangles whose sides were settled from the convexity of their edges ([`sides`]).
+    pub sides: sides::SideCounts,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -287,5 +296,6 @@ pub fn build_with_report(
     }
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
+    report.sides = sides::settle(&mut hull);
     Ok((hull, report))
 }
