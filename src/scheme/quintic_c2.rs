@@ -10,6 +10,7 @@
 
 pub mod dense;
 pub mod jets;
+pub mod signs;
 pub mod sparse;
 pub mod system;
 
@@ -31,6 +32,9 @@ pub struct QuinticOptions {
     /// Lift of the free weights toward the vertices off T (apexes, edge midpoints), in units of
     /// their height above T: 0 = the plain blend of the Taylor polynomials.
     pub lift: f64,
+    /// Enforce Theorem 2.1's sign conditions (k = 1, [`signs`]) on the weights the C2
+    /// constraints leave free, by pinning the ones whose targets miss their sign.
+    pub signs: bool,
 }
 
 impl Default for QuinticOptions {
@@ -38,6 +42,7 @@ impl Default for QuinticOptions {
         QuinticOptions {
             curvature: 1.0,
             lift: LIFT,
+            signs: false,
         }
     }
 }
@@ -67,6 +72,13 @@ impl QuinticOptions {
                         ),
                     }
                 }
+                "signs" => match v.as_bool() {
+                    Some(b) => o.signs = b,
+                    None => bail!(
+                        "{}: `scheme.signs` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
                     match x {
@@ -78,7 +90,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }
@@ -114,7 +126,8 @@ pub fn build_with_stats(
     let (tets, _pos) = system::tetrahedra(hull)?;
     let sys = system::assemble(&tets, np)?;
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
-    let (value, stats) = sys.solve(&tets, &jets, nt, &target)?;
+    let (value, mut stats) = sys.solve(&tets, &jets, nt, &target, options.signs)?;
+    stats.signs.base_conflicts = signs::base_conflicts(hull).len();
     let mut complex = PatchComplex::new("quintic-c2");
     complex.continuity = Some(2);
     complex.vertices = hull.points.iter().map(|p| p.to_array()).collect();
