@@ -172,3 +172,241 @@ fn jvertex_json_roundtrip() {
     let bad = text.replacen("\"jvertex\":3", "\"jvertex\":7", 1);
     assert!(apatch::complex_io::from_json_str(&bad, Path::new("x.json")).is_err());
 }
+
+/// The 12×8 quad torus's inner hull and its cubic complex with and without the L-U completion
+/// (`sided::complete_lu_pairs`), built as the scene builds it.
+fn torus_complexes() -> (
+    apatch::scene::Scene,
+    apatch::hull::simplicial::SimplicialHull,
+    apatch::scheme::cubic_c1::CubicBuild,
+    apatch::scheme::cubic_c1::CubicBuild,
+) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper1994/torus_quad12x8.toml");
+    let sc = apatch::scene::load(&path).unwrap();
+    let hull = apatch::scene::inner_hull(&sc).unwrap().unwrap();
+    let before = build_full(
+        &hull,
+        &CubicOptions {
+            complete_lu_pairs: false,
+            ..CubicOptions::default()
+        },
+    )
+    .unwrap();
+    let after = build_full(&hull, &CubicOptions::default()).unwrap();
+    (sc, hull, before, after)
+}
+
+/// Primary rays (160×160, 1 spp) of the scene's camera whose first hit faces away from the
+/// camera: a ray that meets the inside of the surface first went through a hole.
+fn back_facing_hits(sc: &apatch::scene::Scene, c: &apatch::complex::PatchComplex) -> usize {
+    use apatch::trace::{self, Geometry, Mode};
+    let geo = Geometry::new(c).unwrap();
+    let mut s = sc.settings.clone();
+    s.camera = s.camera.resized(160, 160).unwrap();
+    s.spp = 1;
+    s.threads = 1;
+    s.mode = Mode::Normal;
+    let origin = s.camera.origin;
+    let frame =
+        trace::render(&geo, &s, &|| {}, &std::sync::atomic::AtomicBool::new(false)).unwrap();
+    frame
+        .pixels
+        .iter()
+        .filter(|p| p.alpha > 0.0)
+        .filter(|p| {
+            let n = glam::DVec3::from(p.normal.map(f64::from));
+            let d = (glam::DVec3::from(p.position.map(f64::from)) - origin).normalize();
+            // Through a hole the first hit faces away clearly; grazing silhouette hits are
+            // within a few degrees of 0 (f32 normals).
+            n.dot(d) > 0.1
+        })
+        .count()
+}
+
+/// Rays from points inside the solid torus (within 0.1 of the tube's centre circle, radius 1;
+/// the tube radius is 0.4 and the hull's surface stays within ~0.05 of the polyhedron) in
+/// seeded random directions: on a closed surface the first hit is where the ray leaves, ∇F
+/// along the ray. Counts the rays that miss or first meet the surface from outside (escaped
+/// through a hole).
+fn escapes(c: &apatch::complex::PatchComplex, rays: usize) -> usize {
+    use glam::DVec3;
+    let geo = apatch::trace::Geometry::new(c).unwrap();
+    let mut state = 7u64;
+    let mut rnd = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut out = 0;
+    for _ in 0..rays {
+        let u = rnd() * std::f64::consts::TAU;
+        let o = DVec3::new(u.cos(), u.sin(), 0.0)
+            + 0.1 * DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+        let d = loop {
+            let v = DVec3::new(rnd(), rnd(), rnd()) * 2.0 - 1.0;
+            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                break v.normalize();
+            }
+        };
+        let escaped = match geo.intersect(o, d, 0.0, f64::INFINITY) {
+            None => true,
+            Some(h) => {
+                let p = &c.patches[h.patch as usize];
+                let g = p.gradient(o + h.t * d);
+                // Leaving the solid: ∇F (outward) along the ray. A grazing exit has ∇F·d ≈ 0;
+                // a ray that escaped and met the torus again from outside has ∇F·d clearly < 0.
+                g.dot(d) < -0.05 * g.length()
+            }
+        };
+        out += usize::from(escaped);
+    }
+    out
+}
+
+/// Issue 7 on the 12×8 quad torus: the inner hull leaves 24 non-convex triangles single sided
+/// (Definition 3.6 (4) asks for L-U pairs there), the surface crosses their bases and `check`
+/// reports holes; with the partner apexes added the hull is still valid (`inner::verify`: no
+/// overlapping tetrahedra, tangent containment) and the complex passes `check` (C1 jumps
+/// ≤ 1e-9, no overshared faces, one crossing per j-line, no boundary face crossed). Independent
+/// truth: rays from inside the solid torus and the scene's camera rays see the holes before and
+/// none after.
+#[test]
+fn torus_holes_are_found_and_closed() {
+    let (sc, hull, before, after) = torus_complexes();
+    assert!(before.lu_completed.is_empty());
+    assert_eq!(after.lu_completed.len(), 24, "{:?}", after.lu_completed);
+
+    let rb = check(&before.complex, &CheckOptions::default());
+    assert!(rb.failures().contains(&"holes"), "{rb}");
+    assert!(rb.holes.crossing >= 24, "{rb}");
+    let at = rb.holes.crossing_at.as_ref().unwrap();
+    assert_eq!(at.patches.len(), 1, "{rb}");
+
+    let ra = check(&after.complex, &CheckOptions::default());
+    assert!(ra.passed(), "{ra}");
+    // 1e-9: the issue's bound on relative C1 jumps.
+    assert!(
+        ra.gradient_jump.worst <= 1e-9 && ra.value_jump.worst <= 1e-9,
+        "{ra}"
+    );
+    assert_eq!(ra.holes.crossing, 0, "{ra}");
+    assert_eq!(ra.faces.overshared, 0, "{ra}");
+    assert!(
+        ra.sheets.j_lines > 0 && ra.sheets.j_multi_lines == 0,
+        "{ra}"
+    );
+
+    // The completed hull is still a smoothable hull.
+    let (completed, changed) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+    assert_eq!(changed, after.lu_completed);
+    assert!(apatch::hull::inner::verify(&hull).is_empty());
+    let v = apatch::hull::inner::verify(&completed);
+    assert!(
+        v.is_empty(),
+        "{} violations, first {:?}",
+        v.len(),
+        v.first()
+    );
+
+    let (eb, ea) = (
+        escapes(&before.complex, 4000),
+        escapes(&after.complex, 4000),
+    );
+    let (cb, ca) = (
+        back_facing_hits(&sc, &before.complex),
+        back_facing_hits(&sc, &after.complex),
+    );
+    eprintln!("torus_quad12x8 cubic: rays from inside escaping {eb} -> {ea} of 4000; camera rays through holes {cb} -> {ca} of 160x160");
+    assert!(
+        eb > 0 && cb > 0,
+        "the holes must be visible to the rays: {eb} {cb}"
+    );
+    assert_eq!((ea, ca), (0, 0));
+}
+
+/// Triangles convex for their side keep one apex: every shipped convex solid and the non-convex
+/// prisms are unchanged by the completion.
+#[test]
+fn convex_triangles_stay_single_sided() {
+    use apatch::hull::inner::{self, InnerOptions};
+    for name in [
+        "cube.obj",
+        "icosahedron.obj",
+        "l_prism.obj",
+        "star_prism.obj",
+        "corner_poly.obj",
+    ] {
+        let (m, _) = apatch::mesh::load(&Path::new("scenes/models").join(name)).unwrap();
+        let vn = apatch::mesh::vertex_normals(&m, apatch::mesh::NormalMethod::Angle).unwrap();
+        let hull = inner::build(&m, &vn, &InnerOptions::default()).unwrap();
+        let (_, changed) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+        assert!(changed.is_empty(), "{name}: {changed:?}");
+    }
+}
+
+/// Exploration for the quintic scheme (owned elsewhere): the same completion under
+/// `quintic_c2::build` on the torus.
+#[test]
+#[ignore = "exploration"]
+fn explore_quintic_on_completed_hull() {
+    let (sc, hull, _, _) = torus_complexes();
+    let (completed, changed) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+    for (name, h) in [("original", &hull), ("completed", &completed)] {
+        let c = apatch::scheme::quintic_c2::build(
+            h,
+            &apatch::scheme::quintic_c2::QuinticOptions::default(),
+        )
+        .unwrap();
+        let r = check(&c, &CheckOptions::default());
+        eprintln!(
+            "quintic {name} ({} changed): back-facing {} escapes {} of 4000\n{r}",
+            changed.len(),
+            back_facing_hits(&sc, &c),
+            escapes(&c, 4000)
+        );
+    }
+}
+
+/// Exploration: the quintic's crossed boundary faces on the completed torus hull, their
+/// coefficients by level.
+#[test]
+#[ignore = "exploration"]
+fn explore_quintic_crossings() {
+    let (_, hull, _, _) = torus_complexes();
+    let (completed, _) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+    let c = apatch::scheme::quintic_c2::build(
+        &completed,
+        &apatch::scheme::quintic_c2::QuinticOptions::default(),
+    )
+    .unwrap();
+    let idx = apatch::bb::multi_indices(5);
+    let mut shown = 0;
+    for (k, p) in c.patches.iter().enumerate() {
+        if p.role != apatch::complex::Role::Edge || shown >= 3 {
+            continue;
+        }
+        for opp in [0usize, 1] {
+            let face: Vec<(String, f64)> = idx
+                .iter()
+                .zip(&p.weights)
+                .filter(|(l, _)| l[opp] == 0)
+                .map(|(l, &w)| (format!("{:?}", l), w))
+                .collect();
+            let pos = face.iter().any(|x| x.1 > 1e-9);
+            let neg = face.iter().any(|x| x.1 < -1e-9);
+            if pos && neg {
+                shown += 1;
+                eprintln!(
+                    "patch {k} edge {} face without vertex {opp}: tet {:?}",
+                    p.element, p.tet
+                );
+                for (l, w) in &face {
+                    eprintln!("   {l} {w:.4e}");
+                }
+                break;
+            }
+        }
+    }
+}

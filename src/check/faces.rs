@@ -28,6 +28,8 @@ pub(super) struct FaceMeasures {
     pub value: Measure,
     pub gradient: Measure,
     pub hessian: Measure,
+    /// The faces of one patch only: (position in `evals`, the opposite local vertex).
+    pub boundary: Vec<(u32, u8)>,
 }
 
 /// The worst jumps on one shared face.
@@ -128,6 +130,7 @@ pub(super) fn measure(evals: &[PatchEval<'_>], opts: &CheckOptions) -> FaceMeasu
         value: jumps.value,
         gradient: jumps.gradient,
         hessian: jumps.hessian,
+        boundary,
     }
 }
 

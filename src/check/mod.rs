@@ -36,6 +36,7 @@
 pub mod distance;
 pub mod eval;
 mod faces;
+pub mod holes;
 mod interp;
 mod report;
 mod sheets;
@@ -253,6 +254,32 @@ pub struct SheetStats {
     pub j_multi_at: Option<Location>,
 }
 
+/// Holes: boundary faces of the hull (faces of one patch only) that the surface crosses
+/// ([`holes`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct HoleStats {
+    /// Boundary faces of single-sheeted ([`crate::complex::SheetRule::Any`]) patches examined.
+    pub boundary_faces: usize,
+    /// Of those, faces where F is certified not to change sign (one-signed BB coefficients,
+    /// of the face or of all its sub-triangles, or a patch whose weights share one strict sign).
+    pub certified: usize,
+    /// Faces where F takes both strict signs: the surface reaches the boundary of the hull and
+    /// ends there, a hole (a failure).
+    pub crossing: usize,
+    /// Crossed faces counted by the hull role of their patch ("face", "edge", …).
+    pub crossing_by_role: std::collections::BTreeMap<String, usize>,
+    /// Faces neither certified nor found crossing (information).
+    pub uncertified: usize,
+    /// Boundary faces of shooting patches, not examined (their surface is the first root only).
+    pub skipped: usize,
+    /// The largest depth of a crossing: the smaller of max F and −min F on the face over the
+    /// patch's largest weight.
+    pub worst: f64,
+    /// The worst crossing face's patch and a point of F's minority sign on it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub crossing_at: Option<Location>,
+}
+
 /// Everything [`check`] measured, with the options used.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CheckReport {
@@ -281,6 +308,8 @@ pub struct CheckReport {
     pub interpolation: InterpolationStats,
     /// Sheet uniqueness.
     pub sheets: SheetStats,
+    /// The surface against the hull's boundary (holes).
+    pub holes: HoleStats,
     /// The options used.
     pub options: CheckOptions,
 }
@@ -333,6 +362,9 @@ impl CheckReport {
         if self.sheets.j_multi_lines > 0 {
             f.push("multiple sheets along j-lines");
         }
+        if self.holes.crossing > 0 {
+            f.push("holes");
+        }
         f
     }
 }
@@ -361,6 +393,7 @@ pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
     let faces = faces::measure(&evals, opts);
     let interpolation = interp::measure(complex, &evals);
     let sheets = sheets::measure(&evals, opts);
+    let holes = holes::measure(&evals, &faces.boundary);
     CheckReport {
         scheme: complex.scheme.clone(),
         continuity,
@@ -374,6 +407,7 @@ pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
         hessian_jump: faces.hessian,
         interpolation,
         sheets,
+        holes,
         options: opts.clone(),
     }
 }
@@ -503,9 +537,43 @@ mod tests {
                 .starts_with("patch 3: 4 weights"),
             "{r}"
         );
-        assert_eq!(r.failures(), vec!["invalid patches"], "{r}");
+        // The unmeasured patches leave open faces on their neighbours, where the sphere crosses
+        // them: holes, reported after the cause.
+        assert_eq!(r.failures(), vec!["invalid patches", "holes"], "{r}");
         // An empty complex measures nothing and passes.
         assert!(check(&PatchComplex::new("empty"), &CheckOptions::default()).passed());
+    }
+
+    /// A closed sphere passes the hole test; the same complex with one patch removed has a
+    /// hole where the sphere meets the faces that patch shared, and fails with that location.
+    #[test]
+    fn missing_patch_is_a_hole() {
+        let c = sphere_complex(3);
+        let r = check(&c, &CheckOptions::default());
+        assert!(r.holes.boundary_faces > 0 && r.holes.crossing == 0, "{r}");
+        assert!(r.passed(), "{r}");
+        // The patch whose tetrahedron the sphere passes through, nearest the point (0.8, 0, 0).
+        let k = c
+            .patches
+            .iter()
+            .position(|p| {
+                let t = p.tet().unwrap();
+                let a = t.bary(DVec3::new(0.8, 0.01, 0.02));
+                a.iter().all(|&x| x > 0.0)
+            })
+            .unwrap();
+        let mut holed = c.clone();
+        holed.patches.remove(k);
+        let r = check(&holed, &CheckOptions::default());
+        assert!(r.holes.crossing > 0, "{r}");
+        assert!(r.failures().contains(&"holes"), "{r}");
+        let at = r.holes.crossing_at.as_ref().unwrap();
+        // The crossing point is on the removed tetrahedron's boundary, near the sphere.
+        let x = DVec3::from_array(at.point);
+        assert!((x.length() - 0.8).abs() < 0.5, "{r}");
+        let t = c.patches[k].tet().unwrap();
+        // 1e-9: barycentrics of a point computed from the same tetrahedron's corners.
+        assert!(t.bary(x).iter().all(|&a| a > -1e-9), "{r}");
     }
 
     #[test]
@@ -629,12 +697,14 @@ mod tests {
         let r = check(&c, &CheckOptions::default());
         assert!(r.sheets.multi_root_lines > 0, "{r}");
         assert_eq!(r.sheets.multi_sheet_patches, 1, "{r}");
-        assert!(r.passed(), "{r}");
+        // A lone tetrahedron: both sheets run into its open faces (holes), but the sheets alone
+        // are only a warning.
+        assert_eq!(r.failures(), vec!["holes"], "{r}");
         let strict = CheckOptions {
             single_sheet: true,
             ..CheckOptions::default()
         };
-        assert!(!check(&c, &strict).passed());
+        assert!(check(&c, &strict).failures().contains(&"multiple sheets"));
     }
 
     #[test]

@@ -173,6 +173,31 @@ impl fmt::Display for CheckReport {
                 fmt_location_as("e.g.", &s.j_multi_at)
             )?;
         }
+        let h = &self.holes;
+        if h.boundary_faces > 0 {
+            writeln!(
+                f,
+                "holes            {} of {} boundary faces crossed by the surface{} (depth {:.3e}), \
+                 {} certified one-signed, {} uncertified  {}{}",
+                h.crossing,
+                h.boundary_faces,
+                if h.crossing_by_role.is_empty() {
+                    String::new()
+                } else {
+                    let roles: Vec<String> = h
+                        .crossing_by_role
+                        .iter()
+                        .map(|(r, n)| format!("{n} {r}"))
+                        .collect();
+                    format!(" ({})", roles.join(", "))
+                },
+                h.worst,
+                h.certified,
+                h.uncertified,
+                verdict(h.crossing == 0),
+                fmt_location_as("worst", &h.crossing_at)
+            )?;
+        }
         let failures = self.failures();
         if failures.is_empty() {
             writeln!(f, "PASSED")

@@ -20,6 +20,7 @@
 //! ```
 
 pub mod flat;
+pub mod sided;
 pub mod weights;
 
 use crate::complex::{Patch, PatchComplex, Role};
@@ -51,6 +52,10 @@ pub struct CubicOptions {
     pub center: f64,
     /// |∇F| at the points of T (the weights scale with it; the surface does not).
     pub gradient_scale: f64,
+    /// Give single-sided triangles of T that are not convex for their side the partner
+    /// tetrahedron of an L-U pair (Definition 3.6 (4); [`sided`]) before building. Without it the
+    /// surface leaves the hull through their bases (holes).
+    pub complete_lu_pairs: bool,
 }
 
 impl Default for CubicOptions {
@@ -60,6 +65,7 @@ impl Default for CubicOptions {
             levels: HashMap::new(),
             center: 1.0,
             gradient_scale: 1.0,
+            complete_lu_pairs: true,
         }
     }
 }
@@ -80,6 +86,8 @@ pub struct CubicBuild {
     /// Edge tetrahedra whose midpoint s is not on the apex side of the face tetrahedron's base
     /// (the sign conditions cannot be enforced there; `check` measures the sheets).
     pub unsigned: usize,
+    /// Triangles of T given a partner apex ([`sided::complete_lu_pairs`]).
+    pub lu_completed: Vec<usize>,
 }
 
 /// Weights of the face tetrahedron of one (triangle, side).
@@ -102,6 +110,12 @@ pub fn build(hull: &SimplicialHull, options: &CubicOptions) -> Result<PatchCompl
 /// As [`build`].
 pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<CubicBuild> {
     validate(hull, options)?;
+    let (completed, lu_completed) = if options.complete_lu_pairs {
+        sided::complete_lu_pairs(hull)
+    } else {
+        (hull.clone(), Vec::new())
+    };
+    let hull = &completed;
     let c = options.gradient_scale;
     let p = &hull.points;
     let g: Vec<DVec3> = hull.normals.iter().map(|n| c * *n).collect();
@@ -114,6 +128,7 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
         flat_unsolved: 0,
         raised: 0,
         unsigned: 0,
+        lu_completed,
     };
 
     // Number 2: a_1110 per triangle (shared by both sides of an L-U pair), quadratic precision.
