@@ -32,6 +32,12 @@ pub struct QuinticOptions {
     /// Lift of the free weights toward the vertices off T (apexes, edge midpoints), in units of
     /// their height above T: 0 = the plain blend of the Taylor polynomials.
     pub lift: f64,
+    /// Give single-sided triangles of T that are not convex for their side the partner
+    /// tetrahedron of an L-U pair before building (Definition 3.6 (4); the cubic scheme's
+    /// [`crate::scheme::cubic_c1::sided::complete_lu_pairs`]): their base weights fixed by the
+    /// data have the apex's sign ([`signs::base_conflicts`]), so with one side only the
+    /// surface would leave the hull through the base (a hole).
+    pub complete_lu_pairs: bool,
     /// Enforce Theorem 2.1's sign conditions (k = 1, [`signs`]) on the weights the C2
     /// constraints leave free, by pinning the ones whose targets miss their sign.
     pub signs: bool,
@@ -43,6 +49,7 @@ impl Default for QuinticOptions {
             curvature: 1.0,
             lift: LIFT,
             signs: false,
+            complete_lu_pairs: true,
         }
     }
 }
@@ -72,6 +79,13 @@ impl QuinticOptions {
                         ),
                     }
                 }
+                "complete_lu_pairs" => match v.as_bool() {
+                    Some(b) => o.complete_lu_pairs = b,
+                    None => bail!(
+                        "{}: `scheme.complete_lu_pairs` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => match v.as_bool() {
                     Some(b) => o.signs = b,
                     None => bail!(
@@ -90,7 +104,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }
@@ -120,6 +134,12 @@ pub fn build_with_stats(
     options: &QuinticOptions,
 ) -> Result<(PatchComplex, BuildStats)> {
     validate(hull)?;
+    let (completed, lu_completed) = if options.complete_lu_pairs {
+        crate::scheme::cubic_c1::sided::complete_lu_pairs(hull)
+    } else {
+        (hull.clone(), Vec::new())
+    };
+    let hull = &completed;
     let np = hull.points.len() as u32;
     let nt = hull.triangles.len() as u32;
     let jets = jets::estimate(hull, options.curvature);
@@ -128,6 +148,7 @@ pub fn build_with_stats(
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
     let (value, mut stats) = sys.solve(&tets, &jets, nt, &target, options.signs)?;
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
+    stats.lu_completed = lu_completed.len();
     let mut complex = PatchComplex::new("quintic-c2");
     complex.continuity = Some(2);
     complex.vertices = hull.points.iter().map(|p| p.to_array()).collect();

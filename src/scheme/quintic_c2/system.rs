@@ -376,6 +376,9 @@ pub struct SolveStats {
     pub sparse_groups: usize,
     /// How the weights meet Theorem 2.1's sign conditions ([`signs`]).
     pub signs: SignStats,
+    /// Triangles of T given the partner apex of an L-U pair before building
+    /// (`QuinticOptions::complete_lu_pairs`).
+    pub lu_completed: usize,
 }
 
 /// A group whose equations could not be met in one pass.
