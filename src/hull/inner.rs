@@ -31,6 +31,7 @@ pub mod above;
 pub mod coplanar;
 pub mod corner;
 pub mod decompose;
+pub mod sides;
 pub mod verify;
 
 pub use verify::{verify, HullViolation, ViolationKind};
@@ -136,6 +137,8 @@ pub struct InnerReport {
     pub unseparable: Vec<u32>,
     /// How the face tetrahedra were chosen.
     pub cases: corner::CaseCounts,
+    /// Triangles whose sides were settled from the convexity of their edges ([`sides`]).
+    pub sides: sides::SideCounts,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -283,5 +286,6 @@ pub fn build_with_report(
         }
     }
     corner::spread_hallway_apexes(&mut hull, &hallway);
+    report.sides = sides::settle(&mut hull);
     Ok((hull, report))
 }
