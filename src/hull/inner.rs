@@ -31,6 +31,7 @@ pub mod above;
 pub mod coplanar;
 pub mod corner;
 pub mod decompose;
+pub mod guardnet;
 pub mod sides;
 pub mod verify;
 
@@ -38,7 +39,7 @@ pub use verify::{verify, HullViolation, ViolationKind};
 
 use crate::error::{Error, Result};
 use crate::hull::simplicial::{PointOrigin, SimplicialHull};
-use crate::mesh::{Mesh, Topology};
+use crate::mesh::Mesh;
 use glam::DVec3;
 use std::path::Path;
 
@@ -182,7 +183,9 @@ pub fn build_with_report(
     let mut report = InnerReport::default();
     let merged = coplanar::merge_coplanar(mesh);
     let mesh = &merged;
-    let pieces = decompose::convex_pieces(mesh)?;
+    // Algorithm 2 step (1): regions with several pieces get a corner guard net.
+    let net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
+    let pieces = &net.pieces;
     let input_face = |f: u32| mesh.face_parent[f as usize];
     report.split_faces = pieces
         .split
@@ -194,7 +197,7 @@ pub fn build_with_report(
         .iter()
         .map(|&(f, g)| (input_face(f), g))
         .collect();
-    let topo = Topology::new(nv, &pieces.faces);
+    let topo = &net.topo;
 
     let mut hull = SimplicialHull::default();
     for (f, _) in pieces.faces.iter().enumerate() {
@@ -212,10 +215,10 @@ pub fn build_with_report(
     let mut hallway = Vec::new();
     #[allow(clippy::needless_range_loop)] // v indexes positions, normals, lines and topology
     for v in 0..nv {
-        if topo.vertex_corners(v as u32).is_empty() {
-            continue; // unreferenced: not part of the polyhedron
+        if topo.vertex_corners(v as u32).is_empty() || net.inside(v as u32) {
+            continue; // unreferenced, or inside one region: no corner of the polyhedron
         }
-        let fan = match topo.vertex_fan(v as u32) {
+        let fan = match net.fan(v as u32) {
             Some(f) if f.closed => f,
             Some(_) => {
                 return Err(Error::Invalid(format!(
@@ -286,6 +289,7 @@ pub fn build_with_report(
         }
     }
     corner::spread_hallway_apexes(&mut hull, &hallway);
+    net.add_edge_cells(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
     Ok((hull, report))
 }

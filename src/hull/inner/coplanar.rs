@@ -53,16 +53,7 @@ pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
         let (Some(nf_), Some(ng)) = (normals[f], normals[g]) else {
             return false;
         };
-        if (nf_ - ng).length() > NORMAL_TOL {
-            return false;
-        }
-        let pts = |h: usize| mesh.faces[h].iter().map(|&v| mesh.positions[v as usize]);
-        let size = pts(f)
-            .chain(pts(g))
-            .map(|p| (p - mesh.positions[mesh.faces[f][0] as usize]).length())
-            .fold(0.0, f64::max);
-        let o = mesh.positions[mesh.faces[f][0] as usize];
-        pts(g).all(|p| nf_.dot(p - o).abs() <= PLANE_DISTANCE * size)
+        same_plane(&mesh.positions, &mesh.faces[f], nf_, &mesh.faces[g], ng)
     };
     let mut any = false;
     for (&(a, b), &f) in &directed {
@@ -139,6 +130,25 @@ pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
         face_parent: reps,
         faces,
     }
+}
+
+/// True when faces `f` and `g` (unit normals `nf`, `ng`) lie in one plane: normals within
+/// [`NORMAL_TOL`] and `g`'s vertices within [`PLANE_DISTANCE`] (relative) of `f`'s plane.
+#[must_use]
+pub fn same_plane(positions: &[DVec3], f: &[u32], nf: DVec3, g: &[u32], ng: DVec3) -> bool {
+    if (nf - ng).length() > NORMAL_TOL {
+        return false;
+    }
+    let pts = |h: &[u32]| h.iter().map(|&v| positions[v as usize]).collect::<Vec<_>>();
+    let o = positions[f[0] as usize];
+    let (pf, pg) = (pts(f), pts(g));
+    let size = pf
+        .iter()
+        .chain(&pg)
+        .map(|&p| (p - o).length())
+        .fold(0.0, f64::max);
+    pg.iter()
+        .all(|&p| nf.dot(p - o).abs() <= PLANE_DISTANCE * size)
 }
 
 /// The boundary of the union of `group`'s faces as one simple loop (counter-clockwise from

@@ -122,11 +122,30 @@ pub fn kernel_guard(positions: &[DVec3], face: &[u32], normal: DVec3) -> Option<
             DVec2::new(p.dot(u), p.dot(v))
         })
         .collect();
-    let n = flat.len();
     let area = polygon_area(&flat);
     if area <= 0.0 {
         return None;
     }
+    let kernel = kernel_region(&flat)?;
+    let ka = polygon_area(&kernel);
+    if ka < MIN_KERNEL_AREA * area {
+        return None;
+    }
+    // Area centroid of the kernel.
+    let mut c = DVec2::ZERO;
+    for k in 0..kernel.len() {
+        let (p, q) = (kernel[k], kernel[(k + 1) % kernel.len()]);
+        c += (p + q) * p.perp_dot(q);
+    }
+    c /= 6.0 * ka;
+    Some(o + c.x * u + c.y * v)
+}
+
+/// The kernel of a counter-clockwise 2D polygon (the intersection of the inner half-planes of
+/// its edges) as a convex polygon, or `None` when it has fewer than three corners (empty).
+#[must_use]
+pub fn kernel_region(flat: &[DVec2]) -> Option<Vec<DVec2>> {
+    let n = flat.len();
     let (lo, hi) = flat.iter().fold(
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
         |(a, b), &p| (a.min(p), b.max(p)),
@@ -151,29 +170,20 @@ pub fn kernel_guard(positions: &[DVec3], face: &[u32], normal: DVec3) -> Option<
             return None;
         }
     }
-    let ka = polygon_area(&kernel);
-    if ka < MIN_KERNEL_AREA * area {
-        return None;
-    }
-    // Area centroid of the kernel.
-    let mut c = DVec2::ZERO;
-    for k in 0..kernel.len() {
-        let (p, q) = (kernel[k], kernel[(k + 1) % kernel.len()]);
-        c += (p + q) * p.perp_dot(q);
-    }
-    c /= 6.0 * ka;
-    Some(o + c.x * u + c.y * v)
+    Some(kernel)
 }
 
 /// Signed area of a 2D polygon (positive counter-clockwise).
-fn polygon_area(p: &[DVec2]) -> f64 {
+#[must_use]
+pub fn polygon_area(p: &[DVec2]) -> f64 {
     let n = p.len();
     0.5 * (0..n).map(|k| p[k].perp_dot(p[(k + 1) % n])).sum::<f64>()
 }
 
-/// Hertel–Mehlhorn: removes diagonals between triangles of one polygon while the union of the
+/// Hertel–Mehlhorn: removes diagonals between convex polygons (triangles of one polygon, or
+/// coplanar faces) while the union of the
 /// two pieces on either side stays convex (in the plane normal to `normal`).
-fn merge_convex(positions: &[DVec3], normal: DVec3, tris: Vec<Vec<u32>>) -> Vec<Vec<u32>> {
+pub fn merge_convex(positions: &[DVec3], normal: DVec3, tris: Vec<Vec<u32>>) -> Vec<Vec<u32>> {
     let u = normal.any_orthonormal_vector();
     let v = normal.cross(u);
     let flat = |i: u32| {
