@@ -6,8 +6,9 @@ use apatch::mesh::{self, NormalMethod};
 use apatch::scheme::quintic_c2::{build_with_stats, QuinticOptions};
 use std::path::Path;
 
-/// The scheme's defaults, with `LIFT=x`, `CURV=x`, `SIGNS=1` and `LU=0` in the environment
-/// overriding the lift, the curvature, the sign pins and the L-U completion (to explore).
+/// The scheme's defaults, with `LIFT=x`, `CURV=x`, `SIGNS=1`, `LU=0` and `JOINT=1` in the
+/// environment overriding the lift, the curvature, the sign pins, the L-U completion and the
+/// joint stars (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -20,6 +21,7 @@ fn options() -> QuinticOptions {
             .and_then(|x| x.parse().ok())
             .unwrap_or(1.0),
         complete_lu_pairs: std::env::var("LU").map_or(true, |s| s != "0"),
+        joint_stars: std::env::var("JOINT").is_ok_and(|s| s == "1"),
     }
 }
 

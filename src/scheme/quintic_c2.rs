@@ -38,6 +38,11 @@ pub struct QuinticOptions {
     /// data have the apex's sign ([`signs::base_conflicts`]), so with one side only the
     /// surface would leave the hull through the base (a hole).
     pub complete_lu_pairs: bool,
+    /// Solve every point's star together with the number 3/4 weights of its edges and its
+    /// Hessian (number 2 weights, closest to the estimate), as the solve does for points not in
+    /// general position: the square systems of appendices D and E then have free dimensions
+    /// that [`QuinticOptions::signs`] can use. Slower (larger groups).
+    pub joint_stars: bool,
     /// Enforce Theorem 2.1's sign conditions (k = 1, [`signs`]) on the weights the C2
     /// constraints leave free, by pinning the ones whose targets miss their sign.
     pub signs: bool,
@@ -50,6 +55,7 @@ impl Default for QuinticOptions {
             lift: LIFT,
             signs: false,
             complete_lu_pairs: true,
+            joint_stars: false,
         }
     }
 }
@@ -86,6 +92,13 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "joint_stars" => match v.as_bool() {
+                    Some(b) => o.joint_stars = b,
+                    None => bail!(
+                        "{}: `scheme.joint_stars` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => match v.as_bool() {
                     Some(b) => o.signs = b,
                     None => bail!(
@@ -104,7 +117,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }
@@ -146,7 +159,14 @@ pub fn build_with_stats(
     let (tets, _pos) = system::tetrahedra(hull)?;
     let sys = system::assemble(&tets, np)?;
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
-    let (value, mut stats) = sys.solve(&tets, &jets, nt, &target, options.signs)?;
+    let (value, mut stats) = sys.solve(
+        &tets,
+        &jets,
+        nt,
+        &target,
+        options.signs,
+        options.joint_stars,
+    )?;
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
     stats.lu_completed = lu_completed.len();
     let mut complex = PatchComplex::new("quintic-c2");

@@ -400,8 +400,12 @@ impl System {
     /// tetrahedra) is inconsistent with the free weights fixed before it, every unknown is solved
     /// at once instead, closest to its target ([`SolveStats::global`]).
     ///
+    /// With `pin`, Theorem 2.1's signs are enforced where the groups allow ([`pin_signs`]);
+    /// with `joint_stars`, every point starts relaxed at level 2.
+    ///
     /// # Errors
     /// A group whose equations cannot be met even so, naming where.
+    #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &self,
         tets: &[HullTet],
@@ -409,8 +413,16 @@ impl System {
         nt: u32,
         target: &dyn Fn(usize, [u8; 4]) -> f64,
         pin: bool,
+        joint_stars: bool,
     ) -> Result<(Vec<f64>, SolveStats)> {
         let mut level: HashMap<u32, u8> = HashMap::new();
+        if joint_stars {
+            // Every star with its edge middles and its point's Hessian, closest to the
+            // targets and the estimates: the stars' square systems get free dimensions.
+            for p in 0..self.np {
+                level.insert(p, 2);
+            }
+        }
         let mut first_failure = None;
         for _pass in 0..6 {
             let (value, mut stats, failures) =
