@@ -6,14 +6,22 @@ use apatch::mesh::{self, NormalMethod};
 use apatch::scheme::quintic_c2::{build_with_stats, QuinticOptions};
 use std::path::Path;
 
-/// The scheme's defaults, with `LIFT=x` in the environment overriding the lift (to explore).
+/// The scheme's defaults, with `LIFT=x`, `CURV=x`, `SIGNS=1`, `LU=0` and `JOINT=1` in the
+/// environment overriding the lift, the curvature, the sign pins, the L-U completion and the
+/// joint stars (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
             .ok()
             .and_then(|x| x.parse().ok())
             .unwrap_or(apatch::scheme::quintic_c2::LIFT),
-        ..QuinticOptions::default()
+        signs: std::env::var("SIGNS").is_ok_and(|s| s == "1"),
+        curvature: std::env::var("CURV")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(1.0),
+        complete_lu_pairs: std::env::var("LU").map_or(true, |s| s != "0"),
+        joint_stars: std::env::var("JOINT").is_ok_and(|s| s == "1"),
     }
 }
 
@@ -86,6 +94,11 @@ fn inner_hull_models_are_c2() {
         let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
         let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
         let (c, stats) = build_with_stats(&hull, &options()).unwrap();
+        // No single-sided face tetrahedron has a base weight the data fix with its apex's
+        // sign (the torus's holes, see torus_holes_are_base_conflicts_of_the_hull).
+        if !name.contains("torus") {
+            assert_eq!(stats.signs.base_conflicts, 0, "{name}");
+        }
         // Relative residual of the solved equations: rounding of short sums.
         assert!(stats.max_residual < 1e-12, "{name}: {stats:?}");
         let r = check(&c, &CheckOptions::default());
@@ -182,11 +195,14 @@ fn global_fallback_uses_sparse_solver() {
     let r = check(&c, &CheckOptions::default());
     assert!(r.gradient_jump.worst <= 1e-9, "{:?}", r.gradient_jump);
     assert!(r.hessian_jump.worst <= 1e-7, "{:?}", r.hessian_jump);
-    // Known wrong: `check` finds holes here (2 bases of single-sided face tetrahedra at the flat
-    // top, where F leaves zero along the zero-convex edge; 10 of 20000 rays from inside escape
-    // through them, none on the cubic complex of the same hull). This test proves C2.
+    // Known wrong since `check` detects holes: on this former hull the surface crosses 2 of the
+    // 98 boundary faces (the bases at the split top face's middle edge, depth 3e-3): the jets
+    // of its coplanar points and the number 3 weights the global solve gives that edge miss
+    // Theorem 2.1's base sign (`stats.signs`: 2 jet and 20 edge-middle weights). The shipped
+    // cube_poly hull merges the top face and has no holes.
     let f: Vec<&str> = r.failures().into_iter().filter(|f| *f != "holes").collect();
     assert!(f.is_empty(), "{f:?}");
+    assert!(r.holes.crossing <= 2, "{:?}", r.holes);
 }
 
 /// torus_quad (quad faces in 50 coplanar stars, a group of over 7000 weights) is C2 through
@@ -337,4 +353,211 @@ fn base_crossings() {
         "{}: {bad} of {faces} single-sided face patches cross their base",
         path.display()
     );
+}
+
+/// Exploration: per patch of a scene, its j-lines crossed twice and its weights' Theorem 2.1
+/// sign misses by level.
+#[test]
+#[ignore = "exploration: SCENE=path"]
+fn jline_patches() {
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    let sc = apatch::scene::load(&path).unwrap();
+    let c = apatch::scene::build_complex(&sc).unwrap();
+    for (k, p) in c.patches.iter().enumerate() {
+        let mut one = c.clone();
+        one.patches = vec![p.clone()];
+        let r = check(&one, &CheckOptions::default());
+        if r.sheets.j_multi_lines == 0 {
+            continue;
+        }
+        let mi = apatch::bb::multi_indices(usize::from(p.degree));
+        let apex = p.weights[apatch::bb::index_of([0, 0, 0, p.degree])];
+        let s = apex.signum();
+        let mut lv = String::new();
+        for (i, l) in mi.iter().enumerate() {
+            let level = if p.role == apatch::complex::Role::Edge {
+                l[2] + l[3]
+            } else {
+                l[3]
+            };
+            let w = p.weights[i];
+            let bad = (level == 0 && w * s > 1e-12) || (level >= 2 && w * s < -1e-12);
+            if bad {
+                lv += &format!(" {l:?}={w:.2e}");
+            }
+        }
+        eprintln!(
+            "patch {k} {:?} el {} multi {} of {} F(v2) {:.3e} F(v3) {:.3e} tet {:?} at {:?}: misses{lv}",
+            p.role, p.element, r.sheets.j_multi_lines, r.sheets.j_lines,
+            p.weights[apatch::bb::index_of([0, 0, p.degree, 0])], apex, p.tet, r.sheets.j_multi_at
+        );
+    }
+}
+
+/// The holes of the 12×8 torus come from the hull's data, not from the free weights: every
+/// single-sided face patch whose zero set crosses its base triangle (F sampled on the base
+/// with the apex's sign, an independent measurement of the built surface) sits on a triangle
+/// that `signs::base_conflicts` flags from the normals and points of T alone (a number 1
+/// weight of the base with the apex's sign, which Theorem 2.1 forbids and no free weight can
+/// change), with or without the sign pins. The inner hull now gives those triangles both
+/// sides itself (`hull::inner::sides`), so the test takes the inner apex away again from every
+/// double-sided triangle that is not convex for its outer side: the single-sided hull the
+/// torus had before.
+#[test]
+fn torus_holes_are_base_conflicts_of_the_hull() {
+    use apatch::hull::simplicial::Side;
+    use apatch::scheme::quintic_c2::{signs, system};
+    let path = Path::new("scenes/models/torus_quad12x8.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let mut hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+    for t in 0..hull.triangles.len() {
+        if hull.apexes[t].iter().all(Option::is_some) {
+            let mut one = hull.clone();
+            one.apexes[t][Side::Inner as usize] = None;
+            if signs::base_conflicts(&one)
+                .iter()
+                .any(|c| c.triangle == t as u32)
+            {
+                hull.apexes[t][Side::Inner as usize] = None;
+            }
+        }
+    }
+    let conflicts = signs::base_conflicts(&hull);
+    let flagged: std::collections::HashSet<u32> = conflicts.iter().map(|c| c.triangle).collect();
+    assert!(!flagged.is_empty());
+    let (tets, _) = system::tetrahedra(&hull).unwrap();
+    for pins in [false, true] {
+        let o = QuinticOptions {
+            signs: pins,
+            complete_lu_pairs: false,
+            ..QuinticOptions::default()
+        };
+        let (c, stats) = build_with_stats(&hull, &o).unwrap();
+        // Theorem 2.1's count agrees: the jets miss their sign exactly on flagged triangles'
+        // edges (number 1 weights and their Hessian neighbours on the same edges).
+        assert!(stats.signs.violated_by_stage[0] > 0, "{stats:?}");
+        let mut crossing = 0;
+        for (k, p) in c.patches.iter().enumerate() {
+            let t = &tets[k];
+            let single = hull.apexes[t.triangle as usize]
+                .iter()
+                .filter(|a| a.is_some())
+                .count()
+                == 1;
+            if p.role != apatch::complex::Role::Face || !single {
+                continue;
+            }
+            let apex = p.weights[apatch::bb::index_of([0, 0, 0, 5])];
+            let m = 24;
+            let mut crosses = false;
+            for i in 1..m {
+                for j in 1..m - i {
+                    let a = [i, j, m - i - j].map(|x| x as f64 / m as f64);
+                    let f = p.value_bary([a[0], a[1], a[2], 0.0]);
+                    // Far above rounding (F is O(1e-2) on these bases).
+                    if f * apex > 1e-12 {
+                        crosses = true;
+                    }
+                }
+            }
+            if crosses {
+                crossing += 1;
+                assert!(
+                    flagged.contains(&t.triangle),
+                    "patch {k} crosses its base on unflagged triangle {}",
+                    t.triangle
+                );
+            }
+        }
+        // And every flagged triangle does cross: the prediction is exact.
+        assert_eq!(crossing, flagged.len(), "pins {pins}");
+        assert_eq!(stats.signs.base_conflicts, conflicts.len());
+        eprintln!(
+            "pins {pins}: {crossing} crossing patches, {} flagged triangles, {} conflicts",
+            flagged.len(),
+            conflicts.len()
+        );
+    }
+    // With the L-U completion (the default) every flagged triangle gets its partner
+    // tetrahedron and no face tetrahedron's base is crossed any more.
+    let (c, stats) = build_with_stats(&hull, &QuinticOptions::default()).unwrap();
+    assert_eq!(stats.lu_completed, flagged.len(), "{stats:?}");
+    assert_eq!(stats.signs.base_conflicts, 0, "{stats:?}");
+    let r = check(&c, &CheckOptions::default());
+    assert_eq!(
+        r.holes.crossing_by_role.get("face").copied().unwrap_or(0),
+        0,
+        "{:?}",
+        r.holes
+    );
+}
+
+/// Exploration: `SCENE=path PATCH=k`: the weights of patch k on its faces through the apex
+/// side (λ_0 = 0, λ_1 = 0) and its tetrahedron.
+#[test]
+#[ignore = "exploration: SCENE=path PATCH=k"]
+fn patch_faces() {
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    let k: usize = std::env::var("PATCH").unwrap().parse().unwrap();
+    let sc = apatch::scene::load(&path).unwrap();
+    let c = apatch::scene::build_complex(&sc).unwrap();
+    let p = &c.patches[k];
+    eprintln!("patch {k} {:?} tet {:?}", p.role, p.tet);
+    for (i, l) in apatch::bb::multi_indices(5).iter().enumerate() {
+        if l[0] == 0 || l[1] == 0 {
+            eprintln!("{l:?} {:.4e}", p.weights[i]);
+        }
+    }
+}
+
+/// Theorem 2.1 (k = 1) holds for every weight of every patch on the convex test polyhedra:
+/// read from the built complex alone (each patch's side from its apex weight, F > 0 outside),
+/// face patches have base weights (λ_q = 0) ≤ 0 and weights with λ_q ≥ 2 ≥ 0, edge patches
+/// the same by μ_q + μ_s; so each is a j-patch by the theorem, not only by sampling. The
+/// scheme's own count (`stats.signs`) agrees. (On the octahedron, the prisms and the torus the
+/// determined star weights of appendices D and E miss their signs: docs/quintic.md.)
+#[test]
+fn theorem_2_1_holds_on_convex_models() {
+    for name in [
+        "cube.obj",
+        "tetrahedron.obj",
+        "icosahedron.obj",
+        "dodecahedron.obj",
+        "cube_poly.obj",
+    ] {
+        let path = Path::new("scenes/models").join(name);
+        let (m, _) = mesh::load(&path).unwrap();
+        let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+        let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+        let (c, stats) = build_with_stats(&hull, &QuinticOptions::default()).unwrap();
+        assert_eq!(stats.signs.violated(), 0, "{name}: {:?}", stats.signs);
+        let wmax = c
+            .patches
+            .iter()
+            .flat_map(|p| p.weights.iter())
+            .fold(0.0_f64, |a, w| a.max(w.abs()));
+        // Zero weights (F = 0 at T's points) carry rounding of the blossoms: 1e-12 relative.
+        let tiny = 1e-12 * wmax;
+        let mi = apatch::bb::multi_indices(5);
+        for (k, p) in c.patches.iter().enumerate() {
+            let apex = p.weights[apatch::bb::index_of([0, 0, 0, 5])];
+            // Every patch here lies outside T (single-sided convex hull): apex F > 0.
+            assert!(apex > 0.0, "{name} patch {k}");
+            for (i, l) in mi.iter().enumerate() {
+                let level = if p.role == apatch::complex::Role::Edge {
+                    l[2] + l[3]
+                } else {
+                    l[3]
+                };
+                let w = p.weights[i];
+                let ok = match level {
+                    0 => w <= tiny,
+                    1 => true,
+                    _ => w >= -tiny,
+                };
+                assert!(ok, "{name} patch {k} ({:?}) weight {l:?} = {w:e}", p.role);
+            }
+        }
+    }
 }

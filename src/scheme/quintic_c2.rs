@@ -10,6 +10,7 @@
 
 pub mod dense;
 pub mod jets;
+pub mod signs;
 pub mod sparse;
 pub mod system;
 
@@ -31,6 +32,20 @@ pub struct QuinticOptions {
     /// Lift of the free weights toward the vertices off T (apexes, edge midpoints), in units of
     /// their height above T: 0 = the plain blend of the Taylor polynomials.
     pub lift: f64,
+    /// Give single-sided triangles of T that are not convex for their side the partner
+    /// tetrahedron of an L-U pair before building (Definition 3.6 (4); the cubic scheme's
+    /// [`crate::scheme::cubic_c1::sided::complete_lu_pairs`]): their base weights fixed by the
+    /// data have the apex's sign ([`signs::base_conflicts`]), so with one side only the
+    /// surface would leave the hull through the base (a hole).
+    pub complete_lu_pairs: bool,
+    /// Solve every point's star together with the number 3/4 weights of its edges and its
+    /// Hessian (number 2 weights, closest to the estimate), as the solve does for points not in
+    /// general position: the square systems of appendices D and E then have free dimensions
+    /// that [`QuinticOptions::signs`] can use. Slower (larger groups).
+    pub joint_stars: bool,
+    /// Enforce Theorem 2.1's sign conditions (k = 1, [`signs`]) on the weights the C2
+    /// constraints leave free, by pinning the ones whose targets miss their sign.
+    pub signs: bool,
 }
 
 impl Default for QuinticOptions {
@@ -38,6 +53,9 @@ impl Default for QuinticOptions {
         QuinticOptions {
             curvature: 1.0,
             lift: LIFT,
+            signs: false,
+            complete_lu_pairs: true,
+            joint_stars: false,
         }
     }
 }
@@ -67,6 +85,27 @@ impl QuinticOptions {
                         ),
                     }
                 }
+                "complete_lu_pairs" => match v.as_bool() {
+                    Some(b) => o.complete_lu_pairs = b,
+                    None => bail!(
+                        "{}: `scheme.complete_lu_pairs` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
+                "joint_stars" => match v.as_bool() {
+                    Some(b) => o.joint_stars = b,
+                    None => bail!(
+                        "{}: `scheme.joint_stars` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
+                "signs" => match v.as_bool() {
+                    Some(b) => o.signs = b,
+                    None => bail!(
+                        "{}: `scheme.signs` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
                     match x {
@@ -78,7 +117,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }
@@ -108,13 +147,28 @@ pub fn build_with_stats(
     options: &QuinticOptions,
 ) -> Result<(PatchComplex, BuildStats)> {
     validate(hull)?;
+    let (completed, lu_completed) = if options.complete_lu_pairs {
+        crate::scheme::cubic_c1::sided::complete_lu_pairs(hull)
+    } else {
+        (hull.clone(), Vec::new())
+    };
+    let hull = &completed;
     let np = hull.points.len() as u32;
     let nt = hull.triangles.len() as u32;
     let jets = jets::estimate(hull, options.curvature);
     let (tets, _pos) = system::tetrahedra(hull)?;
     let sys = system::assemble(&tets, np)?;
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
-    let (value, stats) = sys.solve(&tets, &jets, nt, &target)?;
+    let (value, mut stats) = sys.solve(
+        &tets,
+        &jets,
+        nt,
+        &target,
+        options.signs,
+        options.joint_stars,
+    )?;
+    stats.signs.base_conflicts = signs::base_conflicts(hull).len();
+    stats.lu_completed = lu_completed.len();
     let mut complex = PatchComplex::new("quintic-c2");
     complex.continuity = Some(2);
     complex.vertices = hull.points.iter().map(|p| p.to_array()).collect();

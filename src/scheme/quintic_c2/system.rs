@@ -30,6 +30,7 @@
 //! 6. everything else in the edge tetrahedra (number 14, 15, 17 and the free ones of λ4 > 2).
 
 use super::jets::Jet;
+use super::signs::{self, SignStats};
 use super::{dense, sparse};
 use crate::bb::{multi_indices, Tet};
 use crate::complex::Role;
@@ -166,6 +167,8 @@ pub struct System {
     equations: Vec<Equation>,
     /// Number of points of T (global ids below are points of T).
     np: u32,
+    /// Sign Theorem 2.1 asks of every slot ([`signs::required`] combined over its tetrahedra).
+    req: Vec<i8>,
 }
 
 /// Builds the slots and the C1/C2 equations of every shared face.
@@ -189,6 +192,20 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
             });
         }
         slot_of.push(s);
+    }
+    // Theorem 2.1's signs per slot; a triangle with face tetrahedra on both sides is an L-U
+    // pair, whose shared base carries none.
+    let mut sides: HashMap<u32, u8> = HashMap::new();
+    for tet in tets.iter().filter(|t| t.role == Role::Face) {
+        *sides.entry(tet.triangle).or_insert(0) += 1;
+    }
+    let mut req = vec![0i8; keys.len()];
+    for (t, tet) in tets.iter().enumerate() {
+        let double = tet.role == Role::Face && sides.get(&tet.triangle).copied() == Some(2);
+        for (i, &l) in mi.iter().enumerate() {
+            let s = slot_of[t][i] as usize;
+            req[s] = signs::combine(req[s], signs::required(tet, l, double));
+        }
     }
     // Faces → (tetrahedron, local opposite vertex).
     let mut faces: HashMap<[u32; 3], Vec<(u32, usize)>> = HashMap::new();
@@ -232,6 +249,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         home,
         equations,
         np,
+        req,
     })
 }
 
@@ -356,6 +374,11 @@ pub struct SolveStats {
     pub global: bool,
     /// Groups above [`DENSE_LIMIT`] unknowns, solved by [`sparse`].
     pub sparse_groups: usize,
+    /// How the weights meet Theorem 2.1's sign conditions ([`signs`]).
+    pub signs: SignStats,
+    /// Triangles of T given the partner apex of an L-U pair before building
+    /// (`QuinticOptions::complete_lu_pairs`).
+    pub lu_completed: usize,
 }
 
 /// A group whose equations could not be met in one pass.
@@ -377,20 +400,33 @@ impl System {
     /// tetrahedra) is inconsistent with the free weights fixed before it, every unknown is solved
     /// at once instead, closest to its target ([`SolveStats::global`]).
     ///
+    /// With `pin`, Theorem 2.1's signs are enforced where the groups allow ([`pin_signs`]);
+    /// with `joint_stars`, every point starts relaxed at level 2.
+    ///
     /// # Errors
     /// A group whose equations cannot be met even so, naming where.
+    #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &self,
         tets: &[HullTet],
         jets: &[Jet],
         nt: u32,
         target: &dyn Fn(usize, [u8; 4]) -> f64,
+        pin: bool,
+        joint_stars: bool,
     ) -> Result<(Vec<f64>, SolveStats)> {
         let mut level: HashMap<u32, u8> = HashMap::new();
+        if joint_stars {
+            // Every star with its edge middles and its point's Hessian, closest to the
+            // targets and the estimates: the stars' square systems get free dimensions.
+            for p in 0..self.np {
+                level.insert(p, 2);
+            }
+        }
         let mut first_failure = None;
         for _pass in 0..6 {
             let (value, mut stats, failures) =
-                self.solve_pass(tets, jets, nt, target, &level, false);
+                self.solve_pass(tets, jets, nt, target, &level, false, pin);
             if failures.is_empty() {
                 stats.relaxed_points = level.len();
                 return Ok((value, stats));
@@ -430,7 +466,8 @@ impl System {
         // The staged solve fixed free weights that a later stage cannot live with (e.g. the
         // number 10 system of an edge whose apexes lie in the planes of its points' faces, as on
         // cube_poly): solve every unknown at once, each connected group closest to its targets.
-        let (value, mut stats, failures) = self.solve_pass(tets, jets, nt, target, &level, true);
+        let (value, mut stats, failures) =
+            self.solve_pass(tets, jets, nt, target, &level, true, pin);
         if failures.is_empty() {
             stats.relaxed_points = level.len();
             stats.global = true;
@@ -443,7 +480,7 @@ impl System {
         )))
     }
 
-    #[allow(clippy::too_many_lines)]
+    #[allow(clippy::too_many_lines, clippy::too_many_arguments)]
     fn solve_pass(
         &self,
         tets: &[HullTet],
@@ -452,6 +489,7 @@ impl System {
         target: &dyn Fn(usize, [u8; 4]) -> f64,
         level: &HashMap<u32, u8>,
         global: bool,
+        pin: bool,
     ) -> (Vec<f64>, SolveStats, Vec<Failure>) {
         let ns = self.keys.len();
         let np = self.np;
@@ -517,6 +555,15 @@ impl System {
                 .max()
                 .unwrap_or(0);
             by_stage[usize::from(st)].push(e);
+        }
+        // Equations of each slot (for the look-ahead sign conditions).
+        let mut eqs_of: Vec<Vec<u32>> = vec![Vec::new(); if pin { ns } else { 0 }];
+        if pin {
+            for (e, eq) in self.equations.iter().enumerate() {
+                for t in &eq.terms {
+                    eqs_of[t.0 as usize].push(e as u32);
+                }
+            }
         }
         let mut stats = SolveStats {
             unknowns: known.iter().filter(|k| !**k).count(),
@@ -609,7 +656,7 @@ impl System {
                 let col: HashMap<u32, usize> =
                     unk.iter().enumerate().map(|(i, s)| (*s, i)).collect();
                 let (m, n) = (eqs.len(), unk.len());
-                let mut rows: Vec<sparse::Row> = Vec::with_capacity(m);
+                let mut rows: Vec<sparse::Row> = Vec::with_capacity(m + n);
                 let mut c = vec![0.0; m];
                 for (i, &e) in eqs.iter().enumerate() {
                     let mut row = Vec::new();
@@ -637,22 +684,19 @@ impl System {
                     .iter()
                     .chain(tgt.iter())
                     .fold(1e-300_f64, |acc, x| acc.max(x.abs()));
-                let sol = if n <= DENSE_LIMIT {
-                    let mut a = vec![0.0; m * n];
-                    for (i, row) in rows.iter().enumerate() {
-                        for &(j, k) in row {
-                            a[i * n + j] += k;
-                        }
-                    }
-                    dense::solve_near(&a, m, n, &c, &tgt, 1e-11)
-                } else {
+                if n > DENSE_LIMIT {
                     stats.sparse_groups += 1;
-                    sparse::solve_near(&rows, n, &c, &tgt, 1e-13 * scale, SPARSE_ITERATIONS)
-                };
-                let bad = sol.residual.is_nan()
-                    || sol.residual > 1e-9 * scale
-                    || sol.x.iter().any(|x| !x.is_finite());
-                if bad {
+                }
+                let mut sol = solve_rows(&rows, n, &c, &tgt, scale);
+                if pin && consistent(&sol, scale) {
+                    let conds =
+                        self.sign_conditions(&unk, &col, &value, &known, &stage_of, st, &eqs_of);
+                    let (pinned, given_up) =
+                        pin_signs(&mut sol, &mut rows, &mut c, &conds, &tgt, scale);
+                    stats.signs.pinned += pinned;
+                    stats.signs.given_up += given_up;
+                }
+                if !consistent(&sol, scale) {
                     let pts = where_();
                     let what = match st {
                         1 => format!("the middle of hull edge {pts:?}"),
@@ -692,7 +736,113 @@ impl System {
             })
             .fold(0.0, f64::max)
             / wmax;
+        let (pinned, given_up) = (stats.signs.pinned, stats.signs.given_up);
+        stats.signs = self.sign_stats(&value, &stage_of);
+        stats.signs.pinned = pinned;
+        stats.signs.given_up = given_up;
         (value, stats, failures)
+    }
+
+    /// Theorem 2.1's sign conditions on the group `unk` (columns `col`) at stage `st`: its own
+    /// unknowns with a sign, and later weights that a single equation fixes from this group's
+    /// unknowns and known weights (so the group can keep them signed, which their own stage
+    /// could not: they are determined there).
+    #[allow(clippy::too_many_arguments)]
+    fn sign_conditions(
+        &self,
+        unk: &[u32],
+        col: &HashMap<u32, usize>,
+        value: &[f64],
+        known: &[bool],
+        stage_of: &[u8],
+        st: u8,
+        eqs_of: &[Vec<u32>],
+    ) -> Vec<SignCondition> {
+        let mut out = Vec::new();
+        for (j, &s) in unk.iter().enumerate() {
+            let r = self.req[s as usize];
+            if r == 1 || r == -1 {
+                out.push(SignCondition {
+                    row: vec![(j, 1.0)],
+                    offset: 0.0,
+                    sign: f64::from(r),
+                });
+            }
+        }
+        let mut seen: Vec<u32> = unk
+            .iter()
+            .flat_map(|&s| eqs_of[s as usize].iter().copied())
+            .collect();
+        seen.sort_unstable();
+        seen.dedup();
+        let mut later_seen: HashMap<u32, ()> = HashMap::new();
+        for e in seen {
+            let eq = &self.equations[e as usize];
+            let mut later: Option<(u32, f64)> = None;
+            let mut ok = true;
+            let mut row: sparse::Row = Vec::new();
+            let mut offset = 0.0;
+            for &(s, k) in &eq.terms {
+                if let Some(&j) = col.get(&s) {
+                    row.push((j, k));
+                } else if known[s as usize] {
+                    offset += k * value[s as usize];
+                } else if later.is_none() && stage_of[s as usize] > st {
+                    later = Some((s, k));
+                } else {
+                    ok = false;
+                    break;
+                }
+            }
+            let Some((b, kb)) = later else { continue };
+            let r = self.req[b as usize];
+            // One condition per later weight; the defining equations have coefficient 1 on it.
+            if !ok || row.is_empty() || !(r == 1 || r == -1) || kb.abs() < 0.5 {
+                continue;
+            }
+            if later_seen.insert(b, ()).is_some() {
+                continue;
+            }
+            // k_b·b + row·x + offset = 0  ⇒  b = −(row·x + offset)/k_b.
+            for t in &mut row {
+                t.1 /= -kb;
+            }
+            out.push(SignCondition {
+                row,
+                offset: -offset / kb,
+                sign: f64::from(r),
+            });
+        }
+        out
+    }
+
+    /// Theorem 2.1's signs of the solved `value`s, violations by the stage that fixed them.
+    fn sign_stats(&self, value: &[f64], stage_of: &[u8]) -> SignStats {
+        let mut st = SignStats::default();
+        let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
+        // A weight this small relative to the largest is zero up to the rounding of the
+        // solves (residuals ≤ 1e-12 relative): it meets either sign.
+        let tiny = 1e-12 * wmax;
+        let mut bad = vec![false; value.len()];
+        for (s, &r) in self.req.iter().enumerate() {
+            match r {
+                0 => {}
+                signs::CONFLICT => st.conflicts += 1,
+                _ => {
+                    st.constrained += 1;
+                    if f64::from(r) * value[s] < -tiny {
+                        bad[s] = true;
+                        st.violated_by_stage[usize::from(stage_of[s].min(6))] += 1;
+                    }
+                }
+            }
+        }
+        st.violating_patches = self
+            .slot_of
+            .iter()
+            .filter(|slots| slots.iter().any(|&s| bad[s as usize]))
+            .count();
+        st
     }
 
     /// The 56 weights of tetrahedron `t` from the slot values.
@@ -700,4 +850,134 @@ impl System {
     pub fn weights(&self, t: usize, value: &[f64]) -> Vec<f64> {
         self.slot_of[t].iter().map(|&s| value[s as usize]).collect()
     }
+}
+
+/// Whether a group's solution meets its equations (to 1e-9 of the group's largest datum: far
+/// above the rounding of the solves, far below any inconsistency the systems have shown).
+fn consistent(sol: &dense::Solution, scale: f64) -> bool {
+    !(sol.residual.is_nan() || sol.residual > 1e-9 * scale || sol.x.iter().any(|x| !x.is_finite()))
+}
+
+/// A group's weights closest to `tgt` subject to `rows`·x = `c`: dense up to
+/// [`DENSE_LIMIT`] unknowns, else sparse.
+fn solve_rows(
+    rows: &[sparse::Row],
+    n: usize,
+    c: &[f64],
+    tgt: &[f64],
+    scale: f64,
+) -> dense::Solution {
+    let m = rows.len();
+    if n <= DENSE_LIMIT {
+        let mut a = vec![0.0; m * n];
+        for (i, row) in rows.iter().enumerate() {
+            for &(j, k) in row {
+                a[i * n + j] += k;
+            }
+        }
+        dense::solve_near(&a, m, n, c, tgt, 1e-11)
+    } else {
+        sparse::solve_near(rows, n, c, tgt, 1e-13 * scale, SPARSE_ITERATIONS)
+    }
+}
+
+/// Rounds of [`pin_signs`] per group.
+const PIN_ROUNDS: usize = 8;
+/// How much larger than the unpinned solution's largest weight (or the group's data) a pinned
+/// solution's weights may grow.
+const PIN_GROWTH: f64 = 2.0;
+/// Pins tried one at a time per group when a round's pins together are inconsistent.
+const PIN_SINGLE_TRIES: usize = 48;
+
+/// One of Theorem 2.1's sign conditions on a group: `sign` · (`row`·x + `offset`) ≥ 0, where
+/// x are the group's unknowns: one of them (`row` = x_j), or a later weight that one equation
+/// fixes from this group and known weights (look-ahead).
+pub(crate) struct SignCondition {
+    row: sparse::Row,
+    offset: f64,
+    sign: f64,
+}
+
+impl SignCondition {
+    fn value(&self, x: &[f64]) -> f64 {
+        self.sign * (self.row.iter().map(|&(j, a)| a * x[j]).sum::<f64>() + self.offset)
+    }
+}
+
+/// Theorem 2.1's signs within one group (an active set): every condition the solution `sol`
+/// misses is pinned (its quantity set to its sign × a margin of 1e-6 of the group's scale, so
+/// rounding cannot flip it), and the group is solved again closest to the same targets, until
+/// no condition is missed. Pins that the equations cannot live with (the group turns
+/// inconsistent, or other weights would have to grow past [`PIN_GROWTH`]) are tried one at a
+/// time and the ones that still conflict are given up. Returns (pinned, given up).
+fn pin_signs(
+    sol: &mut dense::Solution,
+    rows: &mut Vec<sparse::Row>,
+    c: &mut Vec<f64>,
+    conds: &[SignCondition],
+    tgt: &[f64],
+    scale: f64,
+) -> (usize, usize) {
+    let n = tgt.len();
+    let margin = 1e-6 * scale;
+    // Rounding of the solves (residual ≤ 1e-9 scale is accepted as consistent).
+    let tiny = 1e-9 * scale;
+    let mut done = vec![false; conds.len()];
+    let (mut pinned, mut given_up) = (0, 0);
+    // A pin that is nearly dependent on the equations is met only by moving other weights far
+    // (weights of 20× the data were seen): such a solution is refused like an inconsistent one.
+    let bound = PIN_GROWTH * sol.x.iter().fold(scale, |a, x| a.max(x.abs()));
+    let acceptable =
+        |s: &dense::Solution| consistent(s, scale) && s.x.iter().all(|x| x.abs() <= bound);
+    let misses = |x: &[f64], done: &[bool]| -> Vec<usize> {
+        let mut v: Vec<usize> = (0..conds.len())
+            .filter(|&k| !done[k] && conds[k].value(x) < -tiny)
+            .collect();
+        // Largest miss first.
+        v.sort_by(|&a, &b| conds[a].value(x).total_cmp(&conds[b].value(x)));
+        v
+    };
+    let push = |rows: &mut Vec<sparse::Row>, c: &mut Vec<f64>, k: usize| {
+        rows.push(conds[k].row.clone());
+        c.push(conds[k].sign * margin - conds[k].offset);
+    };
+    for _ in 0..PIN_ROUNDS {
+        let miss = misses(&sol.x, &done);
+        if miss.is_empty() {
+            break;
+        }
+        let m0 = rows.len();
+        for &k in &miss {
+            push(rows, c, k);
+        }
+        let all = solve_rows(rows, n, c, tgt, scale);
+        if acceptable(&all) {
+            *sol = all;
+            pinned += miss.len();
+            for &j in &miss {
+                done[j] = true;
+            }
+            continue;
+        }
+        rows.truncate(m0);
+        c.truncate(m0);
+        for (tries, &j) in miss.iter().enumerate() {
+            done[j] = true;
+            if tries >= PIN_SINGLE_TRIES {
+                given_up += 1;
+                continue;
+            }
+            push(rows, c, j);
+            let one = solve_rows(rows, n, c, tgt, scale);
+            if acceptable(&one) {
+                *sol = one;
+                pinned += 1;
+            } else {
+                rows.pop();
+                c.pop();
+                given_up += 1;
+            }
+        }
+    }
+    (pinned, given_up)
 }
