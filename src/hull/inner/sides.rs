@@ -53,6 +53,77 @@ pub struct SideCounts {
     pub kept: usize,
     /// Apex pairs raised so that their midpoint clears both triangles ([`raise_midpoints`]).
     pub raised: usize,
+    /// Zero-convex edges whose two triangles had no side in common and were asked for the
+    /// union of their sides ([`join_across_zero_edges`]).
+    pub coplanar_joined: usize,
+}
+
+/// The rule for zero-convex edges (coplanar neighbours, Appendix B). Such an edge asks for no
+/// side of its own (the surface lies in T's plane along it), but Definition 3.6 (5)(ii) still
+/// needs its two triangles to share a side so that edge tetrahedra join them. Where Algorithm
+/// 1's sides (or the sides the triangles' other edges ask for) have no side in common, both
+/// triangles are asked for the union of their sides; repeated until nothing changes, since a
+/// triangle given a new side may then disagree with a flat neighbour of its own. Returns the
+/// number of edges that changed something.
+///
+/// On the nut's flat annuli this removes all 33 edges without edge tetrahedra (1271 hull
+/// violations became 1238).
+fn join_across_zero_edges(
+    hull: &SimplicialHull,
+    edges: &[crate::hull::simplicial::HullEdge],
+    required: &mut [[bool; 2]],
+) -> usize {
+    let zero: Vec<(usize, usize)> = edges
+        .iter()
+        .filter(|e| e.faces[1] != u32::MAX)
+        .filter(|e| {
+            let [a, b] = e.v.map(|i| i as usize);
+            edge_convexity_1994(
+                hull.points[a],
+                hull.normals[a],
+                hull.points[b],
+                hull.normals[b],
+            ) == Convexity::Zero
+        })
+        // Net edges between two corner guards belong to the guard net (step (5')), whose cells'
+        // apexes `guardnet` places with their midpoints over the net edge; rebuilt over the
+        // base they overlap their neighbours (mpi_poly: 387 hull violations became 447).
+        .filter(|e| {
+            !e.v.iter()
+                .all(|&i| matches!(hull.origins[i as usize], PointOrigin::CornerGuard { .. }))
+        })
+        .map(|e| (e.faces[0] as usize, e.faces[1] as usize))
+        .filter(|&(f, g)| f < required.len() && g < required.len())
+        .collect();
+    let has = |required: &[[bool; 2]], t: usize| -> [bool; 2] {
+        let apex = hull.apexes.get(t).copied().unwrap_or([None, None]);
+        [
+            required[t][0] || apex[0].is_some(),
+            required[t][1] || apex[1].is_some(),
+        ]
+    };
+    let mut joined = 0;
+    for _ in 0..32 {
+        let mut changed = false;
+        for &(f, g) in &zero {
+            let (sf, sg) = (has(required, f), has(required, g));
+            if (sf[0] && sg[0]) || (sf[1] && sg[1]) {
+                continue;
+            }
+            let union = [sf[0] || sg[0], sf[1] || sg[1]];
+            if !union[0] && !union[1] {
+                continue;
+            }
+            required[f] = union;
+            required[g] = union;
+            joined += 1;
+            changed = true;
+        }
+        if !changed {
+            break;
+        }
+    }
+    joined
 }
 
 /// The sides (`[outer, inner]`) a surface crossing the edge (p_a, p_b) of T with normals n_a,
@@ -191,6 +262,7 @@ pub fn settle(hull: &mut SimplicialHull) -> SideCounts {
             }
         }
     }
+    counts.coplanar_joined = join_across_zero_edges(hull, &edges, &mut required);
     let mut rebuilt = vec![false; hull.triangles.len()];
     for (t, &req) in required.iter().enumerate() {
         if !req[0] && !req[1] {
@@ -351,6 +423,54 @@ mod tests {
         assert_eq!(edge_sides(a, tilt(0.3), b, tilt(-0.3)), [false, true]);
         assert_eq!(edge_sides(a, tilt(0.3), b, tilt(0.3)), [true, true]);
         assert_eq!(edge_sides(a, DVec3::Z, b, DVec3::Z), [false, false]);
+    }
+
+    /// Two coplanar triangles (a zero-convex shared edge, normals all +z) built with opposite
+    /// sides only: the shared edge asks for no side, so without the rule no edge tetrahedra
+    /// could join them. [`settle`] gives both the union of their sides (an L-U pair each, apexes
+    /// on either side of the plane), so every side one has the other has too.
+    #[test]
+    fn zero_convex_edge_joins_opposite_sides() {
+        let p = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+        ];
+        let mut hull = SimplicialHull {
+            points: p.to_vec(),
+            normals: vec![DVec3::Z; 4],
+            origins: vec![PointOrigin::Other; 4],
+            triangles: vec![[0, 1, 2], [2, 1, 3]],
+            apexes: vec![
+                [Some(DVec3::new(0.3, 0.3, 0.2)), None],
+                [None, Some(DVec3::new(0.7, 0.7, -0.2))],
+            ],
+            element: vec![0, 1],
+        };
+        let edges = hull.edges().unwrap();
+        let mut required = vec![[false; 2]; 2];
+        let joined = join_across_zero_edges(&hull, &edges, &mut required);
+        assert_eq!(joined, 1);
+        assert_eq!(required, vec![[true, true]; 2]);
+        // The same edge between two corner guards (a guard-net edge) is left to the net.
+        let mut guarded = hull.clone();
+        guarded.origins[1] = PointOrigin::CornerGuard { face: 0 };
+        guarded.origins[2] = PointOrigin::CornerGuard { face: 0 };
+        let mut req2 = vec![[false; 2]; 2];
+        assert_eq!(join_across_zero_edges(&guarded, &edges, &mut req2), 0);
+        // Through settle: both triangles end with apexes on both sides, the outer one above
+        // the plane z = 0 and the inner one below it.
+        let counts = settle(&mut hull);
+        assert_eq!(counts.coplanar_joined, 1);
+        for t in 0..2 {
+            let [o, i] = hull.apexes[t];
+            assert!(
+                o.unwrap().z > 0.0 && i.unwrap().z < 0.0,
+                "{:?}",
+                hull.apexes[t]
+            );
+        }
     }
 
     /// Two triangles folded 60° along their shared edge (a ridge of T) with low outer apexes:
