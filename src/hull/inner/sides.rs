@@ -240,7 +240,8 @@ fn apexes_along(
 
 /// Gives every triangle of `hull` the face tetrahedra its edges ask for, rebuilding the
 /// apexes over the base where a side is missing or an apex is not over its base (module docs).
-/// Triangles all of whose edges are zero convex (coplanar groups, Appendix B) keep theirs.
+/// Triangles all of whose edges are zero convex (coplanar groups, Appendix B) keep theirs,
+/// unless a flat neighbour shares no side with them ([`join_across_zero_edges`]).
 pub fn settle(hull: &mut SimplicialHull) -> SideCounts {
     let mut counts = SideCounts::default();
     let Ok(edges) = hull.edges() else {
