@@ -1,0 +1,141 @@
+//! Pockets next to edges of T on the side they do not ask for.
+//!
+//! An edge e = [p_i p_j] of T whose two triangles both carry a face tetrahedron on side σ (an L-U
+//! pair made double sided by their other edges) gets edge tetrahedra [p_i p_j q s] on σ even when
+//! e itself is convex for the other side only: its number 1 weights w_2100, w_1200 then have the
+//! sign σ (the side's sign conditions ask for −σ there), so F has the sign σ on e. The level-one weights of those edge tetrahedra, w_1110 =
+//! A_e(q) and w_1101 = A_e(s) (the edge blossom, [`super::weights::EdgeBlossom`]), are fixed by
+//! the number 2 weights of the two triangles; when they have the sign −σ while the levels ≥ 2
+//! have σ (the sign conditions), the Bernstein coefficients along a line from e to [q s]
+//! change sign twice: F has a pocket of the wrong sign next to e, a second sheet along the
+//! j-edge.
+//!
+//! The fix keeps C¹ exact: it changes only the number 2 weights a_1110 (free in the paper, shared
+//! by both face tetrahedra of a triangle), and every blossom is refitted from them afterwards. It
+//! asks σ·A_e(q) ≥ margin for both apexes q on σ (then A_e(s), their mean, too), with A_e
+//! written in barycentric coordinates of [p_i p_j m0 m1] (m0, m1 the triangles' third points):
+//! A_e(q) = α_i A(p_i) + α_j A(p_j) + α_0 c_0 + α_1 c_1, linear in the two number 2 weights
+//! c_0, c_1. The constraints of all such edges are met by cyclic projection (least change of
+//! the number 2 weights, Kaczmarz), triangles on flat edges (whose number 2 weights solve
+//! [`super::flat`]'s equations) left out.
+
+use crate::hull::simplicial::{HullEdge, Side, SimplicialHull};
+use glam::DVec3;
+
+use super::weights::{bary_in, gradient_weight};
+
+/// Fraction of the edge's own weights (σ-signed mean of w_2100 and w_1200) that σ·A_e(q) must
+/// stay above zero by, so that the level-one coefficients have the edge's sign with room.
+pub const POCKET_MARGIN: f64 = 0.1;
+
+/// Projection sweeps over all constraints.
+pub const POCKET_SWEEPS: usize = 50;
+
+/// One linear constraint Σ coef_k·c[tri_k] ≤ rhs on the number 2 weights.
+#[derive(Clone, Copy, Debug)]
+struct Constraint {
+    tri: [usize; 2],
+    coef: [f64; 2],
+    rhs: f64,
+}
+
+/// Changes the number 2 weights `center` so that no edge tetrahedron on the side its edge does
+/// not ask for has level-one weights of its side's sign (see the module documentation).
+/// `g` are the scaled normals (∇F at the points of T), `frozen[t]` marks triangles whose number 2
+/// weight must not change. Returns the number of constraints (edge, side, apex) found.
+pub fn clear_pockets(
+    hull: &SimplicialHull,
+    edges: &[HullEdge],
+    g: &[DVec3],
+    frozen: &[bool],
+    center: &mut [f64],
+) -> usize {
+    let p = &hull.points;
+    let mut cons = Vec::new();
+    for e in edges {
+        let [t0, t1] = e.faces;
+        if t1 == u32::MAX {
+            continue;
+        }
+        let (t0, t1) = (t0 as usize, t1 as usize);
+        if frozen[t0] && frozen[t1] {
+            continue;
+        }
+        let [i, j] = e.v.map(|v| v as usize);
+        let third = |t: usize| {
+            hull.triangles[t]
+                .iter()
+                .map(|&v| v as usize)
+                .find(|&v| v != i && v != j)
+                .unwrap_or(i)
+        };
+        let (m0, m1) = (third(t0), third(t1));
+        let ai = gradient_weight(p[i], g[i], p[j]);
+        let aj = gradient_weight(p[j], g[j], p[i]);
+        for side in Side::BOTH {
+            let sigma = match side {
+                Side::Outer => 1.0,
+                Side::Inner => -1.0,
+            };
+            let (Some(q0), Some(q1)) = (
+                hull.apexes[t0][side as usize],
+                hull.apexes[t1][side as usize],
+            ) else {
+                continue;
+            };
+            // The edge asks for the other side only: F on it has the sign σ.
+            if !(sigma * ai >= 0.0 && sigma * aj >= 0.0 && sigma * (ai + aj) > 0.0) {
+                continue;
+            }
+            let margin = POCKET_MARGIN * sigma * (ai + aj) / 2.0;
+            for q in [q0, q1] {
+                let Some(b) = bary_in([p[i], p[j], p[m0], p[m1]], q) else {
+                    continue;
+                };
+                if !b.iter().all(|x| x.is_finite()) {
+                    continue;
+                }
+                // σ·A(q) ≥ margin ⇔ −σ(α_0 c_0 + α_1 c_1) ≤ σ(α_i a_i + α_j a_j) − margin.
+                let mut coef = [-sigma * b[2], -sigma * b[3]];
+                if frozen[t0] {
+                    coef[0] = 0.0;
+                }
+                if frozen[t1] {
+                    coef[1] = 0.0;
+                }
+                let fixed_part = b[0] * ai + b[1] * aj;
+                let mut rhs = sigma * fixed_part - margin;
+                if frozen[t0] {
+                    rhs += sigma * b[2] * center[t0];
+                }
+                if frozen[t1] {
+                    rhs += sigma * b[3] * center[t1];
+                }
+                if coef[0] * coef[0] + coef[1] * coef[1] > 0.0 {
+                    cons.push(Constraint {
+                        tri: [t0, t1],
+                        coef,
+                        rhs,
+                    });
+                }
+            }
+        }
+    }
+    for _ in 0..POCKET_SWEEPS {
+        let mut moved = false;
+        for c in &cons {
+            let lhs = c.coef[0] * center[c.tri[0]] + c.coef[1] * center[c.tri[1]];
+            if lhs > c.rhs {
+                let n2 = c.coef[0] * c.coef[0] + c.coef[1] * c.coef[1];
+                let step = (lhs - c.rhs) / n2;
+                center[c.tri[0]] -= step * c.coef[0];
+                center[c.tri[1]] -= step * c.coef[1];
+                moved = true;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    cons.len()
+}
