@@ -26,7 +26,7 @@ use super::weights::{bary_in, gradient_weight};
 
 /// Fraction of the edge's own weights (σ-signed mean of w_2100 and w_1200) that σ·A_e(q) must
 /// stay above zero by, so that the level-one coefficients have the edge's sign with room.
-pub const POCKET_MARGIN: f64 = 0.1;
+pub const POCKET_MARGIN: f64 = 0.5;
 
 /// Projection sweeps over all constraints.
 pub const POCKET_SWEEPS: usize = 50;
@@ -83,8 +83,9 @@ pub fn clear_pockets(
             ) else {
                 continue;
             };
-            // The edge asks for the other side only: F on it has the sign σ.
-            if !(sigma * ai >= 0.0 && sigma * aj >= 0.0 && sigma * (ai + aj) > 0.0) {
+            // The edge asks for the other side only: F on it has mostly the sign σ (one of its
+            // weights may be a round-off zero, a zero-convex end).
+            if sigma * (ai + aj) <= 0.0 {
                 continue;
             }
             let margin = POCKET_MARGIN * sigma * (ai + aj) / 2.0;
