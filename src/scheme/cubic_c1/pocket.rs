@@ -1,19 +1,20 @@
 //! Pockets next to edges of T on the side they do not ask for.
 //!
-//! An edge e = [p_i p_j] of T whose two triangles both carry a face tetrahedron on side σ (an L-U
-//! pair made double sided by their other edges) gets edge tetrahedra [p_i p_j q s] on σ even when
-//! e itself is convex for the other side only: its number 1 weights w_2100, w_1200 then have the
-//! sign σ (the side's sign conditions ask for −σ there), so F has the sign σ on e. The level-one weights of those edge tetrahedra, w_1110 =
-//! A_e(q) and w_1101 = A_e(s) (the edge blossom, [`super::weights::EdgeBlossom`]), are fixed by
-//! the number 2 weights of the two triangles; when they have the sign −σ while the levels ≥ 2
-//! have σ (the sign conditions), the Bernstein coefficients along a line from e to [q s]
-//! change sign twice: F has a pocket of the wrong sign next to e, a second sheet along the
-//! j-edge.
+//! A face tetrahedron [p_i p_j p_m q] on side σ (and the edge tetrahedra [p_i p_j q s] beyond
+//! it, when the neighbour across e = [p_i p_j] has an apex on σ too) can stand on an edge e of T
+//! that is convex for the other side only (an L-U pair made double sided by its other edges):
+//! the number 1 weights w_2100, w_1200 of e then have (mostly) the sign σ, where the side's sign
+//! conditions ask for −σ, so F has the sign σ on e. The level-one weights next to e, the face
+//! tetrahedron's a_(e_i+e_j+e_q) = A_e(q) and the edge tetrahedra's w_1110 = A_e(q), w_1101 =
+//! A_e(s) (the edge blossom, [`super::weights::EdgeBlossom`]), are fixed by the number 2 weights
+//! of the two triangles; when they have the sign −σ while the levels ≥ 2 have σ (the sign
+//! conditions), the Bernstein coefficients along a line from e to the apex (or to [q s]) change
+//! sign twice: F has a pocket of the wrong sign next to e, a second sheet along the j-lines.
 //!
 //! The fix keeps C¹ exact: it changes only the number 2 weights a_1110 (free in the paper, shared
 //! by both face tetrahedra of a triangle), and every blossom is refitted from them afterwards. It
-//! asks σ·A_e(q) ≥ margin for both apexes q on σ (then A_e(s), their mean, too), with A_e
-//! written in barycentric coordinates of [p_i p_j m0 m1] (m0, m1 the triangles' third points):
+//! asks σ·A_e(q) ≥ margin for every apex q on σ of the two triangles (then A_e(s), the mean of
+//! two, too), with A_e written in barycentric coordinates of [p_i p_j m0 m1] (m0, m1 the triangles' third points):
 //! A_e(q) = α_i A(p_i) + α_j A(p_j) + α_0 c_0 + α_1 c_1, linear in the two number 2 weights
 //! c_0, c_1. The constraints of all such edges are met by cyclic projection (least change of
 //! the number 2 weights, Kaczmarz), triangles on flat edges (whose number 2 weights solve
@@ -27,6 +28,11 @@ use super::weights::{bary_in, gradient_weight};
 /// Fraction of the edge's own weights (σ-signed mean of w_2100 and w_1200) that σ·A_e(q) must
 /// stay above zero by, so that the level-one coefficients have the edge's sign with room.
 pub const POCKET_MARGIN: f64 = 0.5;
+
+/// Largest change of a number 2 weight, relative to the largest number 1 weight of its
+/// triangle: beyond it the triangle's own patches change shape too much (the surface leaves the
+/// hull through edge tetrahedra elsewhere).
+pub const POCKET_CAP: f64 = 1.0;
 
 /// Projection sweeps over all constraints.
 pub const POCKET_SWEEPS: usize = 50;
@@ -77,19 +83,17 @@ pub fn clear_pockets(
                 Side::Outer => 1.0,
                 Side::Inner => -1.0,
             };
-            let (Some(q0), Some(q1)) = (
+            let apexes = [
                 hull.apexes[t0][side as usize],
                 hull.apexes[t1][side as usize],
-            ) else {
-                continue;
-            };
+            ];
             // The edge asks for the other side only: F on it has mostly the sign σ (one of its
             // weights may be a round-off zero, a zero-convex end).
             if sigma * (ai + aj) <= 0.0 {
                 continue;
             }
             let margin = POCKET_MARGIN * sigma * (ai + aj) / 2.0;
-            for q in [q0, q1] {
+            for q in apexes.into_iter().flatten() {
                 let Some(b) = bary_in([p[i], p[j], p[m0], p[m1]], q) else {
                     continue;
                 };
@@ -122,6 +126,23 @@ pub fn clear_pockets(
             }
         }
     }
+    let before = center.to_vec();
+    let cap: Vec<f64> = hull
+        .triangles
+        .iter()
+        .map(|tri| {
+            let mut m = 0.0f64;
+            for k in 0..3 {
+                for l in 0..3 {
+                    if k != l {
+                        let (a, b) = (tri[k] as usize, tri[l] as usize);
+                        m = m.max(gradient_weight(p[a], g[a], p[b]).abs());
+                    }
+                }
+            }
+            POCKET_CAP * m
+        })
+        .collect();
     for _ in 0..POCKET_SWEEPS {
         let mut moved = false;
         for c in &cons {
@@ -129,8 +150,11 @@ pub fn clear_pockets(
             if lhs > c.rhs {
                 let n2 = c.coef[0] * c.coef[0] + c.coef[1] * c.coef[1];
                 let step = (lhs - c.rhs) / n2;
-                center[c.tri[0]] -= step * c.coef[0];
-                center[c.tri[1]] -= step * c.coef[1];
+                for k in 0..2 {
+                    let t = c.tri[k];
+                    center[t] = (center[t] - step * c.coef[k])
+                        .clamp(before[t] - cap[t], before[t] + cap[t]);
+                }
                 moved = true;
             }
         }
