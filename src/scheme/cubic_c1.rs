@@ -20,6 +20,7 @@
 //! ```
 
 pub mod flat;
+pub mod pocket;
 pub mod sided;
 pub mod weights;
 
@@ -88,6 +89,8 @@ pub struct CubicBuild {
     pub unsigned: usize,
     /// Triangles of T given a partner apex ([`sided::complete_lu_pairs`]).
     pub lu_completed: Vec<usize>,
+    /// Constraints on number 2 weights against pockets next to edges ([`pocket`]).
+    pub pocket_constraints: usize,
 }
 
 /// Weights of the face tetrahedron of one (triangle, side).
@@ -129,6 +132,7 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
         raised: 0,
         unsigned: 0,
         lu_completed,
+        pocket_constraints: 0,
     };
 
     // Number 2: a_1110 per triangle (shared by both sides of an L-U pair), quadratic precision.
@@ -177,6 +181,14 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
     }
     out.flat_edges = flat_eqs.len();
     out.flat_unsolved = flat::adjust(&mut center, &flat_eqs, MAX_FLAT_GROUP);
+
+    // Number 2 next to edges on the side they do not ask for: no pocket of F there.
+    let mut frozen = vec![false; nt];
+    for eq in &flat_eqs {
+        frozen[eq.from] = true;
+        frozen[eq.to] = true;
+    }
+    out.pocket_constraints = pocket::clear_pockets(hull, &edges, &g, &frozen, &mut center);
 
     // Number 3: the edge blossoms.
     let mut blossom: HashMap<(u32, u32), EdgeBlossom> = HashMap::new();

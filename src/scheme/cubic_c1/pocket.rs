@@ -1,0 +1,248 @@
+//! Pockets next to edges of T on the side they do not ask for.
+//!
+//! A face tetrahedron [p_i p_j p_m q] on side σ (and the edge tetrahedra [p_i p_j q s] beyond
+//! it, when the neighbour across e = [p_i p_j] has an apex on σ too) can stand on an edge e of T
+//! that is convex for the other side only (an L-U pair made double sided by its other edges):
+//! the number 1 weights w_2100, w_1200 of e then have (mostly) the sign σ, where the side's sign
+//! conditions ask for −σ, so F has the sign σ on e. The level-one weights next to e, the face
+//! tetrahedron's a_(e_i+e_j+e_q) = A_e(q) and the edge tetrahedra's w_1110 = A_e(q), w_1101 =
+//! A_e(s) (the edge blossom, [`super::weights::EdgeBlossom`]), are fixed by the number 2 weights
+//! of the two triangles; when they have the sign −σ while the levels ≥ 2 have σ (the sign
+//! conditions), the Bernstein coefficients along a line from e to the apex (or to [q s]) change
+//! sign twice: F has a pocket of the wrong sign next to e, a second sheet along the j-lines.
+//!
+//! The fix keeps C¹ exact: it changes only the number 2 weights a_1110 (free in the paper, shared
+//! by both face tetrahedra of a triangle), and every blossom is refitted from them afterwards. It
+//! asks σ·A_e(q) ≥ margin for every apex q on σ of the two triangles (then A_e(s), the mean of
+//! two, too), with A_e written in barycentric coordinates of [p_i p_j m0 m1] (m0, m1 the triangles' third points):
+//! A_e(q) = α_i A(p_i) + α_j A(p_j) + α_0 c_0 + α_1 c_1, linear in the two number 2 weights
+//! c_0, c_1. The constraints of all such edges are met by cyclic projection (least change of
+//! the number 2 weights, Kaczmarz), triangles on flat edges (whose number 2 weights solve
+//! [`super::flat`]'s equations) left out.
+
+use crate::hull::simplicial::{HullEdge, Side, SimplicialHull};
+use glam::DVec3;
+
+use super::weights::{bary_in, gradient_weight};
+
+/// Fraction of the edge's own weights (σ-signed mean of w_2100 and w_1200) that σ·A_e(q) must
+/// stay above zero by, so that the level-one coefficients have the edge's sign with room.
+pub const POCKET_MARGIN: f64 = 0.5;
+
+/// Largest change of a number 2 weight, relative to the largest number 1 weight of its
+/// triangle: beyond it the triangle's own patches change shape too much (the surface leaves the
+/// hull through edge tetrahedra elsewhere).
+pub const POCKET_CAP: f64 = 1.0;
+
+/// Projection sweeps over all constraints.
+pub const POCKET_SWEEPS: usize = 50;
+
+/// One linear constraint Σ coef_k·c[tri_k] ≤ rhs on the number 2 weights.
+#[derive(Clone, Copy, Debug)]
+struct Constraint {
+    tri: [usize; 2],
+    coef: [f64; 2],
+    rhs: f64,
+}
+
+/// Changes the number 2 weights `center` so that no edge tetrahedron on the side its edge does
+/// not ask for has level-one weights of its side's sign (see the module documentation).
+/// `g` are the scaled normals (∇F at the points of T), `frozen[t]` marks triangles whose number 2
+/// weight must not change. Returns the number of constraints (edge, side, apex) found.
+pub fn clear_pockets(
+    hull: &SimplicialHull,
+    edges: &[HullEdge],
+    g: &[DVec3],
+    frozen: &[bool],
+    center: &mut [f64],
+) -> usize {
+    let p = &hull.points;
+    let mut cons = Vec::new();
+    for e in edges {
+        let [t0, t1] = e.faces;
+        if t1 == u32::MAX {
+            continue;
+        }
+        let (t0, t1) = (t0 as usize, t1 as usize);
+        if frozen[t0] && frozen[t1] {
+            continue;
+        }
+        let [i, j] = e.v.map(|v| v as usize);
+        let third = |t: usize| {
+            hull.triangles[t]
+                .iter()
+                .map(|&v| v as usize)
+                .find(|&v| v != i && v != j)
+                .unwrap_or(i)
+        };
+        let (m0, m1) = (third(t0), third(t1));
+        let ai = gradient_weight(p[i], g[i], p[j]);
+        let aj = gradient_weight(p[j], g[j], p[i]);
+        for side in Side::BOTH {
+            let sigma = match side {
+                Side::Outer => 1.0,
+                Side::Inner => -1.0,
+            };
+            let apexes = [
+                hull.apexes[t0][side as usize],
+                hull.apexes[t1][side as usize],
+            ];
+            // The edge asks for the other side only: F on it has mostly the sign σ (one of its
+            // weights may be a round-off zero, a zero-convex end).
+            if sigma * (ai + aj) <= 0.0 {
+                continue;
+            }
+            let margin = POCKET_MARGIN * sigma * (ai + aj) / 2.0;
+            for q in apexes.into_iter().flatten() {
+                let Some(b) = bary_in([p[i], p[j], p[m0], p[m1]], q) else {
+                    continue;
+                };
+                if !b.iter().all(|x| x.is_finite()) {
+                    continue;
+                }
+                // σ·A(q) ≥ margin ⇔ −σ(α_0 c_0 + α_1 c_1) ≤ σ(α_i a_i + α_j a_j) − margin.
+                let mut coef = [-sigma * b[2], -sigma * b[3]];
+                if frozen[t0] {
+                    coef[0] = 0.0;
+                }
+                if frozen[t1] {
+                    coef[1] = 0.0;
+                }
+                let fixed_part = b[0] * ai + b[1] * aj;
+                let mut rhs = sigma * fixed_part - margin;
+                if frozen[t0] {
+                    rhs += sigma * b[2] * center[t0];
+                }
+                if frozen[t1] {
+                    rhs += sigma * b[3] * center[t1];
+                }
+                if coef[0] * coef[0] + coef[1] * coef[1] > 0.0 {
+                    cons.push(Constraint {
+                        tri: [t0, t1],
+                        coef,
+                        rhs,
+                    });
+                }
+            }
+        }
+    }
+    let before = center.to_vec();
+    let cap: Vec<f64> = hull
+        .triangles
+        .iter()
+        .map(|tri| {
+            let mut m = 0.0f64;
+            for k in 0..3 {
+                for l in 0..3 {
+                    if k != l {
+                        let (a, b) = (tri[k] as usize, tri[l] as usize);
+                        m = m.max(gradient_weight(p[a], g[a], p[b]).abs());
+                    }
+                }
+            }
+            POCKET_CAP * m
+        })
+        .collect();
+    for _ in 0..POCKET_SWEEPS {
+        let mut moved = false;
+        for c in &cons {
+            let lhs = c.coef[0] * center[c.tri[0]] + c.coef[1] * center[c.tri[1]];
+            if lhs > c.rhs {
+                let n2 = c.coef[0] * c.coef[0] + c.coef[1] * c.coef[1];
+                let step = (lhs - c.rhs) / n2;
+                for k in 0..2 {
+                    let t = c.tri[k];
+                    center[t] = (center[t] - step * c.coef[k])
+                        .clamp(before[t] - cap[t], before[t] + cap[t]);
+                }
+                moved = true;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    cons.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hull::simplicial::PointOrigin;
+    use crate::scheme::cubic_c1::weights::EdgeBlossom;
+
+    /// A ridge along [p0 p1] (convex for the outer side: the normals lean away from each other
+    /// along the edge, so both number 1 weights are ≈ −0.096), its two triangles double sided. With
+    /// positive number 2 weights the blossom at the inner apexes is positive (a pocket on the
+    /// inner side); after `clear_pockets` the refitted blossom (the same fit as the scheme) is
+    /// ≤ −margin at both inner apexes, and the outer apexes' constraints were not asked for.
+    #[test]
+    fn ridge_pocket_is_cleared() {
+        let points = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 1.0, -0.3),
+            DVec3::new(0.5, -1.0, -0.3),
+        ];
+        let normals = vec![
+            DVec3::new(-0.3, 0.0, 1.0).normalize(),
+            DVec3::new(0.3, 0.0, 1.0).normalize(),
+            DVec3::new(0.0, 0.3, 1.0).normalize(),
+            DVec3::new(0.0, -0.3, 1.0).normalize(),
+        ];
+        let triangles = vec![[0, 1, 2], [1, 0, 3]];
+        let apex = |t: usize, dz: f64| {
+            let c = triangles[t]
+                .iter()
+                .map(|&v: &u32| points[v as usize])
+                .sum::<DVec3>()
+                / 3.0;
+            Some(c + DVec3::new(0.0, 0.0, dz))
+        };
+        let hull = SimplicialHull {
+            apexes: vec![[apex(0, 0.3), apex(0, -0.3)], [apex(1, 0.3), apex(1, -0.3)]],
+            points: points.clone(),
+            normals: normals.clone(),
+            origins: vec![PointOrigin::Centroid { face: 0 }; 4],
+            triangles,
+            element: vec![0, 1],
+        };
+        let edges = hull.edges().expect("edges");
+        let fit = |center: &[f64], q: DVec3| {
+            let g = &normals;
+            let known = [
+                (points[1], gradient_weight(points[1], g[1], points[0])),
+                (points[2], center[0]),
+                (points[3], center[1]),
+            ];
+            let prior = (g[0] + g[1]) / 6.0;
+            let b = EdgeBlossom::fit(
+                points[0],
+                gradient_weight(points[0], g[0], points[1]),
+                &known,
+                prior,
+            );
+            b.at(q)
+        };
+        let mut center = vec![0.03, 0.03];
+        let inner = [hull.apexes[0][1].unwrap(), hull.apexes[1][1].unwrap()];
+        // The test's premise: a pocket before (blossom at an inner apex has the outer sign).
+        assert!(inner.iter().any(|&q| fit(&center, q) > 0.0));
+        let n = clear_pockets(&hull, &edges, &normals, &[false, false], &mut center);
+        // Two inner apexes at the ridge; the outer side is the edge's own side (no constraint).
+        assert_eq!(n, 2);
+        // σ·(a_i + a_j)/2 with σ = −1: the mean number 1 weight of the ridge (≈ 0.096).
+        let ai = gradient_weight(points[0], normals[0], points[1]);
+        let aj = gradient_weight(points[1], normals[1], points[0]);
+        assert!(ai < 0.0 && aj < 0.0);
+        let margin = -POCKET_MARGIN * (ai + aj) / 2.0;
+        for q in inner {
+            // σ = −1: A(q) ≤ −margin, up to round-off of the 3×3 fit (1e-12 on O(1) data).
+            assert!(
+                fit(&center, q) <= -margin + 1e-12,
+                "A(q) = {}",
+                fit(&center, q)
+            );
+        }
+    }
+}
