@@ -336,12 +336,9 @@ mod tests {
         // left fixed except where more than two boundary edges meet (none here).
     }
 
-    #[test]
-    fn euler_characteristic_and_orientation_are_kept() {
-        // A closed octahedron (χ = 2) and an open grid (χ = 1), two levels each; every
-        // undirected edge of the closed result has two opposite half-edges (consistently
-        // oriented, manifold), and the counts follow V' = V + E, F' = 4F.
-        let oct = Mesh::new(
+    /// The regular octahedron on the unit axes, faces wound outward.
+    fn octahedron() -> Mesh {
+        Mesh::new(
             vec![
                 DVec3::X,
                 DVec3::Y,
@@ -360,7 +357,15 @@ mod tests {
                 vec![4, 3, 5],
                 vec![0, 4, 5],
             ],
-        );
+        )
+    }
+
+    #[test]
+    fn euler_characteristic_and_orientation_are_kept() {
+        // A closed octahedron (χ = 2) and an open grid (χ = 1), two levels each; every
+        // undirected edge of the closed result has two opposite half-edges (consistently
+        // oriented, manifold), and the counts follow V' = V + E, F' = 4F.
+        let oct = octahedron();
         for (m, chi) in [(oct, 2), (grid(3), 1)] {
             let two = Subdivision {
                 rule: SubdivisionRule::Loop,
@@ -386,26 +391,7 @@ mod tests {
     fn octahedron_shrinks_towards_a_sphere_like_limit() {
         // Symmetry check: the octahedron's vertices stay on the axes, all at one distance
         // (valence 4 everywhere), strictly inside the unit sphere (the vertex rule averages).
-        let oct = Mesh::new(
-            vec![
-                DVec3::X,
-                DVec3::Y,
-                DVec3::Z,
-                -DVec3::X,
-                -DVec3::Y,
-                -DVec3::Z,
-            ],
-            vec![
-                vec![0, 1, 2],
-                vec![1, 3, 2],
-                vec![3, 4, 2],
-                vec![4, 0, 2],
-                vec![1, 0, 5],
-                vec![3, 1, 5],
-                vec![4, 3, 5],
-                vec![0, 4, 5],
-            ],
-        );
+        let oct = octahedron();
         let s = subdivide(&oct, LOOP1).unwrap();
         // (1 − 4β) with β = loop_beta(4) (the four neighbours sum to zero).
         let r = 1.0 - 4.0 * loop_beta(4);

@@ -538,49 +538,8 @@ fn tet_edges(t: &[DVec3; 4]) -> [DVec3; 6] {
 /// (face normals of both, cross products of their edges): ≤ 0 when a plane separates them.
 #[must_use]
 pub fn sat_depth(a: &[DVec3; 4], b: &[DVec3; 4]) -> f64 {
-    let faces = |t: &[DVec3; 4]| {
-        [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]
-            .map(|[i, j, k]| (t[j] - t[i]).cross(t[k] - t[i]))
-    };
-    let edges =
-        |t: &[DVec3; 4]| [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(i, j)| t[j] - t[i]);
-    let mut depth = f64::INFINITY;
-    let mut test = |axis: DVec3| {
-        let Some(ax) = axis.try_normalize() else {
-            return;
-        };
-        let (mut a0, mut a1, mut b0, mut b1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for p in a {
-            let x = ax.dot(*p);
-            a0 = a0.min(x);
-            a1 = a1.max(x);
-        }
-        for p in b {
-            let x = ax.dot(*p);
-            b0 = b0.min(x);
-            b1 = b1.max(x);
-        }
-        depth = depth.min(a1.min(b1) - a0.max(b0));
-    };
-    for n in faces(a).into_iter().chain(faces(b)) {
-        test(n);
-    }
-    let (ea, eb) = (edges(a), edges(b));
-    for x in ea {
-        for y in eb {
-            let c = x.cross(y);
-            // Nearly parallel edges give no new axis (their plane is covered by face normals).
-            if c.length_squared() > 1e-20 * x.length_squared() * y.length_squared() {
-                test(c);
-            }
-        }
-    }
-    depth
+    // No limit: every axis is tested, so the minimum over all of them comes back.
+    sat_depth_above(a, b, f64::NEG_INFINITY).unwrap_or(f64::NEG_INFINITY)
 }
 
 #[cfg(test)]
