@@ -11,7 +11,7 @@
 mod cpu;
 
 use apatch::scheme::rational_c1::{build, RationalOptions};
-use cpu::cpu_seconds;
+use cpu::{cpu_seconds, load_average, median};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use glam::DVec3;
 use std::time::Instant;
@@ -47,18 +47,6 @@ fn models() -> Vec<(&'static str, Model)> {
 }
 
 /// The 1-, 5- and 15-minute load averages (Linux), or "?".
-fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()
-        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|| "?".into())
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// Median triangles per wall second and per CPU-second on 1 and 2 threads (see the module
 /// docs). The dropping of each result is outside the measured span.
 fn cpu_report(models: &[(&'static str, Model)]) {

@@ -28,7 +28,7 @@ use std::time::{Duration, Instant};
 
 #[path = "support/cpu.rs"]
 mod cpu;
-use cpu::cpu_seconds;
+use cpu::{cpu_seconds, load_average};
 
 /// The comparison tracer: the tessellation of the same complex (`export::tessellate`) as f32
 /// triangles in an obvhs CwBvh (its fastest traversal layout), Möller–Trumbore hits, vertex
@@ -341,14 +341,6 @@ fn profile_shaded(
             1.048_576 / cpu
         );
     }
-}
-
-/// The first three fields of `/proc/loadavg` (1, 5 and 15 minute load averages), or "?".
-fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()
-        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|| "?".into())
 }
 
 fn main() {

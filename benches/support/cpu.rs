@@ -19,3 +19,22 @@ pub fn cpu_seconds() -> f64 {
     // Fields 14 and 15 (utime, stime) are at 11 and 12 after the command name.
     (tick(11) + tick(12)) / 100.0
 }
+
+/// The first three fields of `/proc/loadavg` (1, 5 and 15 minute load averages), or "?".
+#[allow(dead_code)] // each bench includes this file; not every bench prints the load
+pub fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "?".into())
+}
+
+/// The median of `v` (the upper one for an even count); NaN for an empty `v`.
+#[allow(dead_code)] // each bench includes this file; not every bench takes medians
+pub fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
