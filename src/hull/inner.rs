@@ -11,7 +11,7 @@
 //!    reduced to Algorithm 1, as §4 allows).
 //! 3. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
 //!    Appendix C) by rotating it where needed; corners where no direction is above all faces
-//!    are reported as errors.
+//!    are re-meshed first by Appendix C's corner smoothing ([`remesh`], before step 1).
 //! 4. [`corner`]: Algorithm 1 steps (3)–(5) vertex by vertex, with Algorithm 2's step (3')
 //!    for hallway corners (trihedral, one reflex face angle): T and the face tetrahedra; then
 //!    [`corner::spread_hallway_apexes`] moves the hallway corners' outer apexes off the
@@ -38,6 +38,7 @@ pub mod coplanar;
 pub mod corner;
 pub mod decompose;
 pub mod guardnet;
+pub mod remesh;
 pub mod sides;
 pub mod verify;
 
@@ -146,6 +147,9 @@ pub struct InnerReport {
     pub cases: corner::CaseCounts,
     /// Triangles whose sides were settled from the convexity of their edges ([`sides`]).
     pub sides: sides::SideCounts,
+    /// Corners re-meshed before the hull because no direction was above all their faces
+    /// (Appendix C, [`remesh`]); vertex indices of the re-meshed mesh follow the input's.
+    pub remeshed: Vec<remesh::RemeshedCorner>,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -185,8 +189,22 @@ pub fn build_with_report(
             normals.len()
         )));
     }
-    let line = |v: usize| mesh.vertex_lines.get(v).copied().unwrap_or(0);
     let mut report = InnerReport::default();
+    // Appendix C: corners round which no direction is above every face are re-meshed first.
+    let remeshed = if options.fix_normals {
+        remesh::remesh_corners(mesh, normals)?
+    } else {
+        None
+    };
+    let (mesh, normals) = match &remeshed {
+        Some(r) => {
+            report.remeshed.clone_from(&r.corners);
+            (&r.mesh, &r.normals[..])
+        }
+        None => (mesh, normals),
+    };
+    let nv = mesh.positions.len();
+    let line = |v: usize| mesh.vertex_lines.get(v).copied().unwrap_or(0);
     let merged = coplanar::merge_coplanar(mesh);
     let mesh = &merged;
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.

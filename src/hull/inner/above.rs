@@ -5,8 +5,8 @@
 //! re-meshing the corner; we first try the cheaper remedy of changing the normal: if a direction
 //! above all the faces exists, the given normal is rotated towards the direction that is most
 //! above them (the max–min of n · n_f over the unit sphere) just far enough to clear a margin.
-//! Only when no such direction exists (the faces wrap round more than a hemisphere) would the
-//! corner need Appendix C's re-meshing, which is not implemented: the build reports the vertex.
+//! Only when no such direction exists (the faces wrap round more than a hemisphere) does the
+//! corner need Appendix C's re-meshing, which [`super::remesh`] does before the hull.
 
 use glam::DVec3;
 
