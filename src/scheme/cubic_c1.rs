@@ -8,6 +8,8 @@
 //! The surface passes through every point of T with normal n, and approximates the polyhedron
 //! (corners are cut) rather than interpolating its vertices. How each weight is fixed, and by
 //! which equation, is tabled in [`weights`].
+//! Before the weights, [`prepare_hull`] completes L-U pairs ([`sided`]) and moves apexes that
+//! lie beyond a tangent plane of their triangle to their own side ([`tangent`]).
 //!
 //! Scene usage (the `[scheme]` table):
 //! ```toml
