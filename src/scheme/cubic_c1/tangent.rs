@@ -30,9 +30,15 @@ pub const TANGENT_TOL: f64 = 1e-9;
 /// that the faces' number 1 weights are certifiably of the side's sign.
 pub const TANGENT_MARGIN: f64 = 0.02;
 
-/// Smallest m·n_k for which moving along the triangle's normal raises the slope at p_k
-/// (normals nearly in the triangle's plane are left alone: the step would be unbounded).
-pub const MIN_RATE: f64 = 1e-3;
+/// Smallest m·n_k for which moving along the triangle's normal raises the slope at p_k: the
+/// slope of a point far along the normal tends to m·n_k, so it must clear [`TANGENT_MARGIN`]
+/// well (normals nearly in the triangle's plane are left alone: the step would be unbounded).
+pub const MIN_RATE: f64 = 2.0 * TANGENT_MARGIN;
+
+/// Largest move, relative to the triangle's longest edge. A longer needle would reach over
+/// its neighbours' tetrahedra (spot and bunny need at most 0.1 and 0.29; mpi_poly's nearly
+/// coplanar corners asked for 6e5).
+pub const MAX_LIFT: f64 = 1.0;
 
 fn sign(side: Side) -> f64 {
     match side {
@@ -56,32 +62,44 @@ pub fn worst_slope(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> f64
 }
 
 /// The apex `q` of triangle `t` on `side`, moved along σ·m until every slope is at least
-/// [`TANGENT_MARGIN`]; `None` when a vertex normal is too close to the triangle's plane.
+/// [`TANGENT_MARGIN`] (up to 1e-6 relative); `None` when a vertex normal is too close to the
+/// triangle's plane ([`MIN_RATE`]) or the move would exceed [`MAX_LIFT`].
 #[must_use]
 pub fn contained_apex(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> Option<DVec3> {
     let tri = hull.triangles[t].map(|v| hull.points[v as usize]);
     let normals = hull.triangles[t].map(|v| hull.normals[v as usize]);
     let m = (tri[1] - tri[0]).cross(tri[2] - tri[0]).try_normalize()?;
+    let longest = (0..3)
+        .map(|k| (tri[k] - tri[(k + 1) % 3]).length())
+        .fold(0.0, f64::max);
     let s = sign(side);
     let away = s * m;
     let mut p = q;
-    // The margin grows with |p − p_k| as p moves: a few rounds reach it.
-    for _ in 0..4 {
+    // The margin grows with |p − p_k| as p moves: a few rounds reach it (each round's shortfall
+    // shrinks by the factor TANGENT_MARGIN / rate ≤ 1/2).
+    for _ in 0..30 {
         let mut step = 0.0f64;
         for (pk, nk) in tri.iter().zip(&normals) {
             let rate = m.dot(*nk);
+            let need = TANGENT_MARGIN * (p - *pk).length() - s * (p - *pk).dot(*nk);
+            if need <= 0.0 {
+                // Met; the final check sees it if later steps (rate < 0) undo it.
+                continue;
+            }
             if rate <= MIN_RATE {
                 return None;
             }
-            let need = TANGENT_MARGIN * (p - *pk).length() - s * (p - *pk).dot(*nk);
             step = step.max(need / rate);
         }
-        if step <= 0.0 {
+        if step <= 1e-6 * TANGENT_MARGIN * longest {
             break;
         }
         p += step * away;
+        if (p - q).length() > MAX_LIFT * longest {
+            return None;
+        }
     }
-    Some(p)
+    (worst_slope(hull, t, side, p) >= TANGENT_MARGIN - 1e-6).then_some(p)
 }
 
 /// `hull` with every apex that lies beyond one of its triangle's tangent planes (slope below
@@ -155,6 +173,22 @@ mod tests {
             // The margin, up to the last round's growth of |p − p_k| (1e-6 relative).
             assert!(slope >= TANGENT_MARGIN - 1e-6, "{slope}");
         }
+    }
+
+    /// A normal nearly in the triangle's plane (m·n = 0.01 at point 1, below [`MIN_RATE`]):
+    /// the slope there can hardly be raised by moving along m, so the apex is left where it was
+    /// (counted as stuck) instead of moved a long way.
+    #[test]
+    fn apex_over_a_grazing_normal_is_stuck() {
+        let mut h = hull(DVec3::new(0.3, 0.3, -0.05));
+        h.normals[1] = DVec3::new(-1.0, 0.3, 0.01).normalize();
+        // The premise: the apex is beyond that tangent plane ((q − p_1)·n_1 > 0 on the inner
+        // side) and m·n_1 < MIN_RATE.
+        assert!((DVec3::new(0.3, 0.3, -0.05) - h.points[1]).dot(h.normals[1]) > 0.0);
+        assert!(h.normals[1].z < MIN_RATE);
+        let (out, moved, stuck) = contain_tangents(&h);
+        assert!(moved.is_empty() && stuck == 1);
+        assert_eq!(out.apexes, h.apexes);
     }
 
     /// A deep inner apex already on its side of every tangent plane is left alone.
