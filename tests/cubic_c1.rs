@@ -366,7 +366,125 @@ fn convex_triangles_stay_single_sided() {
         let hull = inner::build(&m, &vn, &InnerOptions::default()).unwrap();
         let (_, changed) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
         assert!(changed.is_empty(), "{name}: {changed:?}");
+        // Their apexes are on their side of every tangent plane already (Lemma 4.2 for convex
+        // face tetrahedra): `tangent` moves none.
+        let (_, moved, stuck) = apatch::scheme::cubic_c1::tangent::contain_tangents(&hull);
+        assert!(moved.is_empty() && stuck == 0, "{name}: {moved:?}");
     }
+}
+
+/// Both strict signs of F sampled on the face of `patch` opposite its local vertex `opp`
+/// (a lattice of 16 steps per edge; values within 1e-9 of the largest weight count as zero,
+/// far above the weights' round-off and far below the crossings' depth of 1e-3 and more).
+fn face_changes_sign(patch: &apatch::complex::Patch, opp: usize) -> bool {
+    const RES: usize = 16;
+    let scale = patch.weights.iter().fold(0.0f64, |m, w| m.max(w.abs()));
+    let verts: Vec<usize> = (0..4).filter(|&v| v != opp).collect();
+    let (mut pos, mut neg) = (false, false);
+    for i in 0..=RES {
+        for j in 0..=RES - i {
+            let mut a = [0.0; 4];
+            a[verts[0]] = i as f64 / RES as f64;
+            a[verts[1]] = j as f64 / RES as f64;
+            a[verts[2]] = (RES - i - j) as f64 / RES as f64;
+            let f = apatch::check::eval::poly_value(&patch.weights, 3, a);
+            pos |= f > 1e-9 * scale;
+            neg |= f < -1e-9 * scale;
+        }
+    }
+    pos && neg
+}
+
+/// Issue 7 on the bunny: some L-U pairs of its inner hull have an apex beyond the tangent plane
+/// at one of their triangle's points (Definition 3.5 allows it), and F changes sign on the
+/// outer faces [p q s] of the edge tetrahedra over them (holes; `check` found 578 crossed
+/// boundary faces). `tangent::contain_tangents` moves those apexes (none stuck) to their side of
+/// all three tangent planes; the moved hull is still smoothable (`inner::verify`: no overlaps,
+/// tangent containment, sides), and F, sampled directly on the outer faces of every edge
+/// tetrahedron over a moved apex, changes sign on some before and on none after; camera rays
+/// that meet the inside of the surface first (through a hole) are found before and not after.
+/// (`scenes_all` runs the full `check` on the bunny and spot scenes.)
+#[test]
+fn bunny_apexes_beyond_tangent_planes_are_moved() {
+    use apatch::complex::Role;
+    use apatch::scheme::cubic_c1::{prepare_hull, tangent};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper1994/bunny.toml");
+    let sc = apatch::scene::load(&path).unwrap();
+    let hull = apatch::scene::inner_hull(&sc).unwrap().unwrap();
+    let options = CubicOptions::default();
+    let prepared = prepare_hull(&hull, &options);
+    assert!(!prepared.tangent_moved.is_empty());
+    assert_eq!(prepared.tangent_stuck, 0);
+    for &(t, side) in &prepared.tangent_moved {
+        let q0 = hull.apexes[t][side as usize].unwrap();
+        let q1 = prepared.hull.apexes[t][side as usize].unwrap();
+        // The premise: the apex was beyond a tangent plane; after the move it has the margin
+        // (up to the last round's growth of |q − p_k|, 1e-6 relative).
+        assert!(tangent::worst_slope(&hull, t, side, q0) < -tangent::TANGENT_TOL);
+        assert!(
+            tangent::worst_slope(&prepared.hull, t, side, q1) >= tangent::TANGENT_MARGIN - 1e-6
+        );
+    }
+    let v = apatch::hull::inner::verify(&prepared.hull);
+    assert!(
+        v.is_empty(),
+        "{} violations, first {:?}",
+        v.len(),
+        v.first()
+    );
+
+    let before = build_full(
+        &hull,
+        &CubicOptions {
+            contain_tangents: false,
+            ..CubicOptions::default()
+        },
+    )
+    .unwrap();
+    let after = build_full(&hull, &options).unwrap();
+    assert_eq!(after.tangent_moved, prepared.tangent_moved);
+    // Edge patches follow the face patches in `edge_tets` order (the same for both hulls: only
+    // apexes moved).
+    let edge_tets = prepared.hull.edge_tets().unwrap();
+    let first_edge = after
+        .complex
+        .patches
+        .iter()
+        .position(|p| p.role == Role::Edge)
+        .unwrap();
+    let moved: std::collections::HashSet<(usize, Side)> =
+        prepared.tangent_moved.iter().copied().collect();
+    let (mut faces, mut crossed_before, mut crossed_after) = (0, 0, 0);
+    for (k, et) in edge_tets.iter().enumerate() {
+        if !moved.contains(&(et.face as usize, et.side)) {
+            continue;
+        }
+        let (pb, pa) = (
+            &before.complex.patches[first_edge + k],
+            &after.complex.patches[first_edge + k],
+        );
+        assert_eq!(pa.role, Role::Edge);
+        // The outer faces [p_j q s] and [p_i q s] (opposite p_i and p_j).
+        for opp in [0, 1] {
+            faces += 1;
+            crossed_before += usize::from(face_changes_sign(pb, opp));
+            crossed_after += usize::from(face_changes_sign(pa, opp));
+        }
+    }
+    eprintln!(
+        "bunny: {} apexes moved; outer faces of their edge tetrahedra crossed {crossed_before} \
+         -> {crossed_after} of {faces}",
+        prepared.tangent_moved.len()
+    );
+    assert!(crossed_before > 0);
+    assert_eq!(crossed_after, 0);
+    // The ray tracer's view: camera rays whose first hit faces away went through a hole.
+    let (cb, ca) = (
+        back_facing_hits(&sc, &before.complex),
+        back_facing_hits(&sc, &after.complex),
+    );
+    eprintln!("bunny: camera rays through holes {cb} -> {ca} of 160x160");
+    assert!(cb > 0 && ca == 0, "{cb} {ca}");
 }
 
 /// Exploration for the quintic scheme (owned elsewhere): the same completion under

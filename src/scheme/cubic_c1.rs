@@ -8,6 +8,8 @@
 //! The surface passes through every point of T with normal n, and approximates the polyhedron
 //! (corners are cut) rather than interpolating its vertices. How each weight is fixed, and by
 //! which equation, is tabled in [`weights`].
+//! Before the weights, [`prepare_hull`] completes L-U pairs ([`sided`]) and moves apexes that
+//! lie beyond a tangent plane of their triangle to their own side ([`tangent`]).
 //!
 //! Scene usage (the `[scheme]` table):
 //! ```toml
@@ -22,6 +24,7 @@
 pub mod flat;
 pub mod pocket;
 pub mod sided;
+pub mod tangent;
 pub mod weights;
 
 use crate::complex::{Patch, PatchComplex, Role};
@@ -57,6 +60,10 @@ pub struct CubicOptions {
     /// tetrahedron of an L-U pair (Definition 3.6 (4); [`sided`]) before building. Without it the
     /// surface leaves the hull through their bases (holes).
     pub complete_lu_pairs: bool,
+    /// Move apexes that lie beyond a tangent plane at one of their triangle's points (allowed
+    /// for L-U pairs by Definition 3.5) to their own side of all three ([`tangent`]). Without
+    /// it the surface leaves the hull through the edge tetrahedra's outer faces there (holes).
+    pub contain_tangents: bool,
 }
 
 impl Default for CubicOptions {
@@ -67,6 +74,7 @@ impl Default for CubicOptions {
             center: 1.0,
             gradient_scale: 1.0,
             complete_lu_pairs: true,
+            contain_tangents: true,
         }
     }
 }
@@ -91,11 +99,54 @@ pub struct CubicBuild {
     pub lu_completed: Vec<usize>,
     /// Constraints on number 2 weights against pockets next to edges ([`pocket`]).
     pub pocket_constraints: usize,
+    /// Apexes moved to their side of their triangle's tangent planes ([`tangent`]), as
+    /// (triangle, side).
+    pub tangent_moved: Vec<(usize, Side)>,
+    /// Apexes beyond a tangent plane that could not be moved (a vertex normal nearly in the
+    /// triangle's plane).
+    pub tangent_stuck: usize,
 }
 
 /// Weights of the face tetrahedron of one (triangle, side).
 struct FaceWeights {
     w: [f64; 20],
+}
+
+/// The hull the patches are built on ([`prepare_hull`]) and what was changed.
+#[derive(Clone, Debug)]
+pub struct PreparedHull {
+    /// The input hull with L-U partners added and apexes moved.
+    pub hull: SimplicialHull,
+    /// Triangles given a partner apex ([`sided::complete_lu_pairs`]).
+    pub lu_completed: Vec<usize>,
+    /// Apexes moved to their side of the tangent planes ([`tangent::contain_tangents`]).
+    pub tangent_moved: Vec<(usize, Side)>,
+    /// Apexes beyond a tangent plane that could not be moved.
+    pub tangent_stuck: usize,
+}
+
+/// The changes the cubic scheme makes to a hull's apexes before building (as `options` ask):
+/// L-U partners for single-sided triangles not convex for their side ([`sided`]), then apexes
+/// moved to their side of their triangle's tangent planes ([`tangent`]). `hull::inner::verify`
+/// applies to the result as to any hull.
+#[must_use]
+pub fn prepare_hull(hull: &SimplicialHull, options: &CubicOptions) -> PreparedHull {
+    let (completed, lu_completed) = if options.complete_lu_pairs {
+        sided::complete_lu_pairs(hull)
+    } else {
+        (hull.clone(), Vec::new())
+    };
+    let (hull, tangent_moved, tangent_stuck) = if options.contain_tangents {
+        tangent::contain_tangents(&completed)
+    } else {
+        (completed, Vec::new(), 0)
+    };
+    PreparedHull {
+        hull,
+        lu_completed,
+        tangent_moved,
+        tangent_stuck,
+    }
 }
 
 /// Builds the cubic C¹ complex on `hull`.
@@ -113,12 +164,8 @@ pub fn build(hull: &SimplicialHull, options: &CubicOptions) -> Result<PatchCompl
 /// As [`build`].
 pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<CubicBuild> {
     validate(hull, options)?;
-    let (completed, lu_completed) = if options.complete_lu_pairs {
-        sided::complete_lu_pairs(hull)
-    } else {
-        (hull.clone(), Vec::new())
-    };
-    let hull = &completed;
+    let prepared = prepare_hull(hull, options);
+    let hull = &prepared.hull;
     let c = options.gradient_scale;
     let p = &hull.points;
     let g: Vec<DVec3> = hull.normals.iter().map(|n| c * *n).collect();
@@ -131,8 +178,10 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
         flat_unsolved: 0,
         raised: 0,
         unsigned: 0,
-        lu_completed,
+        lu_completed: prepared.lu_completed,
         pocket_constraints: 0,
+        tangent_moved: prepared.tangent_moved,
+        tangent_stuck: prepared.tangent_stuck,
     };
 
     // Number 2: a_1110 per triangle (shared by both sides of an L-U pair), quadratic precision.

@@ -8,7 +8,7 @@
 //! | weight | paper | fixed by |
 //! | --- | --- | --- |
 //! | a_3e_k = 0 | number 0 | F = 0 at the points of T |
-//! | a_2e_k+e_l, w_2100, w_2010, w_2001, … | number 1 | (2.5): (v_l − v_k)·∇F(v_k)/3 |
+//! | a_2e_k+e_l, w_2100, w_2010, w_2001, … | number 1 | (2.5): (v_l − v_k)·∇F(v_k)/3; those toward an apex have its side's sign because apexes beyond a tangent plane were moved first ([`super::tangent`]) |
 //! | a_1110 | number 2 (free) | `center` × the quadratic-precision value Σ(6 edge weights)/4, then the least change keeping the blossom of an edge convex for the other side only at the side's apexes with the edge's sign ([`super::pocket`]) |
 //! | a_e_k+e_l+e_q, w_1110, w_1101 | number 3 | (2.8) across [p_i p_j q], (2.10) across [p_i p_j s] and (2.8) across an L-U pair's triangle: all are values A_e(x) of one affine "edge blossom" per edge e of T ([`EdgeBlossom`]) |
 //! | a_e_k+2e_q | number 4 (free) | the `level` rule, raised for the sign conditions |

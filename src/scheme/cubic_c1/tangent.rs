@@ -1,0 +1,202 @@
+//! Apexes beyond the tangent planes of their triangle's points, on their own side.
+//!
+//! Definition 3.5 asks of an L-U pair only that the tangent plane at each of its triangle's
+//! points p_k cut *one* of the two face tetrahedra (`hull::inner::verify` checks exactly that).
+//! The cubic scheme needs more. Its number 1 weights toward an apex q on side σ,
+//! a_2e_k+e_q = (q − p_k)·∇F(p_k)/3, are fixed by the data; on the faces [p_k q s] of the edge
+//! tetrahedra that no other tetrahedron shares (boundary faces of the hull), and on the free
+//! side faces [p_k p_l q] of an L-U pair's tetrahedron, F starts at p_k with these slopes.
+//! When σ·(q − p_k)·n_k < 0 the apex lies on the other side of p_k's tangent plane, F takes the
+//! sign −σ on that face next to p_k while its weights of levels ≥ 2 have the sign σ (Theorem
+//! 2.1's sign conditions): the surface leaves the hull through the face (a hole, `apatch check`'s
+//! "holes"). No free weight can change a number 1 weight; only the apex can move.
+//!
+//! [`contain_tangents`] moves every such apex along σ·m (m the triangle's outer unit normal),
+//! away from its triangle, by the least step that puts it on its side of all three tangent planes
+//! with the margin [`TANGENT_MARGIN`] × |q − p_k|. Then σ(s − p_k)·n_k ≥ 0 too for the midpoint s
+//! of two such apexes (the edge tetrahedra's fourth point), so every face [p_k q s] starts with
+//! slopes of the sign σ. Apexes already on their side (up to [`TANGENT_TOL`], which keeps the
+//! step (3) apexes that lie *on* a tangent plane in place) are not moved.
+
+use crate::hull::simplicial::{Side, SimplicialHull};
+use glam::DVec3;
+
+/// Relative slope σ(q − p_k)·n_k / |q − p_k| below which an apex counts as beyond a tangent
+/// plane: apexes put on a tangent plane by construction (Algorithm 1's step (3) apex V lies on
+/// the planes of its centroids) give round-off of the coordinates (≈1e-16).
+pub const TANGENT_TOL: f64 = 1e-9;
+
+/// Relative slope a moved apex gets at its worst point of the triangle: room above round-off so
+/// that the faces' number 1 weights are certifiably of the side's sign.
+pub const TANGENT_MARGIN: f64 = 0.02;
+
+/// Smallest m·n_k for which moving along the triangle's normal raises the slope at p_k: the
+/// slope of a point far along the normal tends to m·n_k, so it must clear [`TANGENT_MARGIN`]
+/// well (normals nearly in the triangle's plane are left alone: the step would be unbounded).
+pub const MIN_RATE: f64 = 2.0 * TANGENT_MARGIN;
+
+/// Largest move, relative to the triangle's longest edge. A longer needle would reach over
+/// its neighbours' tetrahedra (spot and bunny need at most 0.1 and 0.29; mpi_poly's nearly
+/// coplanar corners asked for 6e5).
+pub const MAX_LIFT: f64 = 1.0;
+
+fn sign(side: Side) -> f64 {
+    match side {
+        Side::Outer => 1.0,
+        Side::Inner => -1.0,
+    }
+}
+
+/// The smallest relative slope σ(q − p_k)·n_k / |q − p_k| of apex `q` of triangle `t` on `side`.
+#[must_use]
+pub fn worst_slope(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> f64 {
+    let s = sign(side);
+    hull.triangles[t]
+        .iter()
+        .map(|&v| {
+            let (p, n) = (hull.points[v as usize], hull.normals[v as usize]);
+            let d = q - p;
+            s * d.dot(n) / d.length().max(f64::MIN_POSITIVE)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The apex `q` of triangle `t` on `side`, moved along σ·m until every slope is at least
+/// [`TANGENT_MARGIN`] (up to 1e-6 relative); `None` when a vertex normal is too close to the
+/// triangle's plane ([`MIN_RATE`]) or the move would exceed [`MAX_LIFT`].
+#[must_use]
+pub fn contained_apex(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> Option<DVec3> {
+    let tri = hull.triangles[t].map(|v| hull.points[v as usize]);
+    let normals = hull.triangles[t].map(|v| hull.normals[v as usize]);
+    let m = (tri[1] - tri[0]).cross(tri[2] - tri[0]).try_normalize()?;
+    let longest = (0..3)
+        .map(|k| (tri[k] - tri[(k + 1) % 3]).length())
+        .fold(0.0, f64::max);
+    let s = sign(side);
+    let away = s * m;
+    let mut p = q;
+    // The margin grows with |p − p_k| as p moves: a few rounds reach it (each round's shortfall
+    // shrinks by the factor TANGENT_MARGIN / rate ≤ 1/2).
+    for _ in 0..30 {
+        let mut step = 0.0f64;
+        for (pk, nk) in tri.iter().zip(&normals) {
+            let rate = m.dot(*nk);
+            let need = TANGENT_MARGIN * (p - *pk).length() - s * (p - *pk).dot(*nk);
+            if need <= 0.0 {
+                // Met; the final check sees it if later steps (rate < 0) undo it.
+                continue;
+            }
+            if rate <= MIN_RATE {
+                return None;
+            }
+            step = step.max(need / rate);
+        }
+        if step <= 1e-6 * TANGENT_MARGIN * longest {
+            break;
+        }
+        p += step * away;
+        if (p - q).length() > MAX_LIFT * longest {
+            return None;
+        }
+    }
+    (worst_slope(hull, t, side, p) >= TANGENT_MARGIN - 1e-6).then_some(p)
+}
+
+/// `hull` with every apex that lies beyond one of its triangle's tangent planes (slope below
+/// −[`TANGENT_TOL`]) moved by [`contained_apex`], the (triangle, side) pairs moved, and how many
+/// such apexes could not be moved.
+#[must_use]
+pub fn contain_tangents(hull: &SimplicialHull) -> (SimplicialHull, Vec<(usize, Side)>, usize) {
+    let mut out = hull.clone();
+    let mut moved = Vec::new();
+    let mut stuck = 0;
+    for t in 0..hull.triangles.len() {
+        for side in Side::BOTH {
+            let Some(q) = hull.apexes[t][side as usize] else {
+                continue;
+            };
+            if worst_slope(hull, t, side, q) >= -TANGENT_TOL {
+                continue;
+            }
+            match contained_apex(hull, t, side, q) {
+                Some(p) => {
+                    out.apexes[t][side as usize] = Some(p);
+                    moved.push((t, side));
+                }
+                None => stuck += 1,
+            }
+        }
+    }
+    (out, moved, stuck)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hull::simplicial::PointOrigin;
+
+    /// One triangle in z = 0, normals tilted towards each other at the points 1 and 2, an
+    /// L-U pair whose inner apex lies just below the plane: above the tangent planes at 1 and 2.
+    fn hull(inner_apex: DVec3) -> SimplicialHull {
+        SimplicialHull {
+            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            normals: vec![
+                DVec3::Z,
+                DVec3::new(-0.4, 0.4, 1.0).normalize(),
+                DVec3::new(0.4, -0.4, 1.0).normalize(),
+            ],
+            origins: vec![PointOrigin::Other; 3],
+            triangles: vec![[0, 1, 2]],
+            apexes: vec![[Some(DVec3::new(0.3, 0.3, 0.5)), Some(inner_apex)]],
+            element: vec![0],
+        }
+    }
+
+    /// The shallow inner apex is beyond the tangent planes (its slopes are checked
+    /// independently, by the dot products); after the move every slope is at least the margin,
+    /// it moved straight down (along −m), and the outer apex, already above its planes, stayed.
+    #[test]
+    fn shallow_apex_is_moved_below_the_tangent_planes() {
+        let q = DVec3::new(0.3, 0.3, -0.05);
+        let h = hull(q);
+        // The premise: (q − p_1)·n_1 > 0, the inner apex is on the outer side of p_1's plane.
+        assert!((q - h.points[1]).dot(h.normals[1]) > 0.0);
+        let (out, moved, stuck) = contain_tangents(&h);
+        assert_eq!((moved, stuck), (vec![(0, Side::Inner)], 0));
+        assert_eq!(out.apexes[0][0], h.apexes[0][0]);
+        let p = out.apexes[0][1].expect("apex");
+        // Along −z only (exact: the step is a multiple of (0, 0, −1)).
+        assert_eq!((p.x, p.y), (q.x, q.y));
+        assert!(p.z < q.z);
+        for (pk, nk) in h.points.iter().zip(&h.normals) {
+            let slope = -(p - *pk).dot(*nk) / (p - *pk).length();
+            // The margin, up to the last round's growth of |p − p_k| (1e-6 relative).
+            assert!(slope >= TANGENT_MARGIN - 1e-6, "{slope}");
+        }
+    }
+
+    /// A normal nearly in the triangle's plane (m·n = 0.01 at point 1, below [`MIN_RATE`]):
+    /// the slope there can hardly be raised by moving along m, so the apex is left where it was
+    /// (counted as stuck) instead of moved a long way.
+    #[test]
+    fn apex_over_a_grazing_normal_is_stuck() {
+        let mut h = hull(DVec3::new(0.3, 0.3, -0.05));
+        h.normals[1] = DVec3::new(-1.0, 0.3, 0.01).normalize();
+        // The premise: the apex is beyond that tangent plane ((q − p_1)·n_1 > 0 on the inner
+        // side) and m·n_1 < MIN_RATE.
+        assert!((DVec3::new(0.3, 0.3, -0.05) - h.points[1]).dot(h.normals[1]) > 0.0);
+        assert!(h.normals[1].z < MIN_RATE);
+        let (out, moved, stuck) = contain_tangents(&h);
+        assert!(moved.is_empty() && stuck == 1);
+        assert_eq!(out.apexes, h.apexes);
+    }
+
+    /// A deep inner apex already on its side of every tangent plane is left alone.
+    #[test]
+    fn contained_apex_stays() {
+        let h = hull(DVec3::new(0.3, 0.3, -2.0));
+        let (out, moved, stuck) = contain_tangents(&h);
+        assert!(moved.is_empty() && stuck == 0);
+        assert_eq!(out.apexes, h.apexes);
+    }
+}
