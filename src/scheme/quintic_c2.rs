@@ -43,6 +43,10 @@ pub struct QuinticOptions {
     /// general position: the square systems of appendices D and E then have free dimensions
     /// that [`QuinticOptions::signs`] can use. Slower (larger groups).
     pub joint_stars: bool,
+    /// Relax the stars whose determined weights (appendices D and E) miss Theorem 2.1's signs:
+    /// solve them with their edge middles and Hessian, closest to the targets, and repeat
+    /// while the misses fall. Only stars with misses pay for the larger groups.
+    pub relax_stars: bool,
     /// Enforce Theorem 2.1's sign conditions (k = 1, [`signs`]) on the weights the C2
     /// constraints leave free, by pinning the ones whose targets miss their sign.
     pub signs: bool,
@@ -56,6 +60,7 @@ impl Default for QuinticOptions {
             signs: false,
             complete_lu_pairs: true,
             joint_stars: false,
+            relax_stars: true,
         }
     }
 }
@@ -99,6 +104,13 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "relax_stars" => match v.as_bool() {
+                    Some(b) => o.relax_stars = b,
+                    None => bail!(
+                        "{}: `scheme.relax_stars` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => match v.as_bool() {
                     Some(b) => o.signs = b,
                     None => bail!(
@@ -117,7 +129,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }
@@ -166,6 +178,7 @@ pub fn build_with_stats(
         &target,
         options.signs,
         options.joint_stars,
+        options.relax_stars,
     )?;
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
     stats.lu_completed = lu_completed.len();

@@ -45,6 +45,8 @@ pub const N: usize = 5;
 pub const NW: usize = 56;
 /// Largest group solved by the dense QR ([`dense`]); larger ones go to [`sparse`].
 pub const DENSE_LIMIT: usize = 1000;
+/// Rounds of relaxing the stars whose weights miss Theorem 2.1's signs ([`System::solve`]).
+const RELAX_ROUNDS: usize = 4;
 /// Iteration limit of a [`sparse`] solve.
 const SPARSE_ITERATIONS: usize = 50_000;
 
@@ -169,6 +171,8 @@ pub struct System {
     np: u32,
     /// Sign Theorem 2.1 asks of every slot ([`signs::required`] combined over its tetrahedra).
     req: Vec<i8>,
+    /// Slots on a boundary face of the hull (a face of one tetrahedron only).
+    boundary: Vec<bool>,
 }
 
 /// Builds the slots and the C1/C2 equations of every shared face.
@@ -222,9 +226,19 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
     let mut face_list: Vec<FaceUsers> = faces.into_iter().collect();
     face_list.sort_unstable_by_key(|(f, _)| *f);
     let mut equations = Vec::new();
+    let mut boundary = vec![false; keys.len()];
     for (f, users) in face_list {
         match users.len() {
-            1 => continue,
+            1 => {
+                // A boundary face of the hull: the surface must not cross it (a hole).
+                let (t, opp) = users[0];
+                for (i, l) in mi.iter().enumerate() {
+                    if l[opp] == 0 {
+                        boundary[slot_of[t as usize][i] as usize] = true;
+                    }
+                }
+                continue;
+            }
             2 => {}
             _ => {
                 return Err(Error::Invalid(format!(
@@ -250,6 +264,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         equations,
         np,
         req,
+        boundary,
     })
 }
 
@@ -379,6 +394,10 @@ pub struct SolveStats {
     /// Triangles of T given the partner apex of an L-U pair before building
     /// (`QuinticOptions::complete_lu_pairs`).
     pub lu_completed: usize,
+    /// Points of T whose stars were relaxed (solved with their edge middles and Hessian)
+    /// because their determined weights missed Theorem 2.1's signs
+    /// (`QuinticOptions::relax_stars`).
+    pub relaxed_for_signs: usize,
 }
 
 /// A group whose equations could not be met in one pass.
@@ -401,7 +420,9 @@ impl System {
     /// at once instead, closest to its target ([`SolveStats::global`]).
     ///
     /// With `pin`, Theorem 2.1's signs are enforced where the groups allow ([`pin_signs`]);
-    /// with `joint_stars`, every point starts relaxed at level 2.
+    /// with `joint_stars`, every point starts relaxed at level 2; with `relax_stars`, points
+    /// whose star weights miss Theorem 2.1's signs are relaxed the same way and the whole
+    /// solve repeated, while the number of misses falls (at most `RELAX_ROUNDS` rounds).
     ///
     /// # Errors
     /// A group whose equations cannot be met even so, naming where.
@@ -414,6 +435,7 @@ impl System {
         target: &dyn Fn(usize, [u8; 4]) -> f64,
         pin: bool,
         joint_stars: bool,
+        relax_stars: bool,
     ) -> Result<(Vec<f64>, SolveStats)> {
         let mut level: HashMap<u32, u8> = HashMap::new();
         if joint_stars {
@@ -423,10 +445,100 @@ impl System {
                 level.insert(p, 2);
             }
         }
+        let (mut value, mut stats) = self.solve_levels(tets, jets, nt, target, &mut level, pin)?;
+        if !relax_stars {
+            return Ok((value, stats));
+        }
+        // Theorem 2.1 misses of determined star weights: relax those stars (solve them with
+        // their edge middles and Hessians, closest to the targets), keep the result while the
+        // misses fall.
+        let at2 = |l: &HashMap<u32, u8>| l.values().filter(|l| **l >= 2).count();
+        let before = at2(&level);
+        let mut misses = self.star_misses(&value);
+        for _round in 0..RELAX_ROUNDS {
+            let miss = std::mem::take(&mut misses);
+            let mut trial = level.clone();
+            let mut grew = false;
+            for p in miss {
+                let l = trial.entry(p).or_insert(0);
+                if *l < 2 {
+                    *l = 2;
+                    grew = true;
+                }
+            }
+            if !grew {
+                break;
+            }
+            let Ok((v, s)) = self.solve_levels(tets, jets, nt, target, &mut trial, pin) else {
+                break;
+            };
+            let trial_misses = self.star_misses(&v);
+            if self.boundary_misses(&v) >= self.boundary_misses(&value) {
+                break;
+            }
+            (value, stats, level, misses) = (v, s, trial, trial_misses);
+        }
+        stats.relaxed_for_signs = at2(&level) - before;
+        Ok((value, stats))
+    }
+
+    /// Whether slot `s` misses Theorem 2.1's sign in `value` (`tiny`: zero up to rounding).
+    fn misses(&self, value: &[f64], s: usize, tiny: f64) -> bool {
+        let r = self.req[s];
+        (r == 1 || r == -1) && f64::from(r) * value[s] < -tiny
+    }
+
+    /// Weights on boundary faces of the hull that miss Theorem 2.1's sign in `value`: where
+    /// the surface may cross the boundary (a hole).
+    fn boundary_misses(&self, value: &[f64]) -> usize {
+        let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
+        // As in `sign_stats`: weights this small are zero up to the solves' rounding.
+        let tiny = 1e-12 * wmax;
+        (0..value.len())
+            .filter(|&s| self.boundary[s] && self.misses(value, s, tiny))
+            .count()
+    }
+
+    /// Points of T whose star (or edge middle) weights on boundary faces of the hull miss
+    /// Theorem 2.1's sign in `value`: the points at multiplicity 2 of every such slot that no
+    /// point has at multiplicity ≥ 3 (those are jets).
+    fn star_misses(&self, value: &[f64]) -> Vec<u32> {
+        let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
+        // As in `sign_stats`: weights this small are zero up to the solves' rounding.
+        let tiny = 1e-12 * wmax;
+        let mut out = Vec::new();
+        for s in 0..value.len() {
+            if !self.boundary[s] || !self.misses(value, s, tiny) {
+                continue;
+            }
+            let parts = unkey(self.keys[s]);
+            let hull: Vec<(u32, u8)> = parts.into_iter().filter(|p| p.0 < self.np).collect();
+            if hull.iter().any(|p| p.1 >= 3) {
+                continue;
+            }
+            out.extend(hull.iter().filter(|p| p.1 == 2).map(|p| p.0));
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The staged solve with the relaxed points `level` (raised where a group fails), falling
+    /// back to solving every unknown at once; see [`System::solve`].
+    #[allow(clippy::too_many_arguments)]
+    fn solve_levels(
+        &self,
+        tets: &[HullTet],
+        jets: &[Jet],
+        nt: u32,
+        target: &dyn Fn(usize, [u8; 4]) -> f64,
+        level: &mut HashMap<u32, u8>,
+        pin: bool,
+    ) -> Result<(Vec<f64>, SolveStats)> {
         let mut first_failure = None;
         for _pass in 0..6 {
             let (value, mut stats, failures) =
-                self.solve_pass(tets, jets, nt, target, &level, false, pin);
+                self.solve_pass(tets, jets, nt, target, level, false, pin);
             if failures.is_empty() {
                 stats.relaxed_points = level.len();
                 return Ok((value, stats));
@@ -467,7 +579,7 @@ impl System {
         // number 10 system of an edge whose apexes lie in the planes of its points' faces, as on
         // cube_poly): solve every unknown at once, each connected group closest to its targets.
         let (value, mut stats, failures) =
-            self.solve_pass(tets, jets, nt, target, &level, true, pin);
+            self.solve_pass(tets, jets, nt, target, level, true, pin);
         if failures.is_empty() {
             stats.relaxed_points = level.len();
             stats.global = true;
