@@ -694,7 +694,8 @@ pub fn build_complex_with_info(
 
 /// The inner simplicial hull (1994) a `cubic-c1` or `quintic-c2` scene is built on, with the
 /// scene's normals and hull options; `None` for other scenes. Lets `check` verify the hull
-/// (Definition 3.6) beside the patches.
+/// (Definition 3.6) beside the patches. For `cubic-c1` it is the hull after the scheme's own
+/// changes to the apexes ([`crate::scheme::cubic_c1::prepare_hull`]), the one its patches fill.
 ///
 /// # Errors
 /// Unreadable meshes, bad options, and hulls that cannot be built, naming the file.
@@ -724,6 +725,12 @@ pub fn inner_hull(
     let options = crate::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
     let hull = crate::hull::inner::build(&m, &vn, &options)
         .with_context(|| format!("{}", file.display()))?;
+    if scheme.get("type").and_then(|v| v.as_str()) == Some("cubic-c1") {
+        let (cubic, _) = crate::scheme::cubic_c1::options_from_toml(scheme, &scene.path)?;
+        return Ok(Some(
+            crate::scheme::cubic_c1::prepare_hull(&hull, &cubic).hull,
+        ));
+    }
     Ok(Some(hull))
 }
 

@@ -410,7 +410,14 @@ fn bunny_apexes_beyond_tangent_planes_are_moved() {
     use apatch::scheme::cubic_c1::{prepare_hull, tangent};
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper1994/bunny.toml");
     let sc = apatch::scene::load(&path).unwrap();
-    let hull = apatch::scene::inner_hull(&sc).unwrap().unwrap();
+    // The inner hull itself (`scene::inner_hull` gives the prepared one for cubic-c1 scenes).
+    let (m, _) = apatch::mesh::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models/bunny_npm_lowres.obj"),
+    )
+    .unwrap();
+    let vn = apatch::mesh::vertex_normals(&m, apatch::mesh::NormalMethod::Angle).unwrap();
+    let hull =
+        apatch::hull::inner::build(&m, &vn, &apatch::hull::inner::InnerOptions::default()).unwrap();
     let options = CubicOptions::default();
     let prepared = prepare_hull(&hull, &options);
     assert!(!prepared.tangent_moved.is_empty());
@@ -432,6 +439,9 @@ fn bunny_apexes_beyond_tangent_planes_are_moved() {
         v.len(),
         v.first()
     );
+    // `apatch check` verifies this hull (the scene's normals and options are the defaults).
+    let scene_hull = apatch::scene::inner_hull(&sc).unwrap().unwrap();
+    assert_eq!(scene_hull.apexes, prepared.hull.apexes);
 
     let before = build_full(
         &hull,
