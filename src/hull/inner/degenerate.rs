@@ -11,7 +11,8 @@
 //! the required sides tangent-containing, and keeps Algorithm 1's apexes otherwise.
 //!
 //! [`repair`] finds every face tetrahedron whose relative volume 6V / L³ (L its longest edge)
-//! is below [`DEGENERATE_VOLUME`] — the bound `verify` uses — and replaces its apex by one over
+//! is below [`DEGENERATE_VOLUME`] — the bound `verify` uses — or whose apex lies more than
+//! [`FAR_APEX`] base lengths away, and replaces its apex by one over
 //! the base ([`sides::apexes_over_base`](super::sides::apexes_over_base)): on the same sides, or
 //! else as an L-U pair (one apex on each side), which is tangent-containing wherever the base
 //! meets its vertices' tangent planes from either side. A triangle that still has no
@@ -42,6 +43,24 @@ pub fn relative_volume(a: DVec3, b: DVec3, c: DVec3, q: DVec3) -> f64 {
     (b - a).cross(c - a).dot(q - a) / (l * l * l)
 }
 
+/// Largest distance of an apex from its base's centroid, in longest base edges, before
+/// [`repair`] rebuilds it over the base. Algorithm 1's apexes lie within about one base length
+/// (a trihedral corner's V, the projections of step (5)); one several base lengths away comes
+/// from a nearly parallel intersection (mpi_poly's hull triangle 35, base edges ≈ 5, had its
+/// outer apex 345 away) and crosses its neighbours' tetrahedra. No triangle of the passing
+/// paper1994 hulls comes near 4.
+pub const FAR_APEX: f64 = 4.0;
+
+/// True when the apex of triangle `t` on `side` lies more than [`FAR_APEX`] longest base edges
+/// from the base's centroid.
+#[must_use]
+pub fn is_far(hull: &SimplicialHull, t: usize, side: Side) -> bool {
+    hull.face_tet(t, side).is_some_and(|[a, b, c, q]| {
+        let len = (b - a).length().max((c - b).length()).max((a - c).length());
+        (q - (a + b + c) / 3.0).length() > FAR_APEX * len
+    })
+}
+
 /// True when the face tetrahedron of triangle `t` on `side` is degenerate in `verify`'s sense
 /// (relative volume below [`DEGENERATE_VOLUME`] in magnitude).
 #[must_use]
@@ -60,9 +79,13 @@ pub fn is_degenerate(hull: &SimplicialHull, t: usize, side: Side) -> bool {
 pub fn repair(hull: &mut SimplicialHull, vertex_lines: &[u32]) -> Result<usize> {
     let mut changed = 0;
     for t in 0..hull.triangles.len() {
-        let bad: Vec<Side> = Side::BOTH
+        let degenerate: Vec<Side> = Side::BOTH
             .into_iter()
             .filter(|&s| is_degenerate(hull, t, s))
+            .collect();
+        let bad: Vec<Side> = Side::BOTH
+            .into_iter()
+            .filter(|&s| degenerate.contains(&s) || is_far(hull, t, s))
             .collect();
         if bad.is_empty() {
             continue;
@@ -79,13 +102,16 @@ pub fn repair(hull: &mut SimplicialHull, vertex_lines: &[u32]) -> Result<usize> 
                 .all(|&q| relative_volume(base[0], base[1], base[2], q).abs() >= DEGENERATE_VOLUME)
         });
         let Some(apexes) = ok else {
+            if degenerate.is_empty() {
+                continue; // far but thick: kept as built
+            }
             let element = hull.element[t];
             let line = vertex_lines.get(element as usize).copied().unwrap_or(0);
             let [a, b, c] = base;
             return Err(Error::Invalid(format!(
                 "inner hull: the {:?} face tetrahedron of hull triangle {t} (built for input vertex {element}, line {line}) is degenerate (relative volume {:.2e}) and no apex over its base (area {:.3e}) is tangent-containing; the corner there is too flat or too thin for the 1994 hull",
-                bad[0],
-                hull.face_tet(t, bad[0])
+                degenerate[0],
+                hull.face_tet(t, degenerate[0])
                     .map_or(0.0, |[a, b, c, q]| relative_volume(a, b, c, q)),
                 0.5 * (b - a).cross(c - a).length(),
             )));
@@ -167,5 +193,27 @@ mod tests {
         };
         assert_eq!(repair(&mut hull, &[]).unwrap(), 0);
         assert_eq!(hull.apexes[0], [Some(q), None]);
+    }
+
+    /// A thick but far apex (straight above, 100 base lengths up: relative volume ≈ 1e-4, not
+    /// degenerate) is brought down over the base, within [`FAR_APEX`] base lengths.
+    #[test]
+    fn far_thick_apex_is_brought_over_the_base() {
+        let far = DVec3::new(0.3, 0.3, 100.0);
+        let mut hull = SimplicialHull {
+            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            normals: vec![DVec3::Z; 3],
+            origins: vec![PointOrigin::Other; 3],
+            triangles: vec![[0, 1, 2]],
+            apexes: vec![[Some(far), None]],
+            element: vec![0],
+        };
+        assert!(!is_degenerate(&hull, 0, Side::Outer) && is_far(&hull, 0, Side::Outer));
+        assert_eq!(repair(&mut hull, &[]).unwrap(), 1);
+        let q = hull.apexes[0][0].unwrap();
+        // The longest base edge is √2; the centroid is (1/3, 1/3, 0).
+        let g = DVec3::new(1.0 / 3.0, 1.0 / 3.0, 0.0);
+        assert!(q.z > 0.0 && (q - g).length() <= FAR_APEX * 2f64.sqrt());
+        assert!(hull.apexes[0][1].is_none());
     }
 }
