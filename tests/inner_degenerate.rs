@@ -31,7 +31,9 @@ fn fandisk_face_tetrahedra_are_thick_and_the_cubic_scheme_builds() {
                     l = l.max(tet[i].distance(tet[j]));
                 }
             }
-            let v6 = (tet[1] - tet[0]).cross(tet[2] - tet[0]).dot(tet[3] - tet[0]);
+            let v6 = (tet[1] - tet[0])
+                .cross(tet[2] - tet[0])
+                .dot(tet[3] - tet[0]);
             worst = worst.min(v6.abs() / (l * l * l));
         }
     }
