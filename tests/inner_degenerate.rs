@@ -43,3 +43,28 @@ fn fandisk_face_tetrahedra_are_thick_and_the_cubic_scheme_builds() {
     let complex = build(&hull, &CubicOptions::default()).unwrap();
     assert!(!complex.patches.is_empty());
 }
+
+/// mpi_poly's hull violations are overlaps (long-range corner guards), not near-coplanarity:
+/// its 16 nearly coplanar face pairs fold by 0.094°–0.163°, and T stays edge-convex (Lemma 4.1:
+/// no nonconvex edge) with no degenerate face tetrahedron. Guards the finding recorded in
+/// `scenes/pending/paper1994/README.md`.
+#[test]
+fn mpi_poly_hull_is_edge_convex_without_degenerate_face_tetrahedra() {
+    use apatch::hull::inner::{verify, ViolationKind};
+    let (m, _) = mesh::load(Path::new("scenes/models/mpi_poly.obj")).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (hull, _) = build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+    let violations = verify(&hull);
+    assert!(
+        !violations.is_empty(),
+        "mpi_poly passes now: move its scene"
+    );
+    for v in &violations {
+        assert_ne!(v.kind, ViolationKind::EdgeNonconvex, "{}", v.message);
+        // Degenerate edge tetrahedra remain at corner 18 (see the pending README); face
+        // tetrahedra are never degenerate.
+        if v.kind == ViolationKind::Degenerate {
+            assert!(v.message.contains("edge tetrahedron"), "{}", v.message);
+        }
+    }
+}
