@@ -61,6 +61,59 @@ pub fn is_far(hull: &SimplicialHull, t: usize, side: Side) -> bool {
     })
 }
 
+/// True when the tangent plane at every base vertex (normal `normals[k]`) leaves neither all
+/// of the other three points of (base, q) strictly on one side (Definition 3.5, no tolerance).
+fn tangent_containing(base: [DVec3; 3], normals: [DVec3; 3], q: DVec3) -> bool {
+    (0..3).all(|k| {
+        let vals = [base[(k + 1) % 3], base[(k + 2) % 3], q].map(|x| normals[k].dot(x - base[k]));
+        let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        lo <= 0.0 && hi >= 0.0
+    })
+}
+
+/// Grid steps per unit of the longest base edge in [`apex_beside_base`]'s search.
+const BESIDE_STEPS: usize = 20;
+
+/// An apex on `side` of the triangle `base` that need not lie over it: the point nearest the
+/// base's centroid g, on a grid of heights (0.08 to 1 longest edge L, as over the base) and
+/// offsets in the base's plane (up to 1.5 L each way, steps of L / [`BESIDE_STEPS`]), that makes
+/// the tetrahedron tangent-containing and thick. For triangles whose vertex normal lies nearly
+/// in the base's plane (mpi_poly's hull triangle 35 at a pseudo-centroid: n·N = 0.03) no apex
+/// over the base within L reaches that vertex's tangent plane, but one beside the base does
+/// (0.47 L from g there); Algorithm 1 put it 40 L away. `None` when the grid has none.
+#[must_use]
+pub fn apex_beside_base(base: [DVec3; 3], normals: [DVec3; 3], side: Side) -> Option<DVec3> {
+    let [a, b, c] = base;
+    let n = (b - a).cross(c - a).try_normalize()?;
+    let len = (b - a).length().max((c - b).length()).max((a - c).length());
+    let g = (a + b + c) / 3.0;
+    let u = (b - a).normalize();
+    let v = n.cross(u);
+    let sigma = if side == Side::Outer { 1.0 } else { -1.0 };
+    let step = len / BESIDE_STEPS as f64;
+    let reach = (1.5 * BESIDE_STEPS as f64) as i64;
+    let mut best: Option<(f64, DVec3)> = None;
+    for ih in 0..=BESIDE_STEPS {
+        let h = (0.08 + 0.92 * ih as f64 / BESIDE_STEPS as f64) * len;
+        for i in -reach..=reach {
+            for j in -reach..=reach {
+                let q = g + sigma * h * n + (i as f64 * step) * u + (j as f64 * step) * v;
+                let r = (q - g).length();
+                if best.is_some_and(|(d, _)| d <= r) {
+                    continue;
+                }
+                if relative_volume(a, b, c, q).abs() >= DEGENERATE_VOLUME
+                    && tangent_containing(base, normals, q)
+                {
+                    best = Some((r, q));
+                }
+            }
+        }
+    }
+    best.map(|(_, q)| q)
+}
+
 /// True when the face tetrahedron of triangle `t` on `side` is degenerate in `verify`'s sense
 /// (relative volume below [`DEGENERATE_VOLUME`] in magnitude).
 #[must_use]
@@ -94,7 +147,17 @@ pub fn repair(hull: &mut SimplicialHull, vertex_lines: &[u32]) -> Result<usize> 
         let normals = hull.triangles[t].map(|i| hull.normals[i as usize]);
         let sides = [hull.apexes[t][0].is_some(), hull.apexes[t][1].is_some()];
         let fresh = apexes_over_base(base, normals, sides)
-            .or_else(|| apexes_over_base(base, normals, [true, true]));
+            .or_else(|| apexes_over_base(base, normals, [true, true]))
+            .or_else(|| {
+                // Beside the base: each side that is there, nearest the base's centroid.
+                let mut out = [None, None];
+                for s in Side::BOTH {
+                    if sides[s as usize] {
+                        out[s as usize] = Some(apex_beside_base(base, normals, s)?);
+                    }
+                }
+                Some(out)
+            });
         let ok = fresh.filter(|apexes| {
             apexes
                 .iter()
@@ -193,6 +256,42 @@ mod tests {
         };
         assert_eq!(repair(&mut hull, &[]).unwrap(), 0);
         assert_eq!(hull.apexes[0], [Some(q), None]);
+    }
+
+    /// A vertex normal nearly in the base's plane (n·N = 0.03 at p_0, pointing away from the
+    /// other two vertices): Algorithm 1's kind of answer is an apex 30 up; no apex over the
+    /// base within one base length is tangent-containing at p_0, so the repair puts it beside
+    /// the base (behind p_0). Checked with `verify`'s per-tetrahedron conditions, and the apex is near.
+    #[test]
+    fn normal_in_the_base_plane_gets_an_apex_beside_the_base() {
+        let n0 = DVec3::new(-1.0, -1.0, 0.03).normalize();
+        let mut hull = SimplicialHull {
+            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            normals: vec![n0, DVec3::Z, DVec3::Z],
+            origins: vec![PointOrigin::Other; 3],
+            triangles: vec![[0, 1, 2]],
+            apexes: vec![[Some(DVec3::new(0.0, 0.0, 30.0)), None]],
+            element: vec![0],
+        };
+        // One triangle is no closed T: only the per-tetrahedron conditions count here.
+        use crate::hull::inner::ViolationKind::{Degenerate, NotTangentContaining, WrongSide};
+        let local = |hull: &SimplicialHull| {
+            crate::hull::inner::verify(hull)
+                .into_iter()
+                .filter(|v| matches!(v.kind, Degenerate | NotTangentContaining | WrongSide))
+                .collect::<Vec<_>>()
+        };
+        // The far apex is tangent-containing (it is what Algorithm 1 gives), but far.
+        assert!(local(&hull).is_empty());
+        assert!(is_far(&hull, 0, Side::Outer));
+        assert_eq!(repair(&mut hull, &[]).unwrap(), 1);
+        let q = hull.apexes[0][0].unwrap();
+        assert!(hull.apexes[0][1].is_none());
+        assert!(q.z > 0.0 && !is_far(&hull, 0, Side::Outer), "{q}");
+        let v = local(&hull);
+        assert!(v.is_empty(), "{v:?}");
+        // Behind p_0 (the side its normal points to), not over the base.
+        assert!(n0.dot(q) >= 0.0 && q.x + q.y < 0.0, "{q}");
     }
 
     /// A thick but far apex (straight above, 100 base lengths up: relative volume ≈ 1e-4, not
