@@ -22,6 +22,8 @@
 //!    the least height that keeps it tangent-containing; where T folds, apex pairs are raised
 //!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
 //!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
+//!    [`degenerate`] then rebuilds over the base any face tetrahedron that is still degenerate
+//!    (far apexes from nearly parallel intersections), or names the element in an error.
 //! 6. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
 //!
 //! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
@@ -37,6 +39,7 @@ pub mod above;
 pub mod coplanar;
 pub mod corner;
 pub mod decompose;
+pub mod degenerate;
 pub mod guardnet;
 pub mod remesh;
 pub mod sides;
@@ -150,6 +153,8 @@ pub struct InnerReport {
     /// Corners re-meshed before the hull because no direction was above all their faces
     /// (Appendix C, [`remesh`]); vertex indices of the re-meshed mesh follow the input's.
     pub remeshed: Vec<remesh::RemeshedCorner>,
+    /// Triangles whose degenerate face tetrahedra were rebuilt over their base ([`degenerate`]).
+    pub degenerate_repaired: usize,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -315,5 +320,6 @@ pub fn build_with_report(
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
+    report.degenerate_repaired = degenerate::repair(&mut hull, &mesh.vertex_lines)?;
     Ok((hull, report))
 }
