@@ -37,9 +37,11 @@ pub mod above;
 pub mod coplanar;
 pub mod corner;
 pub mod decompose;
+pub mod fan;
 pub mod guardnet;
 pub mod sides;
 pub mod verify;
+pub mod wedge;
 
 pub use verify::{verify, HullViolation, ViolationKind};
 
@@ -146,6 +148,8 @@ pub struct InnerReport {
     pub cases: corner::CaseCounts,
     /// Triangles whose sides were settled from the convexity of their edges ([`sides`]).
     pub sides: sides::SideCounts,
+    /// Apexes moved back inside the wedge of a fold of T ([`wedge`]).
+    pub wedged: usize,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -297,5 +301,6 @@ pub fn build_with_report(
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
+    report.wedged = wedge::keep_in_wedges(&mut hull);
     Ok((hull, report))
 }
