@@ -9,7 +9,7 @@
 //! [`keep_in_wedges`] moves every such apex the least distance (Dykstra's alternating
 //! projections onto the half-spaces, which converge to the nearest point of their intersection)
 //! to a point that lies, by a margin, on its own triangle's side of every such bisecting plane,
-//! over its base, at least [`super::sides::MIN_HEIGHT`] high, and still on the far side of the
+//! over its base if possible, at least [`super::sides::MIN_HEIGHT`] high, and still on the far side of the
 //! tangent plane at every base vertex whose plane it crosses now (Definition 3.5 stays true).
 //! Apexes that are already inside their wedges are not touched, nor apexes for which no such
 //! point is found, nor the apexes of trihedral corners (step (3), (3')).
@@ -84,9 +84,15 @@ pub fn keep_in_wedges(hull: &mut SimplicialHull) -> usize {
             if wedge[t][side].iter().all(|&(a, b)| a.dot(q0) >= b) {
                 continue;
             }
-            let mut spaces = wedge[t][side].clone();
-            spaces.extend(apex_spaces(hull, t, side, q0));
-            if let Some(q) = nearest_point(q0, &spaces) {
+            // First over the base; where the wedges and the tangent planes leave no room there
+            // (the nut's corner-guard triangles at its 50–80° valleys), anywhere inside them:
+            // the wedges of its shared-side edges still keep the apex beside its own triangle.
+            let found = [true, false].into_iter().find_map(|over_base| {
+                let mut spaces = wedge[t][side].clone();
+                spaces.extend(apex_spaces(hull, t, side, q0, over_base));
+                nearest_point(q0, &spaces)
+            });
+            if let Some(q) = found {
                 hull.apexes[t][side] = Some(q);
                 moved += 1;
             }
@@ -95,10 +101,16 @@ pub fn keep_in_wedges(hull: &mut SimplicialHull) -> usize {
     moved
 }
 
-/// The half-spaces that keep an apex valid: over the base, on its side at least
-/// [`super::sides::MIN_HEIGHT`] times the longest edge, and beyond each base vertex's tangent
-/// plane that `q0` is beyond now while the base does not meet that plane.
-fn apex_spaces(hull: &SimplicialHull, t: usize, side: usize, q0: DVec3) -> Vec<HalfSpace> {
+/// The half-spaces that keep an apex valid: on its side at least [`super::sides::MIN_HEIGHT`]
+/// times the longest edge, beyond each base vertex's tangent plane that `q0` is beyond now while
+/// the base does not meet that plane, and (when `over_base`) over the base.
+fn apex_spaces(
+    hull: &SimplicialHull,
+    t: usize,
+    side: usize,
+    q0: DVec3,
+    over_base: bool,
+) -> Vec<HalfSpace> {
     let tri = hull.triangles[t];
     let base = tri.map(|i| hull.points[i as usize]);
     let sigma = if side == 0 { 1.0 } else { -1.0 };
@@ -112,7 +124,7 @@ fn apex_spaces(hull: &SimplicialHull, t: usize, side: usize, q0: DVec3) -> Vec<H
         sigma * nn,
         sigma * nn.dot(base[0]) + super::sides::MIN_HEIGHT * len,
     )];
-    for k in 0..3 {
+    for k in (0..3).filter(|_| over_base) {
         let (a, b) = (base[k], base[(k + 1) % 3]);
         // In-plane inward normal of edge ab (the base is counter-clockwise round nn).
         let m = nn.cross(b - a);
