@@ -106,6 +106,11 @@ fn diagnose_folds() {
     if "nut".contains(&only) {
         diagnose("nut", &load("nut_pyvista.obj"));
     }
+    for name in ["double_torus_poly", "mpi_poly", "bunny_npm_lowres", "spot"] {
+        if name.contains(&only) {
+            diagnose(name, &load(&format!("{name}.obj")));
+        }
+    }
 }
 
 /// Every pseudo-centroid's fan on the nut is an umbrella round C_0's normal (each triangle

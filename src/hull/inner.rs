@@ -22,7 +22,15 @@
 //!    the least height that keeps it tangent-containing; where T folds, apex pairs are raised
 //!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
 //!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
-//! 6. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//! 6. [`wedge`]: where T folds, apexes of step (5) triangles that lean across the plane
+//!    bisecting the fold (into the neighbour's tetrahedra) are moved the least distance back
+//!    inside their wedge, keeping tangent containment and the least height (beyond the paper;
+//!    the nut's valleys of T).
+//! 7. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//!
+//! In step 4, [`fan`] places the pseudo-centroid C_0 of a separable vertex where its fan
+//! C_0C_iC_{i+1} is an umbrella round n_V with convex edges (beyond the paper: on coarse or
+//! sharply folded models the paper's C_0 folds a fan triangle back over its neighbours).
 //!
 //! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
 //!

@@ -56,6 +56,11 @@ pub fn keep_in_wedges(hull: &mut SimplicialHull) -> usize {
         let (Some(ua), Some(ub)) = (inward(fa), inward(fb)) else {
             continue;
         };
+        // T does not fold here (coplanar triangles: flat regions, guard nets, whose apexes
+        // `guardnet` places on purpose): no wedge.
+        if ua.dot(ub) < -1.0 + 1e-9 {
+            continue;
+        }
         let Some(bn) = (ua - ub).try_normalize() else {
             continue;
         };
@@ -87,10 +92,19 @@ pub fn keep_in_wedges(hull: &mut SimplicialHull) -> usize {
             // First over the base; where the wedges and the tangent planes leave no room there
             // (the nut's corner-guard triangles at its 50–80° valleys), anywhere inside them:
             // the wedges of its shared-side edges still keep the apex beside its own triangle.
+            // The move must not lose tangent containment (Definition 3.5, as `verify` judges
+            // it) at a base vertex where this tetrahedron has it and its partner does not.
+            let keeps = |q: DVec3| {
+                (0..3).all(|k| {
+                    !contains_at(hull, t, q0, k)
+                        || contains_at(hull, t, q, k)
+                        || hull.apexes[t][1 - side].is_some_and(|p| contains_at(hull, t, p, k))
+                })
+            };
             let found = [true, false].into_iter().find_map(|over_base| {
                 let mut spaces = wedge[t][side].clone();
                 spaces.extend(apex_spaces(hull, t, side, q0, over_base));
-                nearest_point(q0, &spaces)
+                nearest_point(q0, &spaces).filter(|&q| keeps(q))
             });
             if let Some(q) = found {
                 hull.apexes[t][side] = Some(q);
@@ -145,6 +159,29 @@ fn apex_spaces(
         }
     }
     out
+}
+
+/// Whether the face tetrahedron of triangle `t` with apex `q` is tangent-containing at its base
+/// vertex `k`, by `verify`'s rule and tolerance.
+fn contains_at(hull: &SimplicialHull, t: usize, q: DVec3, k: usize) -> bool {
+    let tri = hull.triangles[t];
+    let base = tri.map(|i| hull.points[i as usize]);
+    let tet = [base[0], base[1], base[2], q];
+    let mut longest: f64 = 0.0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            longest = longest.max((tet[i] - tet[j]).length());
+        }
+    }
+    let tol = super::verify::PLANE_TOL * longest;
+    let (pk, nk) = (base[k], hull.normals[tri[k] as usize]);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for x in tet.iter().filter(|&&x| x != pk) {
+        let v = nk.dot(*x - pk);
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    lo <= tol && hi >= -tol
 }
 
 /// The point of the intersection of `spaces` nearest to `q0` (Dykstra's algorithm), or `None`
