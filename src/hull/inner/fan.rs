@@ -7,15 +7,18 @@
 //! not: at the top-inner ring of the 5×5 quad torus the two upper faces' centroids project to
 //! a chord that passes *between* V and the torus's axis (five major steps of 72°), and along the
 //! nut's sharp ridges likewise; the triangle C_0C_iC_{i+1} then faces against n_V (T folds back
-//! on itself by ~178°), its face tetrahedra point into the neighbouring triangles' ones and the
-//! hull overlaps (torus_quad: every Intersecting violation involved such a fan).
+//! on itself by ~155–178°), its face tetrahedra point into the neighbouring triangles' ones and
+//! the hull overlaps (torus_quad: every Intersecting violation involves such a fan).
 //!
 //! The cut position is a free quantity of the construction (§7: how far a corner is cut), so
-//! [`into_fan_kernel`] slides C_0 parallel to π — keeping π itself, hence every quantity of
-//! step (5) measured against it (X, T_0, T_1, the s_i) — to the nearest point where every fan
-//! triangle's projection onto π is at least [`FAN_MARGIN`] times its projected base long in
-//! height. Where V's own projection already is such a point (every test polyhedron but the
-//! coarse torus, most of any real model) C_0 stays where the paper puts it.
+//! [`place_pseudo_centroid`] moves C_0 — parallel to π, at the paper's depth or a few other
+//! depths along n_V — to the nearest point where every fan triangle's projection onto π is at
+//! least [`FAN_MARGIN`] times its projected base long in height *and* every edge C_0C_i of T
+//! stays convex (Lemma 4.1). Where the paper's C_0 already is such a point (every test
+//! polyhedron but the coarse tori, all but 15 fans of the nut) it stays. Where no point is (the
+//! 10 fans of torus_quad's top and bottom inner rings: a point inside the kernel is above the
+//! steep inner faces' planes or below the outer faces' centroids), the paper's C_0 stays and the
+//! hull keeps its overlaps there.
 
 use glam::{DVec2, DVec3};
 
