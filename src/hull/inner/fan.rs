@@ -44,7 +44,7 @@ type HalfPlane = (DVec2, f64);
 ///
 /// Returns the paper's C_0 when its fan is an umbrella with margin: every fan triangle's
 /// projection onto π at least [`FAN_MARGIN`] times its projected base high. Otherwise the
-/// nearest point (over the depths of [`DEPTHS`], sliding parallel to each π) where that holds
+/// nearest point (over the depths of `DEPTHS`, sliding parallel to each π) where that holds
 /// *and* every edge C_0C_i of T is convex (Lemma 4.1: C_0 lies on the side of face i's plane
 /// that C_i lies on of π, or on the plane). When none exists, the paper's C_0.
 #[must_use]
