@@ -22,9 +22,18 @@
 //!    the least height that keeps it tangent-containing; where T folds, apex pairs are raised
 //!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
 //!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
-//!    [`degenerate`] then rebuilds over the base any face tetrahedron that is still degenerate
-//!    (far apexes from nearly parallel intersections), or names the element in an error.
-//! 6. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//! 6. [`wedge`]: where T folds, apexes of step (5) triangles that lean across the plane
+//!    bisecting the fold (into the neighbour's tetrahedra) are moved the least distance back
+//!    inside their wedge, keeping tangent containment and the least height (beyond the paper;
+//!    the nut's valleys of T).
+//!    [`degenerate`] then (after the wedges) rebuilds over the base any face tetrahedron that
+//!    is still degenerate (far apexes from nearly parallel intersections), or names the
+//!    element in an error.
+//! 7. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
+//!
+//! In step 4, [`fan`] places the pseudo-centroid C_0 of a separable vertex where its fan
+//! C_0C_iC_{i+1} is an umbrella round n_V with convex edges (beyond the paper: on coarse or
+//! sharply folded models the paper's C_0 folds a fan triangle back over its neighbours).
 //!
 //! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
 //!
@@ -40,10 +49,12 @@ pub mod coplanar;
 pub mod corner;
 pub mod decompose;
 pub mod degenerate;
+pub mod fan;
 pub mod guardnet;
 pub mod remesh;
 pub mod sides;
 pub mod verify;
+pub mod wedge;
 
 pub use verify::{verify, HullViolation, ViolationKind};
 
@@ -155,6 +166,8 @@ pub struct InnerReport {
     pub remeshed: Vec<remesh::RemeshedCorner>,
     /// Triangles whose degenerate face tetrahedra were rebuilt over their base ([`degenerate`]).
     pub degenerate_repaired: usize,
+    /// Apexes moved back inside the wedge of a fold of T ([`wedge`]).
+    pub wedged: usize,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -320,6 +333,7 @@ pub fn build_with_report(
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
+    report.wedged = wedge::keep_in_wedges(&mut hull);
     report.degenerate_repaired = degenerate::repair(&mut hull, &mesh.vertex_lines)?;
     Ok((hull, report))
 }

@@ -149,7 +149,8 @@ pub fn build_corner(
             .copied()
             .min_by(|a, b| a.abs().total_cmp(&b.abs()))
             .expect("k > 3 faces");
-        c.v + (1.0 - options.alpha) * t_star * n
+        // Beyond the paper (`fan`): C_0 slides (or cuts deeper) until its fan is an umbrella.
+        super::fan::place_pseudo_centroid(c.v, n, t_star, options.alpha, &pts, &nrm)
     } else {
         c.v
     };
