@@ -49,6 +49,21 @@ where
     s.parse().unwrap()
 }
 
+/// Checks one `<emitter>` element: its `kind`, the `x`/`y`/`z` attributes of its first element
+/// starting with `at.0` (a direction or a position) against `at.1`, and its `<rgb>` named
+/// `rgb.0` against `rgb.1`.
+fn assert_emitter(e: &str, kind: &str, at: (&str, DVec3), rgb: (&str, DVec3)) {
+    assert_eq!(attr(e, "<emitter", "type"), kind);
+    let v = DVec3::new(
+        num(&attr(e, at.0, "x")),
+        num(&attr(e, at.0, "y")),
+        num(&attr(e, at.0, "z")),
+    );
+    assert_eq!(v, at.1);
+    let head = format!("<rgb name=\"{}\"", rgb.0);
+    assert_eq!(triple(&attr(e, &head, "value")), rgb.1);
+}
+
 /// The `element vertex N` count of a PLY header.
 fn ply_vertices(path: &Path) -> usize {
     let bytes = std::fs::read(path).unwrap();
@@ -132,35 +147,16 @@ fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
             Light::Directional {
                 direction,
                 irradiance,
-            } => {
-                assert_eq!(attr(&e, "<emitter", "type"), "directional");
-                let d = DVec3::new(
-                    num(&attr(&e, "<vector", "x")),
-                    num(&attr(&e, "<vector", "y")),
-                    num(&attr(&e, "<vector", "z")),
-                );
-                assert_eq!(d, direction);
-                assert_eq!(
-                    triple(&attr(&e, "<rgb name=\"irradiance\"", "value")),
-                    irradiance
-                );
-            }
+            } => assert_emitter(
+                &e,
+                "directional",
+                ("<vector", direction),
+                ("irradiance", irradiance),
+            ),
             Light::Point {
                 position,
                 intensity,
-            } => {
-                assert_eq!(attr(&e, "<emitter", "type"), "point");
-                let p = DVec3::new(
-                    num(&attr(&e, "<point", "x")),
-                    num(&attr(&e, "<point", "y")),
-                    num(&attr(&e, "<point", "z")),
-                );
-                assert_eq!(p, position);
-                assert_eq!(
-                    triple(&attr(&e, "<rgb name=\"intensity\"", "value")),
-                    intensity
-                );
-            }
+            } => assert_emitter(&e, "point", ("<point", position), ("intensity", intensity)),
             Light::Constant { radiance } => {
                 assert_eq!(attr(&e, "<emitter", "type"), "constant");
                 assert_eq!(
