@@ -5,6 +5,28 @@ use crate::bb::{multi_indices, num_coeffs};
 use crate::complex::{Patch, PatchComplex, Role, SheetRule};
 use glam::{DMat3, DVec3};
 
+/// One splitmix64 step: a seeded, reproducible uniform number in [0, 1) (the top 53 bits),
+/// for tests and benches that need deterministic random samples without a generator crate.
+pub fn splitmix(state: &mut u64) -> f64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// A uniformly distributed unit vector from [`splitmix`]: rejection sampling in the unit ball
+/// (points too near the centre are rejected too, so normalising them is well conditioned).
+pub fn random_unit(state: &mut u64) -> DVec3 {
+    loop {
+        let v = DVec3::new(splitmix(state), splitmix(state), splitmix(state)) * 2.0 - 1.0;
+        let l = v.length_squared();
+        if l > 1e-4 && l <= 1.0 {
+            return v / l.sqrt();
+        }
+    }
+}
+
 /// A quadric F(x) = xᵀ A x + bᵀ x + c (A symmetric).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quadric {
