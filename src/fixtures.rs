@@ -107,6 +107,34 @@ pub fn quadric_weights(q: &Quadric, tet: &[DVec3; 4], n: usize) -> Vec<f64> {
     w
 }
 
+/// The unit tetrahedron: the origin and the three unit points, the reference simplex of tests.
+pub const UNIT_TET: [DVec3; 4] = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+
+/// A plain polynomial patch: BB `weights` of `degree` on `tet`, no rational terms, any sheet,
+/// role `Other`, element 0, no j-vertex or j-edge (the patch tests build by hand; set other
+/// fields with struct update syntax).
+#[must_use]
+pub fn plain_patch(tet: [DVec3; 4], degree: usize, weights: Vec<f64>) -> Patch {
+    Patch {
+        tet: tet.map(|v| v.to_array()),
+        degree: u8::try_from(degree).expect("patch degree fits in u8"),
+        weights,
+        rational: Vec::new(),
+        sheet: SheetRule::Any,
+        role: Role::Other,
+        element: 0,
+        jvertex: None,
+        jedge: None,
+    }
+}
+
+/// The quadric as a plain patch of degree `n` (≥ 2) on `tet`: exact, with
+/// [`quadric_weights`].
+#[must_use]
+pub fn quadric_patch(q: &Quadric, tet: [DVec3; 4], n: usize) -> Patch {
+    plain_patch(tet, n, quadric_weights(q, &tet, n))
+}
+
 /// The six tetrahedra of the Kuhn subdivision of the cube [lo, hi]: they share faces exactly
 /// with the neighbouring cubes' tetrahedra, so a grid of cubes is a conforming complex.
 #[must_use]
@@ -177,15 +205,8 @@ pub fn quadric_complex(
                 );
                 for tet in kuhn_tets(a, bb) {
                     c.patches.push(Patch {
-                        tet: tet.map(|v| v.to_array()),
-                        degree: degree as u8,
-                        weights: quadric_weights(q, &tet, degree),
-                        rational: Vec::new(),
-                        sheet: SheetRule::Any,
-                        role: Role::Other,
                         element,
-                        jvertex: None,
-                        jedge: None,
+                        ..quadric_patch(q, tet, degree)
                     });
                 }
                 element += 1;
