@@ -216,6 +216,45 @@ pub fn quadric_complex(
     c
 }
 
+/// The regular octahedron on the unit axes: 6 vertices (±x, ±y, ±z in that order), 8
+/// triangles oriented outward. Its vertices are also its exact sphere normals.
+#[must_use]
+pub fn octahedron() -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let v = vec![
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ];
+    let f = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    (v, f)
+}
+
+/// Unit normals of a sphere-like mesh on the unit sphere, `v`, tilted away from the radial
+/// direction by `tilt` along a deterministic per-vertex direction: normals the schemes must
+/// interpolate without being handed the exact sphere (tilt 0 gives the normalised positions).
+#[must_use]
+pub fn tilted_normals(v: &[DVec3], tilt: f64) -> Vec<DVec3> {
+    v.iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let i = i as f64;
+            (*x + tilt * DVec3::new(i.sin(), (2.0 * i).cos(), 0.3)).normalize()
+        })
+        .collect()
+}
+
 /// The regular icosahedron inscribed in the unit sphere: 12 vertices, 20 triangles oriented
 /// outward (counter-clockwise seen from outside). Test meshes for every scheme start here.
 #[must_use]

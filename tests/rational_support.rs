@@ -30,24 +30,7 @@ pub fn sphere_model(name: &'static str, levels: usize) -> Model {
 }
 
 pub fn octahedron() -> Model {
-    let v = vec![
-        DVec3::X,
-        -DVec3::X,
-        DVec3::Y,
-        -DVec3::Y,
-        DVec3::Z,
-        -DVec3::Z,
-    ];
-    let f = vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
+    let (v, f) = apatch::fixtures::octahedron();
     Model {
         name: "octahedron",
         normals: v.clone(),

@@ -16,36 +16,12 @@ fn complex(v: &[DVec3], f: &[[u32; 3]], n: &[DVec3]) -> PatchComplex {
 
 fn icosahedron(tilt: f64) -> PatchComplex {
     let (v, f) = apatch::fixtures::icosahedron();
-    let n: Vec<DVec3> = v
-        .iter()
-        .enumerate()
-        .map(|(i, x)| {
-            let i = i as f64;
-            (*x + tilt * DVec3::new(i.sin(), (2.0 * i).cos(), 0.3)).normalize()
-        })
-        .collect();
+    let n = apatch::fixtures::tilted_normals(&v, tilt);
     complex(&v, &f, &n)
 }
 
 fn octahedron() -> PatchComplex {
-    let v = vec![
-        DVec3::X,
-        -DVec3::X,
-        DVec3::Y,
-        -DVec3::Y,
-        DVec3::Z,
-        -DVec3::Z,
-    ];
-    let f = [
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
+    let (v, f) = apatch::fixtures::octahedron();
     complex(&v, &f, &v)
 }
 
