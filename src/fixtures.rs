@@ -27,6 +27,22 @@ pub fn random_unit(state: &mut u64) -> DVec3 {
     }
 }
 
+/// A tiny seeded generator for reproducible random test geometry: a 64-bit linear
+/// congruential generator (Knuth's MMIX constants) whose top 53 bits give the sample.
+#[derive(Clone, Debug)]
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// The next uniform number in [0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// A quadric F(x) = xᵀ A x + bᵀ x + c (A symmetric).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quadric {
