@@ -232,6 +232,35 @@ pub fn quadric_complex(
     c
 }
 
+/// A mesh through the 2001 rational C¹ scheme as the tests build it: triangulated, with
+/// angle-weighted vertex normals of the input faces and default options. Returns the
+/// triangulation, its triangles and the build.
+///
+/// # Panics
+/// When the normals or the scheme fail (fixtures are known-good meshes).
+#[must_use]
+pub fn rational_angle_build(
+    m: &crate::mesh::Mesh,
+) -> (
+    crate::mesh::Mesh,
+    Vec<[u32; 3]>,
+    crate::scheme::rational_c1::RationalBuild,
+) {
+    use crate::mesh::{triangulate, vertex_normals, NormalMethod};
+    use crate::scheme::rational_c1::{build, RationalOptions};
+    let tri = triangulate(m);
+    let normals = vertex_normals(m, NormalMethod::Angle).expect("angle normals");
+    let triangles: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    let b = build(
+        &tri.positions,
+        &triangles,
+        &normals,
+        &RationalOptions::default(),
+    )
+    .expect("the rational scheme builds");
+    (tri, triangles, b)
+}
+
 /// The regular octahedron on the unit axes: 6 vertices (±x, ±y, ±z in that order), 8
 /// triangles oriented outward. Its vertices are also its exact sphere normals.
 #[must_use]

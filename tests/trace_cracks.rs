@@ -2,9 +2,8 @@
 //! the generated Platonic solids and a subdivided icosahedron) in seeded random directions
 //! always hit the surface, and every hit lies where F = 0 on an accepted sheet.
 
-use apatch::fixtures::{random_unit as unit, splitmix as rng};
-use apatch::mesh::{self, NormalMethod};
-use apatch::scheme::rational_c1::{build, RationalOptions};
+use apatch::fixtures::{random_unit as unit, rational_angle_build, splitmix as rng};
+use apatch::mesh;
 use apatch::trace::Geometry;
 use glam::DVec3;
 use std::path::Path;
@@ -26,16 +25,7 @@ fn rays_from_inside_rational_complexes_never_miss() {
     ] {
         let (m, report) = mesh::load(&dir.join(name)).unwrap();
         report.require(true).unwrap();
-        let tri = mesh::triangulate(&m);
-        let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
-        let triangles: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
-        let b = build(
-            &tri.positions,
-            &triangles,
-            &normals,
-            &RationalOptions::default(),
-        )
-        .unwrap();
+        let (tri, triangles, b) = rational_angle_build(&m);
         let geo = Geometry::new(&b.complex).unwrap();
         // Inscribed radius of the mesh: points well inside it are inside the surface.
         let centre = tri.positions.iter().sum::<DVec3>() / tri.positions.len() as f64;

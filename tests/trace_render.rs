@@ -277,21 +277,10 @@ output = "out/s.png"
 
 #[test]
 fn rational_complex_renders_identically_with_any_thread_count() {
-    use apatch::mesh::{self, NormalMethod};
-    use apatch::scheme::rational_c1::{build, RationalOptions};
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models/icosahedron.obj");
-    let (m, _) = mesh::load(&path).unwrap();
-    let tri = mesh::triangulate(&m);
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
-    let triangles: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
-    let b = build(
-        &tri.positions,
-        &triangles,
-        &normals,
-        &RationalOptions::default(),
-    )
-    .unwrap();
+    let (m, _) = apatch::mesh::load(&path).unwrap();
+    let (_, _, b) = apatch::fixtures::rational_angle_build(&m);
     let geo = Geometry::new(&b.complex).unwrap();
     let (_, mut s) = setup(Mode::Shaded, 1);
     s.camera = Camera::look_at(
