@@ -64,6 +64,14 @@ fn assert_emitter(e: &str, kind: &str, at: (&str, DVec3), rgb: (&str, DVec3)) {
     assert_eq!(triple(&attr(e, &head, "value")), rgb.1);
 }
 
+/// The number in the `value` attribute of the first `<kind name="name" …>` element.
+fn value<T: std::str::FromStr>(xml: &str, kind: &str, name: &str) -> T
+where
+    T::Err: std::fmt::Debug,
+{
+    num(&attr(xml, &format!("<{kind} name=\"{name}\""), "value"))
+}
+
 /// The `element vertex N` count of a PLY header.
 fn ply_vertices(path: &Path) -> usize {
     let bytes = std::fs::read(path).unwrap();
@@ -107,32 +115,17 @@ fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
     assert_eq!(triple(&attr(&xml, "<lookat", "origin")), c.origin);
     assert_eq!(triple(&attr(&xml, "<lookat", "target")), DVec3::ZERO);
     assert_eq!(triple(&attr(&xml, "<lookat", "up")), DVec3::Y);
-    assert_eq!(
-        num::<f64>(&attr(&xml, "<float name=\"fov\"", "value")),
-        c.fov
-    );
+    assert_eq!(value::<f64>(&xml, "float", "fov"), c.fov);
     assert_eq!(attr(&xml, "<string name=\"fov_axis\"", "value"), "x");
-    assert_eq!(
-        num::<f64>(&attr(&xml, "<float name=\"near_clip\"", "value")),
-        c.near_clip
-    );
+    assert_eq!(value::<f64>(&xml, "float", "near_clip"), c.near_clip);
     // Film, sampler, integrator, material.
     assert_eq!(attr(&xml, "<film", "type"), "hdrfilm");
-    assert_eq!(
-        num::<u32>(&attr(&xml, "<integer name=\"width\"", "value")),
-        c.width
-    );
-    assert_eq!(
-        num::<u32>(&attr(&xml, "<integer name=\"height\"", "value")),
-        c.height
-    );
+    assert_eq!(value::<u32>(&xml, "integer", "width"), c.width);
+    assert_eq!(value::<u32>(&xml, "integer", "height"), c.height);
     assert_eq!(attr(&xml, "<string name=\"pixel_format\"", "value"), "rgba");
     assert_eq!(attr(&xml, "<rfilter", "type"), "box");
     assert_eq!(attr(&xml, "<sampler", "type"), "independent");
-    assert_eq!(
-        num::<u32>(&attr(&xml, "<integer name=\"sample_count\"", "value")),
-        s.spp
-    );
+    assert_eq!(value::<u32>(&xml, "integer", "sample_count"), s.spp);
     assert_eq!(attr(&xml, "<integrator", "type"), "direct");
     assert_eq!(
         triple(&attr(&xml, "<rgb name=\"reflectance\"", "value")),
