@@ -22,6 +22,30 @@ fn cube() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cube.toml")
 }
 
+/// `apatch export mitsuba <scene> -o <out>` with `extra` arguments.
+fn export_mitsuba(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "export",
+        "mitsuba",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    apatch(&args)
+}
+
+/// A fresh scratch directory `tmp(name)` holding `file`, the cube scene's text after `edit`;
+/// returns the directory and the file's path.
+fn edited_cube(name: &str, file: &str, edit: impl FnOnce(String) -> String) -> (PathBuf, PathBuf) {
+    let dir = tmp(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = dir.join(file);
+    std::fs::write(&toml, edit(std::fs::read_to_string(cube()).unwrap())).unwrap();
+    (dir, toml)
+}
+
 /// The value of attribute `name` in the first element of `xml` that starts with `head`.
 fn attr(xml: &str, head: &str, name: &str) -> String {
     let start = xml
@@ -94,15 +118,7 @@ fn ply_vertices(path: &Path) -> usize {
 fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
     let dir = tmp("cube");
     let _ = std::fs::remove_dir_all(&dir);
-    let o = apatch(&[
-        "export",
-        "mitsuba",
-        cube().to_str().unwrap(),
-        "-o",
-        dir.to_str().unwrap(),
-        "--resolution",
-        "3",
-    ]);
+    let o = export_mitsuba(&cube(), &dir, &["--resolution", "3"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let xml = std::fs::read_to_string(dir.join("cube.xml")).unwrap();
     let scene = apatch::scene::load(&cube()).unwrap();
@@ -169,28 +185,15 @@ fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
 
 #[test]
 fn depth_mode_exports_the_aov_integrator() {
-    let dir = tmp("depth");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(cube())
-        .unwrap()
-        .replace("mode = \"shaded\"", "mode = \"depth\"")
-        .replace(
-            "models/",
-            &format!("{}/scenes/models/", env!("CARGO_MANIFEST_DIR")),
-        );
-    let toml = dir.join("d.toml");
-    std::fs::write(&toml, text).unwrap();
+    let (dir, toml) = edited_cube("depth", "d.toml", |text| {
+        text.replace("mode = \"shaded\"", "mode = \"depth\"")
+            .replace(
+                "models/",
+                &format!("{}/scenes/models/", env!("CARGO_MANIFEST_DIR")),
+            )
+    });
     let out = dir.join("out");
-    let o = apatch(&[
-        "export",
-        "mitsuba",
-        toml.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--resolution",
-        "2",
-    ]);
+    let o = export_mitsuba(&toml, &out, &["--resolution", "2"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let xml = std::fs::read_to_string(out.join("d.xml")).unwrap();
     assert_eq!(attr(&xml, "<integrator", "type"), "aov");
@@ -203,22 +206,11 @@ fn depth_mode_exports_the_aov_integrator() {
 
 #[test]
 fn bad_scene_is_one_line_exit_2_and_writes_nothing() {
-    let dir = tmp("bad");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let toml = dir.join("bad.toml");
-    let text = std::fs::read_to_string(cube())
-        .unwrap()
-        .replace("fov = 30", "fov = 300");
-    std::fs::write(&toml, text).unwrap();
+    let (dir, toml) = edited_cube("bad", "bad.toml", |text| {
+        text.replace("fov = 30", "fov = 300")
+    });
     let out = dir.join("out");
-    let o = apatch(&[
-        "export",
-        "mitsuba",
-        toml.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = export_mitsuba(&toml, &out, &[]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
