@@ -373,24 +373,10 @@ impl<'de> Visitor<'de> for PatchListVisitor {
 mod tests {
     use super::*;
     use crate::complex::{Role, SheetRule};
+    use crate::fixtures::{plain_patch, UNIT_TET};
 
     fn unit_patch() -> Patch {
-        Patch {
-            tet: [
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-            ],
-            degree: 1,
-            weights: vec![1.0, -1.0, 0.5, 0.25],
-            rational: Vec::new(),
-            sheet: SheetRule::Any,
-            role: Role::Other,
-            element: 0,
-            jvertex: None,
-            jedge: None,
-        }
+        plain_patch(UNIT_TET, 1, vec![1.0, -1.0, 0.5, 0.25])
     }
 
     #[test]

@@ -5,6 +5,44 @@ use crate::bb::{multi_indices, num_coeffs};
 use crate::complex::{Patch, PatchComplex, Role, SheetRule};
 use glam::{DMat3, DVec3};
 
+/// One splitmix64 step: a seeded, reproducible uniform number in [0, 1) (the top 53 bits),
+/// for tests and benches that need deterministic random samples without a generator crate.
+pub fn splitmix(state: &mut u64) -> f64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// A uniformly distributed unit vector from [`splitmix`]: rejection sampling in the unit ball
+/// (points too near the centre are rejected too, so normalising them is well conditioned).
+pub fn random_unit(state: &mut u64) -> DVec3 {
+    loop {
+        let v = DVec3::new(splitmix(state), splitmix(state), splitmix(state)) * 2.0 - 1.0;
+        let l = v.length_squared();
+        if l > 1e-4 && l <= 1.0 {
+            return v / l.sqrt();
+        }
+    }
+}
+
+/// A tiny seeded generator for reproducible random test geometry: a 64-bit linear
+/// congruential generator (Knuth's MMIX constants) whose top 53 bits give the sample.
+#[derive(Clone, Debug)]
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// The next uniform number in [0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// A quadric F(x) = xᵀ A x + bᵀ x + c (A symmetric).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quadric {
@@ -85,6 +123,34 @@ pub fn quadric_weights(q: &Quadric, tet: &[DVec3; 4], n: usize) -> Vec<f64> {
     w
 }
 
+/// The unit tetrahedron: the origin and the three unit points, the reference simplex of tests.
+pub const UNIT_TET: [DVec3; 4] = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+
+/// A plain polynomial patch: BB `weights` of `degree` on `tet`, no rational terms, any sheet,
+/// role `Other`, element 0, no j-vertex or j-edge (the patch tests build by hand; set other
+/// fields with struct update syntax).
+#[must_use]
+pub fn plain_patch(tet: [DVec3; 4], degree: usize, weights: Vec<f64>) -> Patch {
+    Patch {
+        tet: tet.map(|v| v.to_array()),
+        degree: u8::try_from(degree).expect("patch degree fits in u8"),
+        weights,
+        rational: Vec::new(),
+        sheet: SheetRule::Any,
+        role: Role::Other,
+        element: 0,
+        jvertex: None,
+        jedge: None,
+    }
+}
+
+/// The quadric as a plain patch of degree `n` (≥ 2) on `tet`: exact, with
+/// [`quadric_weights`].
+#[must_use]
+pub fn quadric_patch(q: &Quadric, tet: [DVec3; 4], n: usize) -> Patch {
+    plain_patch(tet, n, quadric_weights(q, &tet, n))
+}
+
 /// The six tetrahedra of the Kuhn subdivision of the cube [lo, hi]: they share faces exactly
 /// with the neighbouring cubes' tetrahedra, so a grid of cubes is a conforming complex.
 #[must_use]
@@ -155,15 +221,8 @@ pub fn quadric_complex(
                 );
                 for tet in kuhn_tets(a, bb) {
                     c.patches.push(Patch {
-                        tet: tet.map(|v| v.to_array()),
-                        degree: degree as u8,
-                        weights: quadric_weights(q, &tet, degree),
-                        rational: Vec::new(),
-                        sheet: SheetRule::Any,
-                        role: Role::Other,
                         element,
-                        jvertex: None,
-                        jedge: None,
+                        ..quadric_patch(q, tet, degree)
                     });
                 }
                 element += 1;
@@ -171,6 +230,74 @@ pub fn quadric_complex(
         }
     }
     c
+}
+
+/// A mesh through the 2001 rational C¹ scheme as the tests build it: triangulated, with
+/// angle-weighted vertex normals of the input faces and default options. Returns the
+/// triangulation, its triangles and the build.
+///
+/// # Panics
+/// When the normals or the scheme fail (fixtures are known-good meshes).
+#[must_use]
+pub fn rational_angle_build(
+    m: &crate::mesh::Mesh,
+) -> (
+    crate::mesh::Mesh,
+    Vec<[u32; 3]>,
+    crate::scheme::rational_c1::RationalBuild,
+) {
+    use crate::mesh::{triangulate, vertex_normals, NormalMethod};
+    use crate::scheme::rational_c1::{build, RationalOptions};
+    let tri = triangulate(m);
+    let normals = vertex_normals(m, NormalMethod::Angle).expect("angle normals");
+    let triangles: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    let b = build(
+        &tri.positions,
+        &triangles,
+        &normals,
+        &RationalOptions::default(),
+    )
+    .expect("the rational scheme builds");
+    (tri, triangles, b)
+}
+
+/// The regular octahedron on the unit axes: 6 vertices (±x, ±y, ±z in that order), 8
+/// triangles oriented outward. Its vertices are also its exact sphere normals.
+#[must_use]
+pub fn octahedron() -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let v = vec![
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ];
+    let f = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    (v, f)
+}
+
+/// Unit normals of a sphere-like mesh on the unit sphere, `v`, tilted away from the radial
+/// direction by `tilt` along a deterministic per-vertex direction: normals the schemes must
+/// interpolate without being handed the exact sphere (tilt 0 gives the normalised positions).
+#[must_use]
+pub fn tilted_normals(v: &[DVec3], tilt: f64) -> Vec<DVec3> {
+    v.iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let i = i as f64;
+            (*x + tilt * DVec3::new(i.sin(), (2.0 * i).cos(), 0.3)).normalize()
+        })
+        .collect()
 }
 
 /// The regular icosahedron inscribed in the unit sphere: 12 vertices, 20 triangles oriented

@@ -3,7 +3,8 @@
 //! Seeded (fixed proptest seed, no persistence) so every run checks the same cases.
 
 use apatch::bb::{multi_indices, num_coeffs, poly, uni, BbPoly, Tet};
-use apatch::complex::{Patch, RationalTerm, Role, SheetRule};
+use apatch::complex::{Patch, RationalTerm};
+use apatch::fixtures::{plain_patch, UNIT_TET};
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
@@ -386,15 +387,8 @@ fn rational_patch() -> impl Strategy<Value = Patch> {
                 rational.extend(edge_terms(we));
             }
             Patch {
-                tet: t.v.map(|v| v.to_array()),
-                degree: 3,
-                weights,
                 rational,
-                sheet: SheetRule::Any,
-                role: Role::Other,
-                element: 0,
-                jvertex: None,
-                jedge: None,
+                ..plain_patch(t.v, 3, weights)
             }
         })
 }
@@ -489,20 +483,8 @@ proptest! {
 
 fn unit_tet_patch(rational: Vec<RationalTerm>) -> Patch {
     Patch {
-        tet: [
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-        ],
-        degree: 3,
-        weights: vec![0.0; num_coeffs(3)],
         rational,
-        sheet: SheetRule::Any,
-        role: Role::Other,
-        element: 0,
-        jvertex: None,
-        jedge: None,
+        ..plain_patch(UNIT_TET, 3, vec![0.0; num_coeffs(3)])
     }
 }
 
@@ -543,7 +525,7 @@ fn face_term_tends_to_zero_at_its_edges() {
 #[test]
 fn quadric_fixture_is_reproduced() {
     // The fixtures' exact blossom weights: F must equal the quadric, ∇F its gradient.
-    use apatch::fixtures::{quadric_weights, Quadric};
+    use apatch::fixtures::{quadric_patch, Quadric};
     let q = Quadric::sphere(DVec3::new(0.1, 0.2, -0.3), 0.8);
     let v = [
         DVec3::new(-1.0, -0.5, -0.2),
@@ -552,17 +534,7 @@ fn quadric_fixture_is_reproduced() {
         DVec3::new(0.0, 0.2, 1.4),
     ];
     for n in 2..=7 {
-        let p = Patch {
-            tet: v.map(|x| x.to_array()),
-            degree: n as u8,
-            weights: quadric_weights(&q, &v, n),
-            rational: Vec::new(),
-            sheet: SheetRule::Any,
-            role: Role::Other,
-            element: 0,
-            jvertex: None,
-            jedge: None,
-        };
+        let p = quadric_patch(&q, v, n);
         for x in [
             DVec3::ZERO,
             DVec3::new(0.2, 0.1, 0.3),
@@ -590,7 +562,7 @@ proptest! {
         dir in proptest::array::uniform3(-1.0f64..1.0), normal in proptest::array::uniform3(-1.0f64..1.0),
         n in 2usize..=7, s0 in 0.2f64..0.8,
     ) {
-        use apatch::fixtures::{quadric_weights, Quadric};
+        use apatch::fixtures::{quadric_patch, Quadric};
         let (dir, normal) = (DVec3::from_array(dir), DVec3::from_array(normal));
         prop_assume!(dir.length() > 0.1 && normal.cross(dir).length() > 0.1);
         let (center, r) = (DVec3::new(0.1, 0.2, 0.3), 0.4);
@@ -606,17 +578,7 @@ proptest! {
             DVec3::new(-2.0, -2.0, 3.0),
         ];
         let q = Quadric::sphere(center, r);
-        let p = Patch {
-            tet: v.map(|x| x.to_array()),
-            degree: n as u8,
-            weights: quadric_weights(&q, &v, n),
-            rational: Vec::new(),
-            sheet: SheetRule::Any,
-            role: Role::Other,
-            element: 0,
-            jvertex: None,
-            jedge: None,
-        };
+        let p = quadric_patch(&q, v, n);
         let mut out = [0.0; 16];
         let len = p.segment_poly(x0, x1, &mut out);
         let got = uni::first_root(&out[..len]);

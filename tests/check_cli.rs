@@ -26,6 +26,20 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// `apatch check` of the complex at `path`, which must fail (exit 1): the text report and its
+/// line starting with `measure`.
+fn failed_check(path: &Path, measure: &str) -> (String, String) {
+    let o = apatch(&["check", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
+    let out = stdout(&o);
+    let line = out
+        .lines()
+        .find(|l| l.starts_with(measure))
+        .unwrap_or_else(|| panic!("{out}"))
+        .to_string();
+    (out, line)
+}
+
 fn sphere_file(name: &str, degree: usize) -> PathBuf {
     let q = Quadric::sphere(DVec3::new(0.05, 0.1, -0.1), 0.7);
     let c = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 3, degree);
@@ -74,13 +88,7 @@ fn broken_complex_fails_with_the_jump_named() {
     c.patches[9].weights[k] += 1e-4;
     let path = tmp("broken.json");
     write_json_file(&c, &path).unwrap();
-    let o = apatch(&["check", path.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
-    let out = stdout(&o);
-    let line = out
-        .lines()
-        .find(|l| l.starts_with("value jump"))
-        .unwrap_or_else(|| panic!("{out}"));
+    let (out, line) = failed_check(&path, "value jump");
     assert!(line.contains("FAIL"), "{line}");
     assert!(line.contains("patches") && line.contains('9'), "{line}");
     assert!(out.contains("FAILED: value jump, gradient jump"), "{out}");
@@ -114,13 +122,7 @@ fn holed_complex_fails_with_the_hole_located() {
     c.patches.remove(k);
     let path = tmp("holed.json");
     write_json_file(&c, &path).unwrap();
-    let o = apatch(&["check", path.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
-    let out = stdout(&o);
-    let line = out
-        .lines()
-        .find(|l| l.starts_with("holes"))
-        .unwrap_or_else(|| panic!("{out}"));
+    let (out, line) = failed_check(&path, "holes");
     assert!(
         line.contains("FAIL") && line.contains("worst: patch "),
         "{line}"

@@ -5,21 +5,13 @@ use apatch::check::{check, CheckOptions};
 use apatch::complex::{PatchComplex, Role};
 use apatch::complex_io::write_json_file;
 use apatch::scheme::rational_c1::{build, RationalOptions};
-use glam::DVec3;
 use std::path::Path;
 use std::process::Command;
 
 /// A unit icosahedron with normals tilted by `tilt` (deterministic) and one vertex pulled out.
 fn icosahedron_complex(tilt: f64) -> PatchComplex {
     let (mut v, f) = apatch::fixtures::icosahedron();
-    let n: Vec<DVec3> = v
-        .iter()
-        .enumerate()
-        .map(|(i, x)| {
-            let i = i as f64;
-            (*x + tilt * DVec3::new(i.sin(), (2.0 * i).cos(), 0.3)).normalize()
-        })
-        .collect();
+    let n = apatch::fixtures::tilted_normals(&v, tilt);
     v[0] *= 1.0 + tilt;
     build(&v, &f, &n, &RationalOptions::default())
         .expect("icosahedron builds")

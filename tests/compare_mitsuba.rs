@@ -13,8 +13,12 @@
 
 use apatch::compare::{self, Image};
 use apatch::export::mitsuba::{scene_xml_with, LookAt, Surface};
-use apatch::fixtures::{icosahedron, quadric_complex, Quadric};
+#[path = "support/sphere_scene.rs"]
+mod sphere_scene;
+
+use apatch::fixtures::icosahedron;
 use glam::DVec3;
+use sphere_scene::{sphere_scene, write_unit_sphere};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -148,16 +152,12 @@ const SPHERE_XML: &str = r#"<scene version="3.0.0">
 </scene>
 "#;
 
-const SPHERE_TOML: &str = r#"
-[model]
-patches = "sphere.json"
-[camera]
-origin = [0, 0, 4]
-target = [0, 0, 0]
-up = [0, 1, 0]
-fov = 40
-width = 64
-height = 48
+/// The scene of `SPHERE_XML` for apatch (camera, film, albedo and light alike).
+fn sphere_toml() -> String {
+    sphere_scene("sphere.json", 64, 48, SPHERE_REST)
+}
+
+const SPHERE_REST: &str = r#"
 [film]
 spp = 64
 filter = "box"
@@ -178,10 +178,8 @@ fn sphere_agrees_with_mitsuba() {
         Err(why) => return skip("sphere_agrees_with_mitsuba", &why),
     };
     let dir = scratch("compare-mts-sphere");
-    let q = Quadric::sphere(DVec3::ZERO, 1.0);
-    let c = quadric_complex(&q, DVec3::splat(-1.2), DVec3::splat(1.2), 2, 2);
-    std::fs::write(dir.join("sphere.json"), serde_json::to_string(&c).unwrap()).unwrap();
-    std::fs::write(dir.join("s.toml"), SPHERE_TOML).unwrap();
+    write_unit_sphere(&dir, "sphere.json");
+    std::fs::write(dir.join("s.toml"), sphere_toml()).unwrap();
     std::fs::write(dir.join("s.xml"), SPHERE_XML).unwrap();
     render_mitsuba(&python, &dir, "s.xml");
     render_apatch(&dir, "s.toml");

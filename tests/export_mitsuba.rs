@@ -22,6 +22,30 @@ fn cube() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cube.toml")
 }
 
+/// `apatch export mitsuba <scene> -o <out>` with `extra` arguments.
+fn export_mitsuba(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "export",
+        "mitsuba",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    apatch(&args)
+}
+
+/// A fresh scratch directory `tmp(name)` holding `file`, the cube scene's text after `edit`;
+/// returns the directory and the file's path.
+fn edited_cube(name: &str, file: &str, edit: impl FnOnce(String) -> String) -> (PathBuf, PathBuf) {
+    let dir = tmp(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = dir.join(file);
+    std::fs::write(&toml, edit(std::fs::read_to_string(cube()).unwrap())).unwrap();
+    (dir, toml)
+}
+
 /// The value of attribute `name` in the first element of `xml` that starts with `head`.
 fn attr(xml: &str, head: &str, name: &str) -> String {
     let start = xml
@@ -49,6 +73,29 @@ where
     s.parse().unwrap()
 }
 
+/// Checks one `<emitter>` element: its `kind`, the `x`/`y`/`z` attributes of its first element
+/// starting with `at.0` (a direction or a position) against `at.1`, and its `<rgb>` named
+/// `rgb.0` against `rgb.1`.
+fn assert_emitter(e: &str, kind: &str, at: (&str, DVec3), rgb: (&str, DVec3)) {
+    assert_eq!(attr(e, "<emitter", "type"), kind);
+    let v = DVec3::new(
+        num(&attr(e, at.0, "x")),
+        num(&attr(e, at.0, "y")),
+        num(&attr(e, at.0, "z")),
+    );
+    assert_eq!(v, at.1);
+    let head = format!("<rgb name=\"{}\"", rgb.0);
+    assert_eq!(triple(&attr(e, &head, "value")), rgb.1);
+}
+
+/// The number in the `value` attribute of the first `<kind name="name" …>` element.
+fn value<T: std::str::FromStr>(xml: &str, kind: &str, name: &str) -> T
+where
+    T::Err: std::fmt::Debug,
+{
+    num(&attr(xml, &format!("<{kind} name=\"{name}\""), "value"))
+}
+
 /// The `element vertex N` count of a PLY header.
 fn ply_vertices(path: &Path) -> usize {
     let bytes = std::fs::read(path).unwrap();
@@ -71,15 +118,7 @@ fn ply_vertices(path: &Path) -> usize {
 fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
     let dir = tmp("cube");
     let _ = std::fs::remove_dir_all(&dir);
-    let o = apatch(&[
-        "export",
-        "mitsuba",
-        cube().to_str().unwrap(),
-        "-o",
-        dir.to_str().unwrap(),
-        "--resolution",
-        "3",
-    ]);
+    let o = export_mitsuba(&cube(), &dir, &["--resolution", "3"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let xml = std::fs::read_to_string(dir.join("cube.xml")).unwrap();
     let scene = apatch::scene::load(&cube()).unwrap();
@@ -92,32 +131,17 @@ fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
     assert_eq!(triple(&attr(&xml, "<lookat", "origin")), c.origin);
     assert_eq!(triple(&attr(&xml, "<lookat", "target")), DVec3::ZERO);
     assert_eq!(triple(&attr(&xml, "<lookat", "up")), DVec3::Y);
-    assert_eq!(
-        num::<f64>(&attr(&xml, "<float name=\"fov\"", "value")),
-        c.fov
-    );
+    assert_eq!(value::<f64>(&xml, "float", "fov"), c.fov);
     assert_eq!(attr(&xml, "<string name=\"fov_axis\"", "value"), "x");
-    assert_eq!(
-        num::<f64>(&attr(&xml, "<float name=\"near_clip\"", "value")),
-        c.near_clip
-    );
+    assert_eq!(value::<f64>(&xml, "float", "near_clip"), c.near_clip);
     // Film, sampler, integrator, material.
     assert_eq!(attr(&xml, "<film", "type"), "hdrfilm");
-    assert_eq!(
-        num::<u32>(&attr(&xml, "<integer name=\"width\"", "value")),
-        c.width
-    );
-    assert_eq!(
-        num::<u32>(&attr(&xml, "<integer name=\"height\"", "value")),
-        c.height
-    );
+    assert_eq!(value::<u32>(&xml, "integer", "width"), c.width);
+    assert_eq!(value::<u32>(&xml, "integer", "height"), c.height);
     assert_eq!(attr(&xml, "<string name=\"pixel_format\"", "value"), "rgba");
     assert_eq!(attr(&xml, "<rfilter", "type"), "box");
     assert_eq!(attr(&xml, "<sampler", "type"), "independent");
-    assert_eq!(
-        num::<u32>(&attr(&xml, "<integer name=\"sample_count\"", "value")),
-        s.spp
-    );
+    assert_eq!(value::<u32>(&xml, "integer", "sample_count"), s.spp);
     assert_eq!(attr(&xml, "<integrator", "type"), "direct");
     assert_eq!(
         triple(&attr(&xml, "<rgb name=\"reflectance\"", "value")),
@@ -132,35 +156,16 @@ fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
             Light::Directional {
                 direction,
                 irradiance,
-            } => {
-                assert_eq!(attr(&e, "<emitter", "type"), "directional");
-                let d = DVec3::new(
-                    num(&attr(&e, "<vector", "x")),
-                    num(&attr(&e, "<vector", "y")),
-                    num(&attr(&e, "<vector", "z")),
-                );
-                assert_eq!(d, direction);
-                assert_eq!(
-                    triple(&attr(&e, "<rgb name=\"irradiance\"", "value")),
-                    irradiance
-                );
-            }
+            } => assert_emitter(
+                &e,
+                "directional",
+                ("<vector", direction),
+                ("irradiance", irradiance),
+            ),
             Light::Point {
                 position,
                 intensity,
-            } => {
-                assert_eq!(attr(&e, "<emitter", "type"), "point");
-                let p = DVec3::new(
-                    num(&attr(&e, "<point", "x")),
-                    num(&attr(&e, "<point", "y")),
-                    num(&attr(&e, "<point", "z")),
-                );
-                assert_eq!(p, position);
-                assert_eq!(
-                    triple(&attr(&e, "<rgb name=\"intensity\"", "value")),
-                    intensity
-                );
-            }
+            } => assert_emitter(&e, "point", ("<point", position), ("intensity", intensity)),
             Light::Constant { radiance } => {
                 assert_eq!(attr(&e, "<emitter", "type"), "constant");
                 assert_eq!(
@@ -180,28 +185,15 @@ fn cube_xml_matches_the_scene_and_the_ply_matches_tessellate() {
 
 #[test]
 fn depth_mode_exports_the_aov_integrator() {
-    let dir = tmp("depth");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(cube())
-        .unwrap()
-        .replace("mode = \"shaded\"", "mode = \"depth\"")
-        .replace(
-            "models/",
-            &format!("{}/scenes/models/", env!("CARGO_MANIFEST_DIR")),
-        );
-    let toml = dir.join("d.toml");
-    std::fs::write(&toml, text).unwrap();
+    let (dir, toml) = edited_cube("depth", "d.toml", |text| {
+        text.replace("mode = \"shaded\"", "mode = \"depth\"")
+            .replace(
+                "models/",
+                &format!("{}/scenes/models/", env!("CARGO_MANIFEST_DIR")),
+            )
+    });
     let out = dir.join("out");
-    let o = apatch(&[
-        "export",
-        "mitsuba",
-        toml.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--resolution",
-        "2",
-    ]);
+    let o = export_mitsuba(&toml, &out, &["--resolution", "2"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let xml = std::fs::read_to_string(out.join("d.xml")).unwrap();
     assert_eq!(attr(&xml, "<integrator", "type"), "aov");
@@ -214,22 +206,11 @@ fn depth_mode_exports_the_aov_integrator() {
 
 #[test]
 fn bad_scene_is_one_line_exit_2_and_writes_nothing() {
-    let dir = tmp("bad");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let toml = dir.join("bad.toml");
-    let text = std::fs::read_to_string(cube())
-        .unwrap()
-        .replace("fov = 30", "fov = 300");
-    std::fs::write(&toml, text).unwrap();
+    let (dir, toml) = edited_cube("bad", "bad.toml", |text| {
+        text.replace("fov = 30", "fov = 300")
+    });
     let out = dir.join("out");
-    let o = apatch(&[
-        "export",
-        "mitsuba",
-        toml.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = export_mitsuba(&toml, &out, &[]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");

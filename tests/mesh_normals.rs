@@ -2,6 +2,7 @@
 //! exact graph normals of quadratics sampled on a regular (valence-6) lattice, and Loop limit
 //! normals of extraordinary vertices against the local subdivision iterated to convergence.
 
+use apatch::fixtures::Lcg;
 use apatch::mesh::{self, Fan, Format, Mesh, NormalMethod};
 use glam::DVec3;
 use std::path::Path;
@@ -11,18 +12,6 @@ fn model(name: &str) -> Mesh {
         .join("scenes/models")
         .join(name);
     mesh::load(&path).unwrap().0
-}
-
-/// Seeded generator (64-bit LCG, top 53 bits) for reproducible random geometry.
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 #[test]
@@ -186,13 +175,13 @@ fn loop_limit_normal_matches_subdivision_for_all_valences() {
     let mut rng = Lcg(12345);
     for n in 3..=12usize {
         for _trial in 0..5 {
-            let v = DVec3::new(rng.next(), rng.next(), rng.next()) - 0.5;
+            let v = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5;
             let ring: Vec<DVec3> = (0..n)
                 .map(|k| {
                     let a =
-                        std::f64::consts::TAU * (k as f64 + 0.3 * (rng.next() - 0.5)) / n as f64;
-                    let r = 0.5 + rng.next();
-                    v + DVec3::new(r * a.cos(), r * a.sin(), 0.6 * (rng.next() - 0.5))
+                        std::f64::consts::TAU * (k as f64 + 0.3 * (rng.uniform() - 0.5)) / n as f64;
+                    let r = 0.5 + rng.uniform();
+                    v + DVec3::new(r * a.cos(), r * a.sin(), 0.6 * (rng.uniform() - 0.5))
                 })
                 .collect();
             let positions: Vec<DVec3> = ring.clone();

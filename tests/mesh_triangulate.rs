@@ -2,20 +2,10 @@
 //! keeps the polygon's orientation, every triangle's centroid lies inside the polygon), for
 //! non-convex model faces and seeded random star-shaped polygons in tilted planes.
 
+use apatch::fixtures::Lcg;
 use apatch::mesh::{self, geometry::area_vector, Mesh};
 use glam::{DVec2, DVec3};
 use std::path::Path;
-
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// Even–odd point-in-polygon test in 2D.
 fn inside(poly: &[DVec2], q: DVec2) -> bool {
@@ -130,14 +120,19 @@ fn random_star_shaped_polygons_in_tilted_planes() {
     let mut rng = Lcg(99);
     for trial in 0..300 {
         let n = 3 + (trial % 40);
-        let normal = DVec3::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5).normalize();
+        let normal = DVec3::new(
+            rng.uniform() - 0.5,
+            rng.uniform() - 0.5,
+            rng.uniform() - 0.5,
+        )
+        .normalize();
         let u = normal.any_orthonormal_vector();
         let w = normal.cross(u);
-        let centre = DVec3::new(rng.next(), rng.next(), rng.next()) * 10.0;
+        let centre = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0;
         let positions: Vec<DVec3> = (0..n)
             .map(|k| {
-                let a = std::f64::consts::TAU * (k as f64 + 0.4 * (rng.next() - 0.5)) / n as f64;
-                let r = 0.1 + rng.next();
+                let a = std::f64::consts::TAU * (k as f64 + 0.4 * (rng.uniform() - 0.5)) / n as f64;
+                let r = 0.1 + rng.uniform();
                 centre + r * (a.cos() * u + a.sin() * w)
             })
             .collect();

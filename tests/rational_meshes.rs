@@ -43,19 +43,8 @@ fn run_full(name: &str, opts: &RationalOptions, method: NormalMethod, tol: [f64;
     let cont = support::continuity(c, 3);
     let (lines, slope) = support::min_root_slope(c, 3);
     eprintln!(
-        "{name}: {} tris, {} patches, faces {:?}, edges {:?}, refined {}, promoted {}, raised {}, \
-         interp {fv:.1e}/{gv:.1e}, shared {} jumps {:.1e}/{:.1e}, sharing {}, roots {lines} min slope {slope:.2e}",
-        b.triangles.len(),
-        c.patches.len(),
-        b.faces_by_class,
-        b.edges_by_class,
-        b.refined_edges,
-        b.promoted_faces,
-        b.raised_faces,
-        cont.shared_faces,
-        cont.max_value_jump,
-        cont.max_grad_jump,
-        cont.max_sharing
+        "{}",
+        support::build_summary(name, &b, (fv, gv), &cont, (lines, slope))
     );
     assert!(
         fv < INTERP_TOL && gv < grad_tol,

@@ -21,20 +21,8 @@ fn check_model(m: &Model, opts: &RationalOptions) {
     let cont = continuity(c, 6);
     let (lines, slope) = min_root_slope(c, 6);
     eprintln!(
-        "{}: {} tris, {} patches, classes {:?}, edges {:?}, refined {}, promoted {}, raised {}, \
-         interp {fv:.1e}/{gv:.1e}, shared {} jumps {:.1e}/{:.1e}, sharing {}, roots {lines} min slope {slope:.2e}",
-        m.name,
-        b.triangles.len(),
-        c.patches.len(),
-        b.faces_by_class,
-        b.edges_by_class,
-        b.refined_edges,
-        b.promoted_faces,
-        b.raised_faces,
-        cont.shared_faces,
-        cont.max_value_jump,
-        cont.max_grad_jump,
-        cont.max_sharing
+        "{}",
+        build_summary(m.name, &b, (fv, gv), &cont, (lines, slope))
     );
     assert!(
         fv < INTERP_TOL && gv < INTERP_TOL,

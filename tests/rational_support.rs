@@ -4,6 +4,7 @@
 
 use apatch::complex::{Patch, PatchComplex, Role, SheetRule};
 use apatch::scheme::rational_c1::eval::value_gradient;
+use apatch::scheme::rational_c1::RationalBuild;
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -29,24 +30,7 @@ pub fn sphere_model(name: &'static str, levels: usize) -> Model {
 }
 
 pub fn octahedron() -> Model {
-    let v = vec![
-        DVec3::X,
-        -DVec3::X,
-        DVec3::Y,
-        -DVec3::Y,
-        DVec3::Z,
-        -DVec3::Z,
-    ];
-    let f = vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
+    let (v, f) = apatch::fixtures::octahedron();
     Model {
         name: "octahedron",
         normals: v.clone(),
@@ -165,6 +149,34 @@ pub struct Continuity {
     pub max_value_jump: f64,
     pub max_grad_jump: f64,
     pub max_sharing: usize,
+}
+
+/// The one-line summary the rational tests print for a build: sizes, face and edge classes,
+/// refinements, interpolation errors `(value, gradient)`, continuity, and the number of
+/// shooting lines with the smallest root slope `(lines, slope)` found on them.
+pub fn build_summary(
+    name: &str,
+    b: &RationalBuild,
+    interp: (f64, f64),
+    cont: &Continuity,
+    roots: (usize, f64),
+) -> String {
+    let ((fv, gv), (lines, slope)) = (interp, roots);
+    format!(
+        "{name}: {} tris, {} patches, classes {:?}, edges {:?}, refined {}, promoted {}, raised {}, \
+         interp {fv:.1e}/{gv:.1e}, shared {} jumps {:.1e}/{:.1e}, sharing {}, roots {lines} min slope {slope:.2e}",
+        b.triangles.len(),
+        b.complex.patches.len(),
+        b.faces_by_class,
+        b.edges_by_class,
+        b.refined_edges,
+        b.promoted_faces,
+        b.raised_faces,
+        cont.shared_faces,
+        cont.max_value_jump,
+        cont.max_grad_jump,
+        cont.max_sharing
+    )
 }
 
 fn key(p: [f64; 3]) -> [u64; 3] {

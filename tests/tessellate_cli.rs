@@ -22,19 +22,24 @@ fn scene() -> String {
         .into_owned()
 }
 
+/// `apatch tessellate` of the cube scene to `out` at `resolution`.
+fn tessellate_cube(out: &Path, resolution: usize) -> Output {
+    apatch(&[
+        "tessellate",
+        &scene(),
+        "-o",
+        out.to_str().unwrap(),
+        "--resolution",
+        &resolution.to_string(),
+    ])
+}
+
 #[test]
 fn ply_and_obj_describe_the_same_closed_mesh() {
     let ply = tmp("cube.ply");
     let obj = tmp("cube.obj");
     for out in [&ply, &obj] {
-        let o = apatch(&[
-            "tessellate",
-            &scene(),
-            "-o",
-            out.to_str().unwrap(),
-            "--resolution",
-            "3",
-        ]);
+        let o = tessellate_cube(out, 3);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     // OBJ: count v / vn / f and check every edge is shared by exactly two faces.
@@ -99,14 +104,7 @@ fn bad_input_exits_2_and_leaves_no_file() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("expected .ply or .obj"));
     assert!(!stl.exists());
-    let o = apatch(&[
-        "tessellate",
-        &scene(),
-        "-o",
-        out.to_str().unwrap(),
-        "--resolution",
-        "0",
-    ]);
+    let o = tessellate_cube(&out, 0);
     assert_eq!(o.status.code(), Some(2));
     assert!(!out.exists());
     // No temporary sibling left behind either.

@@ -16,36 +16,12 @@ fn complex(v: &[DVec3], f: &[[u32; 3]], n: &[DVec3]) -> PatchComplex {
 
 fn icosahedron(tilt: f64) -> PatchComplex {
     let (v, f) = apatch::fixtures::icosahedron();
-    let n: Vec<DVec3> = v
-        .iter()
-        .enumerate()
-        .map(|(i, x)| {
-            let i = i as f64;
-            (*x + tilt * DVec3::new(i.sin(), (2.0 * i).cos(), 0.3)).normalize()
-        })
-        .collect();
+    let n = apatch::fixtures::tilted_normals(&v, tilt);
     complex(&v, &f, &n)
 }
 
 fn octahedron() -> PatchComplex {
-    let v = vec![
-        DVec3::X,
-        -DVec3::X,
-        DVec3::Y,
-        -DVec3::Y,
-        DVec3::Z,
-        -DVec3::Z,
-    ];
-    let f = [
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
+    let (v, f) = apatch::fixtures::octahedron();
     complex(&v, &f, &v)
 }
 
@@ -154,11 +130,28 @@ fn worst_distance(c: &PatchComplex, m: &TriMesh, stride: usize) -> f64 {
     worst
 }
 
-fn check_closed(c: &PatchComplex, res: usize, genus: i64, name: &str) {
-    let m = tessellate(c, res).expect("tessellates");
-    let (chi, vol) = topology(&m);
+/// The tessellation is a closed 2-manifold of Euler characteristic 2 − 2·`genus`, enclosing a
+/// positive volume (oriented outward).
+fn assert_closed_outward(m: &TriMesh, genus: i64, name: &str) {
+    let (chi, vol) = topology(m);
     assert_eq!(chi, 2 - 2 * genus, "{name}: Euler characteristic");
     assert!(vol > 0.0, "{name}: signed volume {vol} not outward");
+}
+
+/// Every mesh vertex of the complex is, bit for bit, a vertex of the tessellation.
+fn assert_through_vertices(c: &PatchComplex, m: &TriMesh, name: &str) {
+    let have: HashSet<[u64; 3]> = m.positions.iter().map(|p| p.map(f64::to_bits)).collect();
+    for v in &c.vertices {
+        assert!(
+            have.contains(&v.map(f64::to_bits)),
+            "{name}: vertex {v:?} not interpolated"
+        );
+    }
+}
+
+fn check_closed(c: &PatchComplex, res: usize, genus: i64, name: &str) {
+    let m = tessellate(c, res).expect("tessellates");
+    assert_closed_outward(&m, genus, name);
     // Normals: unit (to rounding), and every triangle faces the way its vertices' ∇F normals
     // point (orientation agrees with the outward gradient everywhere, not just on average).
     for nn in &m.normals {
@@ -175,13 +168,7 @@ fn check_closed(c: &PatchComplex, res: usize, genus: i64, name: &str) {
     // model size (≈ 1) leaves a margin over that and is far below grid spacing.
     let d = worst_distance(c, &m, 1);
     assert!(d < 1e-8, "{name}: a point is {d} from the surface");
-    let have: HashSet<[u64; 3]> = m.positions.iter().map(|p| p.map(f64::to_bits)).collect();
-    for v in &c.vertices {
-        assert!(
-            have.contains(&v.map(f64::to_bits)),
-            "{name}: vertex {v:?} not interpolated"
-        );
-    }
+    assert_through_vertices(c, &m, name);
 }
 
 #[test]
@@ -221,16 +208,8 @@ fn scene_complex(name: &str) -> PatchComplex {
 fn check_scene(name: &str, res: usize, genus: i64) {
     let c = scene_complex(name);
     let m = tessellate(&c, res).expect("tessellates");
-    let (chi, vol) = topology(&m);
-    assert_eq!(chi, 2 - 2 * genus, "{name}: Euler characteristic");
-    assert!(vol > 0.0, "{name}: signed volume {vol} not outward");
-    let have: HashSet<[u64; 3]> = m.positions.iter().map(|p| p.map(f64::to_bits)).collect();
-    for v in &c.vertices {
-        assert!(
-            have.contains(&v.map(f64::to_bits)),
-            "{name}: vertex {v:?} not interpolated"
-        );
-    }
+    assert_closed_outward(&m, genus, name);
+    assert_through_vertices(&c, &m, name);
 }
 
 #[test]

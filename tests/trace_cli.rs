@@ -1,8 +1,10 @@
 //! `apatch render` end to end: overrides, outputs (PNG + EXR, no temporary files left), and
 //! one-line errors with exit code 2 that name the scene file and key.
 
-use apatch::fixtures::{quadric_complex, Quadric};
-use glam::DVec3;
+#[path = "support/sphere_scene.rs"]
+mod sphere_scene;
+
+use sphere_scene::{sphere_scene, write_unit_sphere};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -12,16 +14,12 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
-const SCENE: &str = r#"
-[model]
-patches = "sphere.json"
-[camera]
-origin = [0, 0, 4]
-target = [0, 0, 0]
-up = [0, 1, 0]
-fov = 40
-width = 320
-height = 240
+/// The unit sphere, 320 × 240.
+fn scene() -> String {
+    sphere_scene("sphere.json", 320, 240, SCENE_REST)
+}
+
+const SCENE_REST: &str = r#"
 [film]
 spp = 8
 [[lights]]
@@ -34,16 +32,14 @@ output = "out/sphere.png"
 
 fn setup(name: &str, scene: &str) -> PathBuf {
     let dir = scratch(name);
-    let q = Quadric::sphere(DVec3::ZERO, 1.0);
-    let c = quadric_complex(&q, DVec3::splat(-1.2), DVec3::splat(1.2), 2, 2);
-    std::fs::write(dir.join("sphere.json"), serde_json::to_string(&c).unwrap()).unwrap();
+    write_unit_sphere(&dir, "sphere.json");
     std::fs::write(dir.join("s.toml"), scene).unwrap();
     dir
 }
 
 #[test]
 fn render_writes_png_and_exr_with_overrides() {
-    let dir = setup("ok", SCENE);
+    let dir = setup("ok", &scene());
     let out = Command::new(env!("CARGO_BIN_EXE_apatch"))
         .args([
             "render", "s.toml", "--width", "24", "--height", "16", "--spp", "1",
@@ -67,7 +63,7 @@ fn render_writes_png_and_exr_with_overrides() {
 
 #[test]
 fn bad_scene_exits_2_naming_file_and_key() {
-    let dir = setup("bad", &SCENE.replace("fov = 40", "fov = 40\nfocal = 3"));
+    let dir = setup("bad", &scene().replace("fov = 40", "fov = 40\nfocal = 3"));
     let out = Command::new(env!("CARGO_BIN_EXE_apatch"))
         .args(["render", "s.toml"])
         .current_dir(&dir)
@@ -77,7 +73,7 @@ fn bad_scene_exits_2_naming_file_and_key() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("s.toml") && err.contains("focal"), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
-    std::fs::write(dir.join("s.toml"), SCENE).unwrap();
+    std::fs::write(dir.join("s.toml"), scene()).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_apatch"))
         .args(["render", "s.toml", "--mode", "fancy"])
         .current_dir(&dir)
@@ -95,7 +91,7 @@ fn ctrl_c_stops_the_render_and_leaves_no_file() {
     // A render that takes minutes on one thread (4096² pixels × 64 spp): SIGINT arrives long
     // before it could finish, and it stops at the next row (4096 × 64 samples, well under a
     // second), so the outcome does not depend on timing.
-    let dir = setup("sigint", SCENE);
+    let dir = setup("sigint", &scene());
     let mut child = Command::new(env!("CARGO_BIN_EXE_apatch"))
         .args(["render", "s.toml", "--width", "4096", "--height", "4096"])
         .args(["--spp", "64", "--threads", "1"])

@@ -2,29 +2,11 @@
 //! the generated Platonic solids and a subdivided icosahedron) in seeded random directions
 //! always hit the surface, and every hit lies where F = 0 on an accepted sheet.
 
-use apatch::mesh::{self, NormalMethod};
-use apatch::scheme::rational_c1::{build, RationalOptions};
+use apatch::fixtures::{random_unit as unit, rational_angle_build, splitmix as rng};
+use apatch::mesh;
 use apatch::trace::Geometry;
 use glam::DVec3;
 use std::path::Path;
-
-fn rng(state: &mut u64) -> f64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-}
-
-fn unit(state: &mut u64) -> DVec3 {
-    loop {
-        let v = DVec3::new(rng(state), rng(state), rng(state)) * 2.0 - 1.0;
-        let l = v.length_squared();
-        if l > 1e-4 && l <= 1.0 {
-            return v / l.sqrt();
-        }
-    }
-}
 
 #[test]
 fn rays_from_inside_rational_complexes_never_miss() {
@@ -43,16 +25,7 @@ fn rays_from_inside_rational_complexes_never_miss() {
     ] {
         let (m, report) = mesh::load(&dir.join(name)).unwrap();
         report.require(true).unwrap();
-        let tri = mesh::triangulate(&m);
-        let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
-        let triangles: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
-        let b = build(
-            &tri.positions,
-            &triangles,
-            &normals,
-            &RationalOptions::default(),
-        )
-        .unwrap();
+        let (tri, triangles, b) = rational_angle_build(&m);
         let geo = Geometry::new(&b.complex).unwrap();
         // Inscribed radius of the mesh: points well inside it are inside the surface.
         let centre = tri.positions.iter().sum::<DVec3>() / tri.positions.len() as f64;

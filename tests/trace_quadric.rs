@@ -2,7 +2,7 @@
 //! by a patch complex (fixtures) must give, per camera ray, the analytic hit distance and normal
 //! to 1e-9 relative; rays from inside the closed surface never miss (no cracks).
 
-use apatch::fixtures::{quadric_complex, Quadric};
+use apatch::fixtures::{quadric_complex, random_unit as unit, splitmix as rng, Quadric};
 use apatch::trace::shade::surface;
 use apatch::trace::{Camera, FovAxis, Geometry};
 use glam::DVec3;
@@ -97,25 +97,6 @@ fn ellipsoid_renders_to_the_analytic_image() {
     let q = Quadric::ellipsoid(DVec3::new(0.05, 0.1, -0.1), DVec3::new(1.1, 0.7, 0.9));
     check_image(&q, 2, 4, &camera(DVec3::new(-2.5, 1.5, 3.0), 64, 48));
     check_image(&q, 4, 2, &camera(DVec3::new(3.0, -1.0, 2.0), 48, 48));
-}
-
-/// splitmix64: seeded, reproducible.
-fn rng(state: &mut u64) -> f64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-}
-
-fn unit(state: &mut u64) -> DVec3 {
-    loop {
-        let v = DVec3::new(rng(state), rng(state), rng(state)) * 2.0 - 1.0;
-        let l = v.length_squared();
-        if l > 1e-4 && l <= 1.0 {
-            return v / l.sqrt();
-        }
-    }
 }
 
 /// Rays from random interior points in random directions (and towards the complex's shared

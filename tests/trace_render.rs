@@ -1,6 +1,9 @@
 //! Whole renders: bit-identical for any thread count, no NaN/inf in any EXR channel, every mode
 //! runs, the EXR carries the documented channels, and a scene file renders end to end.
 
+#[path = "support/sphere_scene.rs"]
+mod sphere_scene;
+
 use apatch::fixtures::{quadric_complex, Quadric};
 use apatch::scene;
 use apatch::trace::{
@@ -8,6 +11,7 @@ use apatch::trace::{
     RenderSettings,
 };
 use glam::DVec3;
+use sphere_scene::{sphere_scene, write_unit_sphere};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
@@ -240,19 +244,8 @@ fn cancelled_render_returns_interrupted() {
 #[test]
 fn scene_file_with_patch_json_renders() {
     let dir = scratch("scene");
-    let q = Quadric::sphere(DVec3::ZERO, 1.0);
-    let complex = quadric_complex(&q, DVec3::splat(-1.2), DVec3::splat(1.2), 2, 2);
-    std::fs::write(dir.join("s.json"), serde_json::to_string(&complex).unwrap()).unwrap();
-    let text = r#"
-[model]
-patches = "s.json"
-[camera]
-origin = [0, 0, 4]
-target = [0, 0, 0]
-up = [0, 1, 0]
-fov = 40
-width = 16
-height = 12
+    let complex = write_unit_sphere(&dir, "s.json");
+    let rest = r#"
 [film]
 spp = 2
 [[lights]]
@@ -263,7 +256,7 @@ mode = "shaded"
 output = "out/s.png"
 "#;
     let path = dir.join("s.toml");
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, sphere_scene("s.json", 16, 12, rest)).unwrap();
     let sc = scene::load(&path).unwrap();
     assert_eq!(sc.output, dir.join("out/s.png"));
     let c = scene::build_complex(&sc).unwrap();
@@ -284,21 +277,10 @@ output = "out/s.png"
 
 #[test]
 fn rational_complex_renders_identically_with_any_thread_count() {
-    use apatch::mesh::{self, NormalMethod};
-    use apatch::scheme::rational_c1::{build, RationalOptions};
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models/icosahedron.obj");
-    let (m, _) = mesh::load(&path).unwrap();
-    let tri = mesh::triangulate(&m);
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
-    let triangles: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
-    let b = build(
-        &tri.positions,
-        &triangles,
-        &normals,
-        &RationalOptions::default(),
-    )
-    .unwrap();
+    let (m, _) = apatch::mesh::load(&path).unwrap();
+    let (_, _, b) = apatch::fixtures::rational_angle_build(&m);
     let geo = Geometry::new(&b.complex).unwrap();
     let (_, mut s) = setup(Mode::Shaded, 1);
     s.camera = Camera::look_at(

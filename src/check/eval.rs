@@ -376,22 +376,7 @@ fn add(acc: &mut BaryJet, t: &BaryJet) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::complex::{Role, SheetRule};
-    use crate::fixtures::{kuhn_tets, quadric_weights, Quadric};
-
-    fn patch(tet: [DVec3; 4], degree: usize, weights: Vec<f64>) -> Patch {
-        Patch {
-            tet: tet.map(|v| v.to_array()),
-            degree: degree as u8,
-            weights,
-            rational: Vec::new(),
-            sheet: SheetRule::Any,
-            role: Role::Other,
-            element: 0,
-            jvertex: None,
-            jedge: None,
-        }
-    }
+    use crate::fixtures::{kuhn_tets, plain_patch as patch, quadric_weights, Quadric};
 
     /// The quadric's exact value, gradient and Hessian are the truth for every degree.
     #[test]

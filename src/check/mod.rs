@@ -417,7 +417,7 @@ pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
 mod tests {
     use super::*;
     use crate::complex::{Patch, Role, SheetRule};
-    use crate::fixtures::{quadric_complex, Quadric};
+    use crate::fixtures::{plain_patch, quadric_complex, Quadric, UNIT_TET};
     use glam::DVec3;
 
     fn sphere_complex(degree: usize) -> PatchComplex {
@@ -609,20 +609,9 @@ mod tests {
 
     fn unit_tet_patch(degree: u8, weights: Vec<f64>, sheet: SheetRule) -> Patch {
         Patch {
-            tet: [
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 0.0, 1.0],
-            ],
-            degree,
-            weights,
-            rational: Vec::new(),
             sheet,
             role: Role::Face,
-            element: 0,
-            jvertex: None,
-            jedge: None,
+            ..plain_patch(UNIT_TET, degree.into(), weights)
         }
     }
 

@@ -35,15 +35,9 @@ pub struct MitsubaArgs {
     /// Grid intervals per patch edge of the tessellation.
     #[arg(long, default_value_t = 8)]
     pub resolution: usize,
-    /// Image width in pixels (default: the scene's; as `apatch render --width`).
-    #[arg(long)]
-    pub width: Option<u32>,
-    /// Image height in pixels (default: the scene's).
-    #[arg(long)]
-    pub height: Option<u32>,
-    /// Samples per pixel (default: the scene's).
-    #[arg(long)]
-    pub spp: Option<u32>,
+    /// Image size and samples per pixel (as `apatch render`).
+    #[command(flatten)]
+    pub film: super::FilmArgs,
 }
 
 /// Runs `apatch export …`.
@@ -64,7 +58,7 @@ pub fn run(cmd: ExportCommand) -> anyhow::Result<ExitCode> {
                 bail!("{}: expected a scene .toml", a.scene.display());
             }
             let mut scene = apatch::scene::load(&a.scene)?;
-            super::override_film(&mut scene.settings, a.width, a.height, a.spp)?;
+            a.film.apply(&mut scene.settings)?;
             let complex = super::check::load_complex(&a.scene)?;
             let done = apatch::export::mitsuba::export(&scene, &complex, &a.output, a.resolution)?;
             println!(

@@ -8,6 +8,31 @@ pub mod info;
 pub mod render;
 pub mod tessellate;
 
+/// The `--width`, `--height` and `--spp` flags shared by `render` and `export mitsuba`: each
+/// replaces the scene's value when given.
+#[derive(clap::Args, Debug)]
+pub struct FilmArgs {
+    /// Image width in pixels (default: the scene's).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels (default: the scene's).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Samples per pixel (default: the scene's).
+    #[arg(long)]
+    pub spp: Option<u32>,
+}
+
+impl FilmArgs {
+    /// Applies the flags to a scene's settings ([`override_film`]).
+    ///
+    /// # Errors
+    /// A size the camera rejects, or `--spp 0`.
+    pub fn apply(&self, s: &mut apatch::trace::RenderSettings) -> anyhow::Result<()> {
+        override_film(s, self.width, self.height, self.spp)
+    }
+}
+
 /// Applies the `--width`, `--height` and `--spp` flags shared by `render` and `export mitsuba`
 /// to a scene's settings (the size through `Camera::resized`).
 ///

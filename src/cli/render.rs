@@ -17,15 +17,9 @@ pub struct RenderArgs {
     /// Output file (.png or .exr); the other format is written beside it.
     #[arg(long)]
     pub output: Option<PathBuf>,
-    /// Image width in pixels.
-    #[arg(long)]
-    pub width: Option<u32>,
-    /// Image height in pixels.
-    #[arg(long)]
-    pub height: Option<u32>,
-    /// Samples per pixel.
-    #[arg(long)]
-    pub spp: Option<u32>,
+    /// Image size and samples per pixel.
+    #[command(flatten)]
+    pub film: super::FilmArgs,
     /// Shading mode: shaded, normal, depth, patch, isophote, zebra, curvature.
     #[arg(long)]
     pub mode: Option<String>,
@@ -43,7 +37,7 @@ static CANCEL: AtomicBool = AtomicBool::new(false);
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let mut scene = scene::load(&args.input)?;
     let s = &mut scene.settings;
-    super::override_film(s, args.width, args.height, args.spp)?;
+    args.film.apply(s)?;
     if let Some(m) = &args.mode {
         s.mode = m.parse::<Mode>().map_err(|e| anyhow!("--mode: {e}"))?;
     }

@@ -308,36 +308,27 @@ pub fn tessellate(complex: &PatchComplex, resolution: usize) -> anyhow::Result<T
         for (a, c) in [(0, 1), (1, 2), (2, 0)] {
             note_edge(p3[a], p3[c], element, &b.mesh_vertex);
         }
-        let mut index: Vec<Vec<u32>> = Vec::with_capacity(n + 1);
-        for i in 0..=n {
-            let mut row = Vec::with_capacity(n + 1 - i);
-            for j in 0..=n - i {
-                let k = n - i - j;
-                let q = tri_point(p3, i, j, k, n);
-                let qk = key(q);
-                let s = match b.side.get(&qk) {
-                    Some(&s) if sides[s].is_some() => s,
-                    _ => {
-                        let s = if b.value(first, q) <= 0.0 { 0 } else { 1 };
-                        let s = if sides[s].is_some() { s } else { 1 - s };
-                        b.side.entry(qk).or_insert(s);
-                        s
-                    }
-                };
-                let pa = sides[s].expect("side exists");
-                let top = pts(pa)[3];
-                let v = match b.on_line(pa, q, top, [0.0, 0.0, 0.0, 1.0]) {
-                    Some(v) => Some(v),
-                    None => {
-                        sides[1 - s].and_then(|o| b.on_line(o, q, pts(o)[3], [0.0, 0.0, 0.0, 1.0]))
-                    }
+        let index = tri_grid(p3, n, |q| {
+            let qk = key(q);
+            let s = match b.side.get(&qk) {
+                Some(&s) if sides[s].is_some() => s,
+                _ => {
+                    let s = if b.value(first, q) <= 0.0 { 0 } else { 1 };
+                    let s = if sides[s].is_some() { s } else { 1 - s };
+                    b.side.entry(qk).or_insert(s);
+                    s
                 }
-                .unwrap_or_else(|| b.at_q(q, pa));
-                b.face_point.entry((qk, element)).or_insert(v);
-                row.push(v);
+            };
+            let pa = sides[s].expect("side exists");
+            let top = pts(pa)[3];
+            let v = match b.on_line(pa, q, top, [0.0, 0.0, 0.0, 1.0]) {
+                Some(v) => Some(v),
+                None => sides[1 - s].and_then(|o| b.on_line(o, q, pts(o)[3], [0.0, 0.0, 0.0, 1.0])),
             }
-            index.push(row);
-        }
+            .unwrap_or_else(|| b.at_q(q, pa));
+            b.face_point.entry((qk, element)).or_insert(v);
+            v
+        });
         b.emit(&grid_triangles(&index, n));
     }
 
@@ -348,17 +339,11 @@ pub fn tessellate(complex: &PatchComplex, resolution: usize) -> anyhow::Result<T
         for (a, c) in [(0, 1), (1, 2), (2, 0)] {
             note_edge(p3[a], p3[c], element, &b.mesh_vertex);
         }
-        let mut index: Vec<Vec<u32>> = Vec::with_capacity(n + 1);
-        for i in 0..=n {
-            let mut row = Vec::with_capacity(n + 1 - i);
-            for j in 0..=n - i {
-                let q = tri_point(p3, i, j, n - i - j, n);
-                let v = b.at_q(q, pl);
-                b.face_point.entry((key(q), element)).or_insert(v);
-                row.push(v);
-            }
-            index.push(row);
-        }
+        let index = tri_grid(p3, n, |q| {
+            let v = b.at_q(q, pl);
+            b.face_point.entry((key(q), element)).or_insert(v);
+            v
+        });
         b.emit(&grid_triangles(&index, n));
     }
 
@@ -428,6 +413,18 @@ pub fn tessellate(complex: &PatchComplex, resolution: usize) -> anyhow::Result<T
         normals: b.normals.iter().map(|p| p.to_array()).collect(),
         triangles: b.triangles,
     })
+}
+
+/// The vertex indices of the degree-`n` grid on triangle `p`: row i, entry j is `vertex` of
+/// the grid point (i, j, n − i − j) ([`tri_point`]), visited row by row.
+fn tri_grid(p: [DVec3; 3], n: usize, mut vertex: impl FnMut(DVec3) -> u32) -> Vec<Vec<u32>> {
+    (0..=n)
+        .map(|i| {
+            (0..=n - i)
+                .map(|j| vertex(tri_point(p, i, j, n - i - j, n)))
+                .collect()
+        })
+        .collect()
 }
 
 /// Triangles of a triangular grid `index[i][j]` (i + j ≤ n), in base order.

@@ -13,7 +13,7 @@
 //! Normals: per face corner (`v//vn`); when no face refers to a normal and there are as many
 //! `vn` as `v`, the i-th `vn` is the i-th vertex's normal.
 
-use super::raw::{lines, parse_float, shorten, RawMesh, MAX_FACE_VERTICES, NO_NORMAL};
+use super::raw::{content, lines, parse_float, shorten, RawMesh, MAX_FACE_VERTICES, NO_NORMAL};
 use glam::DVec3;
 
 /// Statements that carry no polygon data for us.
@@ -57,15 +57,9 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
     let mut max_normal_line = 0u32;
     for (line_no, line) in lines(bytes) {
         // Comments run from `#` to the end of the line.
-        let line = match line.iter().position(|&b| b == b'#') {
-            Some(i) => &line[..i],
-            None => line,
-        };
-        if line.iter().all(u8::is_ascii_whitespace) {
+        let Some(text) = content(line_no, line)? else {
             continue;
-        }
-        let text = std::str::from_utf8(line)
-            .map_err(|_| format!("line {line_no}: not UTF-8 text (binary data?)"))?;
+        };
         let at = |m: String| format!("line {line_no}: {m}");
         let mut tokens = text.split_ascii_whitespace();
         let keyword = tokens.next().unwrap_or_default();

@@ -2,7 +2,7 @@
 //! NOFF normals kept as file normals). One vertex per line and one face per line, `#` comments;
 //! 0-based indices. Errors name the 1-based line.
 
-use super::raw::{lines, parse_float, shorten, RawMesh, MAX_FACE_VERTICES};
+use super::raw::{content, lines, parse_float, shorten, RawMesh, MAX_FACE_VERTICES};
 use glam::DVec3;
 
 /// Parses OFF bytes. Errors are "line N: what".
@@ -15,15 +15,9 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, String> {
     let mut last_line = 0;
     for (line_no, line) in lines(bytes) {
         last_line = line_no;
-        let line = match line.iter().position(|&b| b == b'#') {
-            Some(i) => &line[..i],
-            None => line,
-        };
-        if line.iter().all(u8::is_ascii_whitespace) {
+        let Some(text) = content(line_no, line)? else {
             continue;
-        }
-        let text = std::str::from_utf8(line)
-            .map_err(|_| format!("line {line_no}: not UTF-8 text (binary data?)"))?;
+        };
         let at = |m: String| format!("line {line_no}: {m}");
         let mut tokens: Vec<&str> = text.split_ascii_whitespace().collect();
         if !header_seen {

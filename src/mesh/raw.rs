@@ -69,6 +69,24 @@ pub fn shorten(token: &str) -> String {
     }
 }
 
+/// The text of one line of a text mesh format, comments (`#` to the end of the line) removed;
+/// `None` for a blank (or comment-only) line.
+///
+/// # Errors
+/// A line that is not UTF-8, named by its number.
+pub fn content(line_no: u32, line: &[u8]) -> Result<Option<&str>, String> {
+    let line = match line.iter().position(|&b| b == b'#') {
+        Some(i) => &line[..i],
+        None => line,
+    };
+    if line.iter().all(u8::is_ascii_whitespace) {
+        return Ok(None);
+    }
+    std::str::from_utf8(line)
+        .map(Some)
+        .map_err(|_| format!("line {line_no}: not UTF-8 text (binary data?)"))
+}
+
 /// Splits a byte buffer into lines (LF or CRLF; a leading UTF-8 byte-order mark is skipped),
 /// yielding (1-based line number, bytes).
 pub fn lines(bytes: &[u8]) -> impl Iterator<Item = (u32, &[u8])> {

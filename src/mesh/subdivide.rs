@@ -219,6 +219,10 @@ mod tests {
         rule: SubdivisionRule::Loop,
         levels: 1,
     };
+    const LOOP2: Subdivision = Subdivision {
+        rule: SubdivisionRule::Loop,
+        levels: 2,
+    };
 
     /// A regular triangular grid (every interior vertex of valence 6) of `n` × `n` cells with
     /// unit spacing along the three lattice directions, in the plane z = 0.
@@ -264,14 +268,7 @@ mod tests {
             p.x += 0.1 * ((k * 7 % 5) as f64 - 2.0) / 2.0;
             p.z = 0.3 * p.x - 0.7 * p.y + 2.0;
         }
-        let s = subdivide(
-            &m,
-            Subdivision {
-                rule: SubdivisionRule::Loop,
-                levels: 2,
-            },
-        )
-        .unwrap();
+        let s = subdivide(&m, LOOP2).unwrap();
         for p in &s.positions {
             // Rounding of a few affine combinations of O(10) coordinates.
             assert!((p.z - (0.3 * p.x - 0.7 * p.y + 2.0)).abs() < 1e-12, "{p}");
@@ -367,11 +364,7 @@ mod tests {
         // oriented, manifold), and the counts follow V' = V + E, F' = 4F.
         let oct = octahedron();
         for (m, chi) in [(oct, 2), (grid(3), 1)] {
-            let two = Subdivision {
-                rule: SubdivisionRule::Loop,
-                levels: 2,
-            };
-            let s = subdivide(&m, two).unwrap();
+            let s = subdivide(&m, LOOP2).unwrap();
             assert_eq!(euler(&s), chi);
             assert_eq!(s.faces.len(), 16 * m.faces.len());
             let t = Topology::new(s.positions.len(), &s.faces);
@@ -420,14 +413,7 @@ mod tests {
             ],
             vec![vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4], vec![6, 7, 8]],
         );
-        let s = subdivide(
-            &m,
-            Subdivision {
-                rule: SubdivisionRule::Loop,
-                levels: 2,
-            },
-        )
-        .unwrap();
+        let s = subdivide(&m, LOOP2).unwrap();
         assert_eq!(s.faces.len(), 64);
         assert!(s.positions.iter().all(|p| p.is_finite()));
         // The unused vertex stays where it was.

@@ -1077,8 +1077,8 @@ pub struct Jet {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::complex::{RationalTerm, Role};
-    use crate::fixtures::{quadric_weights, Quadric};
+    use crate::complex::RationalTerm;
+    use crate::fixtures::{quadric_patch, Quadric};
 
     fn compile(p: &Patch) -> PatchStore {
         let mut s = PatchStore::default();
@@ -1096,18 +1096,7 @@ mod tests {
     }
 
     fn patch(q: &Quadric, n: usize) -> Patch {
-        let t = tet();
-        Patch {
-            tet: t.map(|v| v.to_array()),
-            degree: n as u8,
-            weights: quadric_weights(q, &t, n),
-            rational: Vec::new(),
-            sheet: SheetRule::Any,
-            role: Role::Other,
-            element: 0,
-            jvertex: None,
-            jedge: None,
-        }
+        quadric_patch(q, tet(), n)
     }
 
     #[test]
