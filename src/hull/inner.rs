@@ -39,6 +39,7 @@ pub mod corner;
 pub mod decompose;
 pub mod guardnet;
 pub mod sides;
+pub mod unfold;
 pub mod verify;
 
 pub use verify::{verify, HullViolation, ViolationKind};
@@ -146,6 +147,9 @@ pub struct InnerReport {
     pub cases: corner::CaseCounts,
     /// Triangles whose sides were settled from the convexity of their edges ([`sides`]).
     pub sides: sides::SideCounts,
+    /// Folded-back edges of T between pseudo-centroid pairs replaced by the other diagonal
+    /// ([`unfold`]).
+    pub flipped_folds: usize,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -296,6 +300,7 @@ pub fn build_with_report(
     }
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
+    report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
     Ok((hull, report))
 }

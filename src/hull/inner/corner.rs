@@ -90,6 +90,43 @@ fn set_apex(slot: &mut [Option<DVec3>; 2], tri: [DVec3; 3], apex: DVec3) {
     slot[side] = Some(apex);
 }
 
+/// Offset δ along n_V of the pseudo-centroid C_0 = V + δ n_V of an unseparable vertex (the paper
+/// puts C_0 = V). The edge C_0G_i of T is convex (Definition 3.1) when
+/// (C_0 − G_i)·n_{G_i} has the sign of t_i = (G_i − V)·n_V or is zero; with C_0 = V the first
+/// factor is zero only for planar faces, and a non-planar input face (double_torus_poly's
+/// five-gons, ~1e-7 off their plane) can give it the wrong sign. Each face bounds δ on one
+/// side (n_V·n_{G_i} > 0 for "above face" normals); δ is 0 when that interval holds 0 (the
+/// paper's C_0 = V), else its middle (the middle of the overlap of the bounds when it is
+/// empty), or twice the one bound there is. |δ| stays of the
+/// order of the non-planarity, far below min |t_i|, so the second factor keeps its sign.
+fn unseparable_offset(v: DVec3, n: DVec3, pts: &[DVec3], nrm: &[DVec3], t: &[f64]) -> f64 {
+    // δ ≥ lo from faces with t_i > 0, δ ≤ hi from faces with t_i < 0.
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    for ((&g, &ng), &ti) in pts.iter().zip(nrm).zip(t) {
+        let cos = n.dot(ng);
+        if cos <= 1e-6 {
+            continue; // not above this face: no bound from it (Appendix C's business)
+        }
+        let bound = -ng.dot(v - g) / cos;
+        if ti > 0.0 {
+            lo = lo.max(bound);
+        } else if ti < 0.0 {
+            hi = hi.min(bound);
+        }
+    }
+    let limit = 1e-3 * t.iter().fold(f64::INFINITY, |m, x| m.min(x.abs()));
+    let delta = if lo <= 0.0 && hi >= 0.0 {
+        0.0 // C_0 = V already gives convex edges: the paper's choice
+    } else if lo.is_finite() && hi.is_finite() {
+        0.5 * (lo + hi)
+    } else if lo > 0.0 {
+        2.0 * lo // clears the binding face by its own offset
+    } else {
+        2.0 * hi
+    };
+    delta.clamp(-limit, limit)
+}
+
 /// Runs steps (3)–(5) for `c`, appending to `hull` (whose first points are the face centroids
 /// and guards with their normals). Returns whether the vertex was separable (step (4)).
 pub fn build_corner(
@@ -151,7 +188,7 @@ pub fn build_corner(
             .expect("k > 3 faces");
         c.v + (1.0 - options.alpha) * t_star * n
     } else {
-        c.v
+        c.v + unseparable_offset(c.v, n, &pts, &nrm, &t) * n
     };
     let i0 = hull.points.len() as u32;
     hull.points.push(c0);
