@@ -45,6 +45,9 @@ pub struct CaseCounts {
     pub case_iv: usize,
     /// Step (3'): hallway corners (trihedral with a reflex face angle), L-U pair V, T_0.
     pub hallway: usize,
+    /// Trihedral saddle corners whose edges of T ask for the side V is not on: an L-U pair
+    /// from V and apexes over the base (`saddle_apex`).
+    pub saddle: usize,
 }
 
 /// One vertex's data for steps (3)–(5).
@@ -88,6 +91,66 @@ fn orient(a: DVec3, b: DVec3, c: DVec3, q: DVec3) -> f64 {
 fn set_apex(slot: &mut [Option<DVec3>; 2], tri: [DVec3; 3], apex: DVec3) {
     let side = usize::from(orient(tri[0], tri[1], tri[2], apex) <= 0.0);
     slot[side] = Some(apex);
+}
+
+/// Where a trihedral saddle's apex on V's side lies between V (0) and the apex over the base
+/// (1) (`saddle_apex`). Measured on double_torus_poly's waist: 0.1 to 0.6 give a valid hull,
+/// 0 (V itself: its tetrahedron reaches across the polyhedron edge VV' into the neighbour's)
+/// and 0.75 (deep under the base: the two mirror-image saddles' tetrahedra meet) do not.
+pub const SADDLE_BLEND: f64 = 0.35;
+
+/// A trihedral saddle corner (one reflex face angle with V on the inner side of the guards'
+/// triangle, so not Algorithm 2's hallway (3'); or edges of both convexity classes) has edges
+/// of T asking for the side V is not on (Definition 3.1; see [`super::sides`]), so it needs an
+/// L-U pair (Def. 3.6 (4)(ii)). The missing side gets the apex over the base of
+/// [`super::sides::apexes_over_base`]; V's side keeps a point between V and that function's
+/// apex on the same side ([`SADDLE_BLEND`]). Both lie in the region where the pair is
+/// tangent-containing (Definition 3.5): for each base vertex, the other two base vertices are
+/// on opposite sides of its tangent plane (the plane cuts the base), or both on one side and
+/// then V (in all three face planes) and the apex over the base (which reaches the plane) are on
+/// or across it, and so is every point between them. Left to [`super::sides::settle`], both
+/// apexes were replaced by apexes over the base, 0.73 of the longest edge deep on
+/// double_torus_poly's waist, and the inner ones of the two mirror-image saddles there
+/// overlapped; with V itself, its tetrahedron overlapped the neighbour's across the edge VV'.
+/// Where no apex over the base exists, the missing side gets a low one (the centroid moved
+/// by [`super::sides::MIN_HEIGHT`] times the longest edge) and V stays.
+fn saddle_apex(
+    slot: &mut [Option<DVec3>; 2],
+    v: DVec3,
+    base: [DVec3; 3],
+    normals: [DVec3; 3],
+    counts: &mut CaseCounts,
+) {
+    let mut req = [false; 2];
+    for k in 0..3 {
+        let s =
+            super::sides::edge_sides(base[k], normals[k], base[(k + 1) % 3], normals[(k + 1) % 3]);
+        req[0] |= s[0];
+        req[1] |= s[1];
+    }
+    let Some(own) = (0..2).find(|&s| slot[s] == Some(v)) else {
+        return; // V is not an apex (a hallway pair replaced it): nothing to blend
+    };
+    let other = 1 - own;
+    if !req[other] || slot[other].is_some() {
+        return;
+    }
+    req[own] = true;
+    counts.saddle += 1;
+    if let Some(over) = super::sides::apexes_over_base(base, normals, req) {
+        if let (Some(q_own), Some(q_other)) = (over[own], over[other]) {
+            slot[own] = Some(v + SADDLE_BLEND * (q_own - v));
+            slot[other] = Some(q_other);
+            return;
+        }
+    }
+    let [a, b, c] = base;
+    let Some(nn) = (b - a).cross(c - a).try_normalize() else {
+        return;
+    };
+    let len = (b - a).length().max((c - b).length()).max((a - c).length());
+    let sign = if other == 0 { 1.0 } else { -1.0 };
+    slot[other] = Some((a + b + c) / 3.0 + sign * super::sides::MIN_HEIGHT * len * nn);
 }
 
 /// Offset δ along n_V of the pseudo-centroid C_0 = V + δ n_V of an unseparable vertex (the paper
@@ -171,6 +234,7 @@ pub fn build_corner(
                 counts.hallway += 1;
             }
         }
+        saddle_apex(&mut slot, c.v, base, [nrm[0], nrm[1], nrm[2]], counts);
         hull.triangles.push(tri);
         hull.apexes.push(slot);
         hull.element.push(c.vertex);
