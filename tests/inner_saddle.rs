@@ -90,6 +90,46 @@ fn survey_double_torus() {
         "unseparable {:?} adjusted {:?}",
         rep.unseparable, rep.adjusted_normals
     );
+    let edges = hull.edges().unwrap();
+    for (ei, e) in edges.iter().enumerate() {
+        if ![
+            435usize, 835, 849, 862, 870, 1197, 1255, 1280, 1281, 1283, 1297, 1298,
+        ]
+        .contains(&ei)
+        {
+            continue;
+        }
+        eprintln!(
+            "EDGE {ei} {:?} faces {:?} elements {} {}",
+            e.v, e.faces, hull.element[e.faces[0] as usize], hull.element[e.faces[1] as usize]
+        );
+    }
+    let mut bad = 0;
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
+            let Some(q) = hull.apexes[t][side] else {
+                continue;
+            };
+            for &i in tri {
+                let (p, n) = (hull.points[i as usize], hull.normals[i as usize]);
+                let h = sign * n.dot(q - p);
+                if h <= 0.0 {
+                    bad += 1;
+                    eprintln!(
+                        "TANG tri {t} el {} side {side} point {i} h {h:.3e}",
+                        hull.element[t]
+                    );
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{bad} apexes on the wrong side of a base vertex's tangent plane; lifted {}",
+        rep.lifted_apexes
+    );
+    let complex = apatch::scheme::cubic_c1::build(&hull, &Default::default()).unwrap();
+    let r = apatch::check::check(&complex, &Default::default());
+    eprintln!("HOLES {:?}", r.holes);
     let topo = mesh::Topology::new(m.positions.len(), &m.faces);
     let els: Vec<u32> = std::env::var("ELS")
         .unwrap_or("1,138,205,211,213,221,222".into())

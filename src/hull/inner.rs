@@ -34,6 +34,7 @@
 //! carries it ([`InnerOptions::trihedral_level`]).
 
 pub mod above;
+pub mod clearance;
 pub mod coplanar;
 pub mod corner;
 pub mod decompose;
@@ -150,6 +151,8 @@ pub struct InnerReport {
     /// Folded-back edges of T between pseudo-centroid pairs replaced by the other diagonal
     /// ([`unfold`]).
     pub flipped_folds: usize,
+    /// Apexes lifted over their base vertices' tangent planes ([`clearance`]).
+    pub lifted_apexes: usize,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -302,5 +305,6 @@ pub fn build_with_report(
     net.add_edge_cells(&mut hull, &mesh.positions);
     report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
+    report.lifted_apexes = clearance::lift_apexes(&mut hull);
     Ok((hull, report))
 }
