@@ -22,6 +22,10 @@
 //!    the least height that keeps it tangent-containing; where T folds, apex pairs are raised
 //!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
 //!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
+//!    Before that, [`unfold`] flips edges of T that fold back between two pseudo-centroids
+//!    (short polyhedron edges between non-trihedral vertices); after it, [`clearance`] lifts
+//!    apexes that lie below a base vertex's tangent plane (else the surface leaves the hull
+//!    through the edge tetrahedra's outer faces).
 //! 6. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
 //!
 //! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.

@@ -22,7 +22,7 @@ use super::sides::{apexes_over_base, edge_sides};
 use crate::hull::simplicial::{PointOrigin, SimplicialHull};
 use crate::mesh::convexity::{edge_convexity_1994, Convexity};
 use glam::DVec3;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 /// Cosine of the angle between two triangles' normals below which their shared edge counts as
 /// folded back (the triangles turn by more than 90°).
@@ -74,48 +74,58 @@ pub const CUTS: [(f64, f64); 9] = [
     (0.25, 0.25),
 ];
 
-/// Flips every edge of T that folds back between a pseudo-centroid pair (module docs), one at a
-/// time, sharpest first, until none qualifies. `positions` are the polyhedron's vertices (the V
+/// Flips every edge of T that folds back between a pseudo-centroid pair (module docs), sharpest
+/// first, in passes until one flips nothing. `positions` are the polyhedron's vertices (the V
 /// of every pseudo-centroid). Returns the number of flips.
 pub fn flip_folds(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
+    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); hull.points.len()];
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        for &i in tri {
+            if let Some(list) = incident.get_mut(i as usize) {
+                list.push(t);
+            }
+        }
+    }
     let mut flips = 0;
-    // Each flip raises the worst fold round the quad, so the loop ends; the bound only guards
-    // against cycling through equal folds.
-    for _ in 0..hull.triangles.len() {
-        if !flip_one(hull, positions) {
+    // Each flip lowers the folds round its quad, so passes end; the bound only guards against
+    // cycling through equal folds.
+    for _ in 0..8 {
+        let done = flip_pass(hull, positions, &mut incident);
+        flips += done;
+        if done == 0 {
             break;
         }
-        flips += 1;
     }
     flips
 }
 
-/// Edge → the (up to two) triangles holding it.
-fn edge_faces(hull: &SimplicialHull) -> HashMap<(u32, u32), Vec<usize>> {
-    let mut map: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (t, tri) in hull.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            map.entry((a.min(b), a.max(b))).or_default().push(t);
-        }
-    }
-    map
+/// The triangles holding the undirected edge (a, b).
+fn faces_of(incident: &[Vec<usize>], hull: &SimplicialHull, a: u32, b: u32) -> Vec<usize> {
+    incident[a as usize]
+        .iter()
+        .copied()
+        .filter(|&t| hull.triangles[t].contains(&b))
+        .collect()
 }
 
 /// Over the edges of every triangle that uses one of `pts`: the smallest cosine between the
 /// normals of an edge's two triangles, the number of edges folded back (that cosine below
 /// [`FOLD_COS`]) and the number of nonconvex edges (Definition 3.1).
-fn local_quality(hull: &SimplicialHull, pts: [u32; 2]) -> (f64, usize, usize) {
-    let map = edge_faces(hull);
+fn local_quality(
+    hull: &SimplicialHull,
+    incident: &[Vec<usize>],
+    pts: [u32; 2],
+) -> (f64, usize, usize) {
     let mut seen = HashSet::new();
     let mut worst = f64::INFINITY;
     let mut nonconvex = 0;
     let mut folded = 0;
-    for tri in hull
-        .triangles
+    let tris: HashSet<usize> = pts
         .iter()
-        .filter(|t| pts.iter().any(|p| t.contains(p)))
-    {
+        .flat_map(|&p| incident[p as usize].iter().copied())
+        .collect();
+    for &t in &tris {
+        let tri = hull.triangles[t];
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
             let key = (a.min(b), a.max(b));
@@ -127,7 +137,7 @@ fn local_quality(hull: &SimplicialHull, pts: [u32; 2]) -> (f64, usize, usize) {
             if edge_convexity_1994(pa, na, pb, nb) == Convexity::Nonconvex {
                 nonconvex += 1;
             }
-            if let [f, g] = map[&key][..] {
+            if let [f, g] = faces_of(incident, hull, a, b)[..] {
                 match (
                     unit_normal(hull, hull.triangles[f]),
                     unit_normal(hull, hull.triangles[g]),
@@ -152,40 +162,65 @@ fn corner_of(hull: &SimplicialHull, positions: &[DVec3], i: u32) -> Option<DVec3
     }
 }
 
-/// A fold between pseudo-centroids: its cosine, the two triangles, the edge (v0, v1) and the
-/// third points c (of the first triangle) and d.
-type Fold = (f64, usize, usize, u32, u32, u32, u32);
+/// Replaces triangle `t` by `new`, keeping `incident` up to date.
+fn set_triangle(hull: &mut SimplicialHull, incident: &mut [Vec<usize>], t: usize, new: [u32; 3]) {
+    for &i in &hull.triangles[t] {
+        incident[i as usize].retain(|&x| x != t);
+    }
+    hull.triangles[t] = new;
+    for &i in &new {
+        incident[i as usize].push(t);
+    }
+}
 
-/// Finds the sharpest fold that a flip (with the first of [`CUTS`] that works) improves, and
-/// makes it; false when there is none.
-fn flip_one(hull: &mut SimplicialHull, positions: &[DVec3]) -> bool {
+/// One pass: every fold between pseudo-centroids, sharpest first, is flipped (with the first of
+/// [`CUTS`] that works) if that still improves it. Returns the number of flips.
+fn flip_pass(hull: &mut SimplicialHull, positions: &[DVec3], incident: &mut [Vec<usize>]) -> usize {
     let Ok(edges) = hull.edges() else {
-        return false;
+        return 0;
     };
-    let present: HashSet<(u32, u32)> = edges
-        .iter()
-        .map(|e| (e.v[0].min(e.v[1]), e.v[0].max(e.v[1])))
-        .collect();
-    // Folds between pseudo-centroid pairs, sharpest first.
-    let mut folds: Vec<Fold> = Vec::new();
+    // Folds between pseudo-centroid pairs: (cosine, the edge), sharpest first.
+    let mut folds: Vec<(f64, [u32; 2])> = Vec::new();
     for e in &edges {
         if e.faces[1] == u32::MAX {
             continue;
         }
         let [f0, f1] = e.faces.map(|f| f as usize);
-        let [v0, v1] = e.v;
+        let (Some(n0), Some(n1)) = (
+            unit_normal(hull, hull.triangles[f0]),
+            unit_normal(hull, hull.triangles[f1]),
+        ) else {
+            continue;
+        };
+        if n0.dot(n1) < FOLD_COS {
+            folds.push((n0.dot(n1), e.v));
+        }
+    }
+    folds.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut flips = 0;
+    for (_, [v0, v1]) in folds {
+        // The edge as it is now (earlier flips may have removed it).
+        let faces = faces_of(incident, hull, v0, v1);
+        let [fa, fb] = faces[..] else {
+            continue;
+        };
+        let (f0, f1) = if third(hull.triangles[fa], v0, v1).is_some() {
+            (fa, fb)
+        } else {
+            (fb, fa)
+        };
         let (Some(c), Some(d)) = (
             third(hull.triangles[f0], v0, v1),
             third(hull.triangles[f1], v1, v0),
         ) else {
             continue;
         };
-        if corner_of(hull, positions, c).is_none()
-            || corner_of(hull, positions, d).is_none()
-            || c == d
-            || present.contains(&(c.min(d), c.max(d)))
-        {
+        let (Some(vc), Some(vd)) = (corner_of(hull, positions, c), corner_of(hull, positions, d))
+        else {
             continue;
+        };
+        if c == d || !faces_of(incident, hull, c, d).is_empty() {
+            continue; // the other diagonal is an edge already
         }
         let (Some(n0), Some(n1)) = (
             unit_normal(hull, hull.triangles[f0]),
@@ -193,62 +228,67 @@ fn flip_one(hull: &mut SimplicialHull, positions: &[DVec3]) -> bool {
         ) else {
             continue;
         };
-        let before = n0.dot(n1);
-        if before < FOLD_COS {
-            folds.push((before, f0, f1, v0, v1, c, d));
+        if n0.dot(n1) >= FOLD_COS {
+            continue;
         }
-    }
-    folds.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (_, f0, f1, v0, v1, c, d) in folds {
-        let (before_worst, before_folded, before_bad) = local_quality(hull, [c, d]);
+        let (before_worst, before_folded, before_bad) = local_quality(hull, incident, [c, d]);
         let old = (
             hull.points[c as usize],
             hull.points[d as usize],
             hull.triangles[f0],
             hull.triangles[f1],
         );
-        let (vc, vd) = (
-            corner_of(hull, positions, c).expect("checked"),
-            corner_of(hull, positions, d).expect("checked"),
-        );
         // The quad runs v1, c, v0, d; the new triangles share the diagonal (c, d).
-        hull.triangles[f0] = [c, v0, d];
-        hull.triangles[f1] = [d, v1, c];
+        set_triangle(hull, incident, f0, [c, v0, d]);
+        set_triangle(hull, incident, f1, [d, v1, c]);
+        let mut done = false;
         for (lc, ld) in CUTS {
             hull.points[c as usize] = vc + lc * (old.0 - vc);
             hull.points[d as usize] = vd + ld * (old.1 - vd);
-            let (worst, folded, bad) = local_quality(hull, [c, d]);
+            let (worst, folded, bad) = local_quality(hull, incident, [c, d]);
             // No new nonconvex edge (Lemma 4.1); fewer folds round c and d, or as many and
             // the worst one milder.
             let better = folded < before_folded || folded == before_folded && worst > before_worst;
             if bad > before_bad || !better {
                 continue;
             }
-            if let Some(()) = place_apexes(hull, [c, d], [f0, f1]) {
-                return true;
+            if let Some(()) = place_apexes(hull, incident, [c, d], [f0, f1]) {
+                done = true;
+                break;
             }
         }
-        hull.points[c as usize] = old.0;
-        hull.points[d as usize] = old.1;
-        hull.triangles[f0] = old.2;
-        hull.triangles[f1] = old.3;
+        if done {
+            flips += 1;
+        } else {
+            hull.points[c as usize] = old.0;
+            hull.points[d as usize] = old.1;
+            set_triangle(hull, incident, f0, old.2);
+            set_triangle(hull, incident, f1, old.3);
+        }
     }
-    false
+    flips
 }
 
 /// Gives the triangles `new` (which must get them) and every other triangle that uses one of
 /// `pts` (where they exist; [`sides::settle`] revisits those) face tetrahedra over their bases
 /// on the sides their edges ask for (the outer side when they ask for none). `None`, changing
 /// nothing, when one of `new` has no such apexes.
-fn place_apexes(hull: &mut SimplicialHull, pts: [u32; 2], new: [usize; 2]) -> Option<()> {
+fn place_apexes(
+    hull: &mut SimplicialHull,
+    incident: &[Vec<usize>],
+    pts: [u32; 2],
+    new: [usize; 2],
+) -> Option<()> {
     let mut out = Vec::new();
-    for (t, tri) in hull.triangles.iter().enumerate() {
-        if !pts.iter().any(|p| tri.contains(p)) {
-            continue;
-        }
+    let tris: HashSet<usize> = pts
+        .iter()
+        .flat_map(|&p| incident[p as usize].iter().copied())
+        .collect();
+    for t in tris {
+        let tri = hull.triangles[t];
         let base = tri.map(|i| hull.points[i as usize]);
         let normals = tri.map(|i| hull.normals[i as usize]);
-        let req = required_sides(hull, *tri);
+        let req = required_sides(hull, tri);
         let req = if req[0] || req[1] { req } else { [true, false] };
         match apexes_over_base(base, normals, req) {
             Some(a) => out.push((t, a)),
