@@ -473,3 +473,37 @@ pub fn spread_hallway_apexes(hull: &mut SimplicialHull, hallway: &[HallwayApex])
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::convexity::{edge_convexity_1994, Convexity};
+
+    /// An unseparable vertex (centroids above and below its tangent plane) whose faces are off
+    /// their planes by ~1e-7, as non-planar input polygons are: with C_0 = V the edge to the
+    /// first guard is nonconvex (Definition 3.1); with the offset of `unseparable_offset` both
+    /// edges are convex, and the offset stays of the order of the non-planarity.
+    #[test]
+    fn unseparable_offset_makes_edges_convex() {
+        let v = DVec3::ZERO;
+        let n = DVec3::Z;
+        let ng = DVec3::new(-0.3, 0.0, 1.0).normalize();
+        // Face 0 above V's tangent plane, its guard 1e-7 off the plane through V; face 1
+        // below, 1e-6 off on the other side.
+        let g = [
+            DVec3::new(1.0, 0.0, 0.3) + 1e-7 * ng,
+            DVec3::new(-1.0, 0.0, -0.3) + 1e-6 * ng,
+        ];
+        let nrm = [ng, ng];
+        let t = [n.dot(g[0] - v), n.dot(g[1] - v)];
+        assert!(t[0] > 0.0 && t[1] < 0.0);
+        let class = |c0: DVec3, k: usize| edge_convexity_1994(c0, n, g[k], nrm[k]);
+        assert_eq!(class(v, 0), Convexity::Nonconvex);
+        let delta = unseparable_offset(v, n, &g, &nrm, &t);
+        // Bounded by the two faces' offsets over n·n_G (≈ 0.96).
+        assert!(delta > 0.0 && delta < 1.1e-6, "{delta}");
+        let c0 = v + delta * n;
+        assert_eq!(class(c0, 0), Convexity::Positive);
+        assert_eq!(class(c0, 1), Convexity::Negative);
+    }
+}
