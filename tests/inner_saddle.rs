@@ -139,20 +139,6 @@ fn survey_double_torus() {
         "unseparable {:?} adjusted {:?}",
         rep.unseparable, rep.adjusted_normals
     );
-    let edges = hull.edges().unwrap();
-    for (ei, e) in edges.iter().enumerate() {
-        if ![
-            435usize, 835, 849, 862, 870, 1197, 1255, 1280, 1281, 1283, 1297, 1298,
-        ]
-        .contains(&ei)
-        {
-            continue;
-        }
-        eprintln!(
-            "EDGE {ei} {:?} faces {:?} elements {} {}",
-            e.v, e.faces, hull.element[e.faces[0] as usize], hull.element[e.faces[1] as usize]
-        );
-    }
     let mut bad = 0;
     for (t, tri) in hull.triangles.iter().enumerate() {
         for (side, sign) in [(0usize, 1.0), (1, -1.0)] {
