@@ -22,11 +22,14 @@
 //!    the least height that keeps it tangent-containing; where T folds, apex pairs are raised
 //!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
 //!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
+//!    Before that, [`unfold`] flips edges of T that fold back between two pseudo-centroids
+//!    (short polyhedron edges between non-trihedral vertices).
 //! 6. [`wedge`]: where T folds, apexes of step (5) triangles that lean across the plane
 //!    bisecting the fold (into the neighbour's tetrahedra) are moved the least distance back
 //!    inside their wedge, keeping tangent containment and the least height (beyond the paper;
-//!    the nut's valleys of T).
-//!    [`degenerate`] then (after the wedges) rebuilds over the base any face tetrahedron that
+//!    the nut's valleys of T). After it, [`clearance`] lifts apexes that lie below a base
+//!    vertex's tangent plane (else the surface leaves the hull through the edge tetrahedra's
+//!    outer faces), and [`degenerate`] rebuilds over the base any face tetrahedron that
 //!    is still degenerate (far apexes from nearly parallel intersections), or names the
 //!    element in an error.
 //! 7. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
@@ -45,6 +48,7 @@
 //! carries it ([`InnerOptions::trihedral_level`]).
 
 pub mod above;
+pub mod clearance;
 pub mod coplanar;
 pub mod corner;
 pub mod decompose;
@@ -53,6 +57,7 @@ pub mod fan;
 pub mod guardnet;
 pub mod remesh;
 pub mod sides;
+pub mod unfold;
 pub mod verify;
 pub mod wedge;
 
@@ -168,6 +173,11 @@ pub struct InnerReport {
     pub degenerate_repaired: usize,
     /// Apexes moved back inside the wedge of a fold of T ([`wedge`]).
     pub wedged: usize,
+    /// Folded-back edges of T between pseudo-centroid pairs replaced by the other diagonal
+    /// ([`unfold`]).
+    pub flipped_folds: usize,
+    /// Apexes lifted over their base vertices' tangent planes ([`clearance`]).
+    pub lifted_apexes: usize,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -332,8 +342,10 @@ pub fn build_with_report(
     }
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
+    report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
     report.wedged = wedge::keep_in_wedges(&mut hull);
+    report.lifted_apexes = clearance::lift_apexes(&mut hull);
     report.degenerate_repaired = degenerate::repair(&mut hull, &mesh.vertex_lines)?;
     Ok((hull, report))
 }

@@ -45,6 +45,9 @@ pub struct CaseCounts {
     pub case_iv: usize,
     /// Step (3'): hallway corners (trihedral with a reflex face angle), L-U pair V, T_0.
     pub hallway: usize,
+    /// Trihedral saddle corners whose edges of T ask for the side V is not on: an L-U pair
+    /// from V and apexes over the base (`saddle_apex`).
+    pub saddle: usize,
 }
 
 /// One vertex's data for steps (3)–(5).
@@ -88,6 +91,103 @@ fn orient(a: DVec3, b: DVec3, c: DVec3, q: DVec3) -> f64 {
 fn set_apex(slot: &mut [Option<DVec3>; 2], tri: [DVec3; 3], apex: DVec3) {
     let side = usize::from(orient(tri[0], tri[1], tri[2], apex) <= 0.0);
     slot[side] = Some(apex);
+}
+
+/// Where a trihedral saddle's apex on V's side lies between V (0) and the apex over the base
+/// (1) (`saddle_apex`). Measured on double_torus_poly's waist: 0.1 to 0.6 give a valid hull,
+/// 0 (V itself: its tetrahedron reaches across the polyhedron edge VV' into the neighbour's)
+/// and 0.75 (deep under the base: the two mirror-image saddles' tetrahedra meet) do not.
+pub const SADDLE_BLEND: f64 = 0.35;
+
+/// A trihedral saddle corner (one reflex face angle with V on the inner side of the guards'
+/// triangle, so not Algorithm 2's hallway (3'); or edges of both convexity classes) has edges
+/// of T asking for the side V is not on (Definition 3.1; see [`super::sides`]), so it needs an
+/// L-U pair (Def. 3.6 (4)(ii)). The missing side gets the apex over the base of
+/// [`super::sides::apexes_over_base`]; V's side keeps a point between V and that function's
+/// apex on the same side ([`SADDLE_BLEND`]). Both lie in the region where the pair is
+/// tangent-containing (Definition 3.5): for each base vertex, the other two base vertices are
+/// on opposite sides of its tangent plane (the plane cuts the base), or both on one side and
+/// then V (in all three face planes) and the apex over the base (which reaches the plane) are on
+/// or across it, and so is every point between them. Left to [`super::sides::settle`], both
+/// apexes were replaced by apexes over the base, 0.73 of the longest edge deep on
+/// double_torus_poly's waist, and the inner ones of the two mirror-image saddles there
+/// overlapped; with V itself, its tetrahedron overlapped the neighbour's across the edge VV'.
+/// Where no apex over the base exists, the missing side gets a low one (the centroid moved
+/// by [`super::sides::MIN_HEIGHT`] times the longest edge) and V stays.
+fn saddle_apex(
+    slot: &mut [Option<DVec3>; 2],
+    v: DVec3,
+    base: [DVec3; 3],
+    normals: [DVec3; 3],
+    counts: &mut CaseCounts,
+) {
+    let mut req = [false; 2];
+    for k in 0..3 {
+        let s =
+            super::sides::edge_sides(base[k], normals[k], base[(k + 1) % 3], normals[(k + 1) % 3]);
+        req[0] |= s[0];
+        req[1] |= s[1];
+    }
+    let Some(own) = (0..2).find(|&s| slot[s] == Some(v)) else {
+        return; // V is not an apex (a hallway pair replaced it): nothing to blend
+    };
+    let other = 1 - own;
+    if !req[other] || slot[other].is_some() {
+        return;
+    }
+    req[own] = true;
+    counts.saddle += 1;
+    if let Some(over) = super::sides::apexes_over_base(base, normals, req) {
+        if let (Some(q_own), Some(q_other)) = (over[own], over[other]) {
+            slot[own] = Some(v + SADDLE_BLEND * (q_own - v));
+            slot[other] = Some(q_other);
+            return;
+        }
+    }
+    let [a, b, c] = base;
+    let Some(nn) = (b - a).cross(c - a).try_normalize() else {
+        return;
+    };
+    let len = (b - a).length().max((c - b).length()).max((a - c).length());
+    let sign = if other == 0 { 1.0 } else { -1.0 };
+    slot[other] = Some((a + b + c) / 3.0 + sign * super::sides::MIN_HEIGHT * len * nn);
+}
+
+/// Offset δ along n_V of the pseudo-centroid C_0 = V + δ n_V of an unseparable vertex (the paper
+/// puts C_0 = V). The edge C_0G_i of T is convex (Definition 3.1) when
+/// (C_0 − G_i)·n_{G_i} has the sign of t_i = (G_i − V)·n_V or is zero; with C_0 = V the first
+/// factor is zero only for planar faces, and a non-planar input face (double_torus_poly's
+/// five-gons, ~1e-7 off their plane) can give it the wrong sign. Each face bounds δ on one
+/// side (n_V·n_{G_i} > 0 for "above face" normals); δ is 0 when that interval holds 0 (the
+/// paper's C_0 = V), else its middle (the middle of the overlap of the bounds when it is
+/// empty), or twice the one bound there is. |δ| stays of the
+/// order of the non-planarity, far below min |t_i|, so the second factor keeps its sign.
+fn unseparable_offset(v: DVec3, n: DVec3, pts: &[DVec3], nrm: &[DVec3], t: &[f64]) -> f64 {
+    // δ ≥ lo from faces with t_i > 0, δ ≤ hi from faces with t_i < 0.
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    for ((&g, &ng), &ti) in pts.iter().zip(nrm).zip(t) {
+        let cos = n.dot(ng);
+        if cos <= 1e-6 {
+            continue; // not above this face: no bound from it (Appendix C's business)
+        }
+        let bound = -ng.dot(v - g) / cos;
+        if ti > 0.0 {
+            lo = lo.max(bound);
+        } else if ti < 0.0 {
+            hi = hi.min(bound);
+        }
+    }
+    let limit = 1e-3 * t.iter().fold(f64::INFINITY, |m, x| m.min(x.abs()));
+    let delta = if lo <= 0.0 && hi >= 0.0 {
+        0.0 // C_0 = V already gives convex edges: the paper's choice
+    } else if lo.is_finite() && hi.is_finite() {
+        0.5 * (lo + hi)
+    } else if lo > 0.0 {
+        2.0 * lo // clears the binding face by its own offset
+    } else {
+        2.0 * hi
+    };
+    delta.clamp(-limit, limit)
 }
 
 /// Runs steps (3)–(5) for `c`, appending to `hull` (whose first points are the face centroids
@@ -134,6 +234,7 @@ pub fn build_corner(
                 counts.hallway += 1;
             }
         }
+        saddle_apex(&mut slot, c.v, base, [nrm[0], nrm[1], nrm[2]], counts);
         hull.triangles.push(tri);
         hull.apexes.push(slot);
         hull.element.push(c.vertex);
@@ -152,7 +253,7 @@ pub fn build_corner(
         // Beyond the paper (`fan`): C_0 slides (or cuts deeper) until its fan is an umbrella.
         super::fan::place_pseudo_centroid(c.v, n, t_star, options.alpha, &pts, &nrm)
     } else {
-        c.v
+        c.v + unseparable_offset(c.v, n, &pts, &nrm, &t) * n
     };
     let i0 = hull.points.len() as u32;
     hull.points.push(c0);
@@ -371,5 +472,39 @@ pub fn spread_hallway_apexes(hull: &mut SimplicialHull, hallway: &[HallwayApex])
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::convexity::{edge_convexity_1994, Convexity};
+
+    /// An unseparable vertex (centroids above and below its tangent plane) whose faces are off
+    /// their planes by ~1e-7, as non-planar input polygons are: with C_0 = V the edge to the
+    /// first guard is nonconvex (Definition 3.1); with the offset of `unseparable_offset` both
+    /// edges are convex, and the offset stays of the order of the non-planarity.
+    #[test]
+    fn unseparable_offset_makes_edges_convex() {
+        let v = DVec3::ZERO;
+        let n = DVec3::Z;
+        let ng = DVec3::new(-0.3, 0.0, 1.0).normalize();
+        // Face 0 above V's tangent plane, its guard 1e-7 off the plane through V; face 1
+        // below, 1e-6 off on the other side.
+        let g = [
+            DVec3::new(1.0, 0.0, 0.3) + 1e-7 * ng,
+            DVec3::new(-1.0, 0.0, -0.3) + 1e-6 * ng,
+        ];
+        let nrm = [ng, ng];
+        let t = [n.dot(g[0] - v), n.dot(g[1] - v)];
+        assert!(t[0] > 0.0 && t[1] < 0.0);
+        let class = |c0: DVec3, k: usize| edge_convexity_1994(c0, n, g[k], nrm[k]);
+        assert_eq!(class(v, 0), Convexity::Nonconvex);
+        let delta = unseparable_offset(v, n, &g, &nrm, &t);
+        // Bounded by the two faces' offsets over n·n_G (≈ 0.96).
+        assert!(delta > 0.0 && delta < 1.1e-6, "{delta}");
+        let c0 = v + delta * n;
+        assert_eq!(class(c0, 0), Convexity::Positive);
+        assert_eq!(class(c0, 1), Convexity::Negative);
     }
 }

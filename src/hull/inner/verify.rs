@@ -574,7 +574,17 @@ mod tests {
         for name in ["letter_P_poly.obj", "torus_quad.obj", "icosahedron.obj"] {
             let (m, _) = mesh::load(&root.join(name)).unwrap();
             let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
-            let hull = build(&m, &normals, &InnerOptions::default()).unwrap();
+            let mut hull = build(&m, &normals, &InnerOptions::default()).unwrap();
+            if name == "torus_quad.obj" {
+                // Its hull verifies since `unfold` flips its folds; apexes raised to four times
+                // their height over the base centroid make overlaps to compare on.
+                for (t, tri) in hull.triangles.iter().enumerate() {
+                    let g = tri.iter().map(|&i| hull.points[i as usize]).sum::<DVec3>() / 3.0;
+                    for q in hull.apexes[t].iter_mut().flatten() {
+                        *q = g + 4.0 * (*q - g);
+                    }
+                }
+            }
             let mut tets = Vec::new();
             for t in 0..hull.triangles.len() {
                 for s in Side::BOTH {
