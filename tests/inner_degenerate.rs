@@ -13,9 +13,11 @@ use std::path::Path;
 fn fandisk_face_tetrahedra_are_thick_and_the_cubic_scheme_builds() {
     let (m, _) = mesh::load(Path::new("scenes/models/fandisk.obj")).unwrap();
     let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    // Whether `degenerate::repair` or an earlier step (the pseudo-centroids of `fan`, the
+    // wedges) keeps the apexes thick depends on the pipeline; the contract checked here is that
+    // none is degenerate (the repair itself is unit-tested in `hull::inner::degenerate`).
     let (hull, report) = build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
-    // The repair ran where Algorithm 1 left degenerate or far apexes (4 triangles today).
-    assert!(report.degenerate_repaired > 0);
+    eprintln!("degenerate repaired: {}", report.degenerate_repaired);
     // Independent recomputation of every face tetrahedron's relative volume 6V / L³ (L its
     // longest edge); 1e-8 is `verify`'s degeneracy bound (barycentric coordinates keep 8 of
     // f64's 16 digits above it).
