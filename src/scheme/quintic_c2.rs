@@ -47,6 +47,12 @@ pub struct QuinticOptions {
     /// solve them with their edge middles and Hessian, closest to the targets, and repeat
     /// while the misses fall. Only stars with misses pay for the larger groups.
     pub relax_stars: bool,
+    /// Where a star's square system is singular (T not in general position around its point,
+    /// e.g. edges through it collinear in pairs), impose the system's consistency conditions
+    /// (one linear condition per dependent equation) on the edge middles solved before it,
+    /// instead of relaxing the star. Off by default: the conditions couple the edge middles of
+    /// all such points into one group.
+    pub consistent_stars: bool,
     /// Enforce Theorem 2.1's sign conditions (k = 1, [`signs`]) on the weights the C2
     /// constraints leave free, by pinning the ones whose targets miss their sign.
     pub signs: bool,
@@ -61,6 +67,7 @@ impl Default for QuinticOptions {
             complete_lu_pairs: true,
             joint_stars: false,
             relax_stars: true,
+            consistent_stars: false,
         }
     }
 }
@@ -111,6 +118,13 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "consistent_stars" => match v.as_bool() {
+                    Some(b) => o.consistent_stars = b,
+                    None => bail!(
+                        "{}: `scheme.consistent_stars` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => match v.as_bool() {
                     Some(b) => o.signs = b,
                     None => bail!(
@@ -129,7 +143,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }
@@ -179,6 +193,7 @@ pub fn build_with_stats(
         options.signs,
         options.joint_stars,
         options.relax_stars,
+        options.consistent_stars,
     )?;
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
     stats.lu_completed = lu_completed.len();

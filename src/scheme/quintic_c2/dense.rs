@@ -99,6 +99,67 @@ pub fn solve_near(
     Solution { x, rank, residual }
 }
 
+/// The dependencies among the rows of A (`m`×`n`, row-major): vectors y with yᵀA = 0, one per
+/// row beyond the numerical rank (pivots below `rank_tol` × the largest row norm, as in
+/// [`solve_near`]). A x = c is consistent exactly when yᵀc = 0 for each of them.
+#[must_use]
+pub fn dependencies(a: &[f64], m: usize, n: usize, rank_tol: f64) -> Vec<Vec<f64>> {
+    debug_assert_eq!(a.len(), m * n);
+    let mut cols: Vec<Vec<f64>> = (0..m).map(|i| a[i * n..(i + 1) * n].to_vec()).collect();
+    let mut perm: Vec<usize> = (0..m).collect();
+    let max_norm = cols
+        .iter()
+        .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .fold(0.0, f64::max);
+    let mut rank = 0;
+    for k in 0..m.min(n) {
+        let (p, pn) = (k..m)
+            .map(|j| (j, cols[j][k..].iter().map(|x| x * x).sum::<f64>()))
+            .fold(
+                (k, -1.0),
+                |best, cur| if cur.1 > best.1 { cur } else { best },
+            );
+        if pn.sqrt() <= rank_tol * max_norm || pn <= 0.0 {
+            break;
+        }
+        cols.swap(k, p);
+        perm.swap(k, p);
+        let norm = pn.sqrt();
+        let alpha = if cols[k][k] >= 0.0 { -norm } else { norm };
+        let mut v = cols[k][k..].to_vec();
+        v[0] -= alpha;
+        let vv: f64 = v.iter().map(|t| t * t).sum();
+        let beta = if vv > 0.0 { 2.0 / vv } else { 0.0 };
+        for col in cols.iter_mut().skip(k) {
+            let s: f64 = beta * v.iter().zip(&col[k..]).map(|(a, b)| a * b).sum::<f64>();
+            for (ci, vi) in col[k..].iter_mut().zip(&v) {
+                *ci -= s * vi;
+            }
+        }
+        rank = k + 1;
+    }
+    // Row perm[j] (j ≥ rank) = Σ_k w_k row perm[k] with R w = (its first `rank` coordinates),
+    // R upper triangular: R[i][k] = cols[k][i].
+    let mut out = Vec::new();
+    for j in rank..m {
+        let mut w = vec![0.0; rank];
+        for i in (0..rank).rev() {
+            let mut s = cols[j][i];
+            for k in i + 1..rank {
+                s -= cols[k][i] * w[k];
+            }
+            w[i] = s / cols[i][i];
+        }
+        let mut y = vec![0.0; m];
+        y[perm[j]] = 1.0;
+        for k in 0..rank {
+            y[perm[k]] -= w[k];
+        }
+        out.push(y);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -132,5 +193,26 @@ mod tests {
         // Inconsistent dependent row shows in the residual.
         let s = solve_near(&a, 2, 2, &[2.0, 5.0], &[0.0, 0.0], 1e-12);
         assert!(s.residual > 0.1);
+    }
+
+    /// Row 3 = row 1 + 2·row 2: one dependency, yᵀA = 0, against the construction.
+    #[test]
+    fn dependencies_of_rows() {
+        let a = [1.0, 2.0, 0.0, 0.0, 1.0, 3.0, 1.0, 4.0, 6.0];
+        let ys = dependencies(&a, 3, 3, 1e-12);
+        assert_eq!(ys.len(), 1);
+        let y = &ys[0];
+        for j in 0..3 {
+            let s: f64 = (0..3).map(|i| y[i] * a[i * 3 + j]).sum();
+            // Rounding of a 3×3 QR with entries O(1).
+            assert!(s.abs() < 1e-13, "{y:?}");
+        }
+        // Proportional to (1, 2, −1).
+        let r = y[0] / 1.0;
+        assert!(
+            (y[1] - 2.0 * r).abs() < 1e-13 && (y[2] + r).abs() < 1e-13,
+            "{y:?}"
+        );
+        assert!(dependencies(&[2.0, 1.0, 1.0, 3.0], 2, 2, 1e-12).is_empty());
     }
 }

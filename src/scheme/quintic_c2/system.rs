@@ -398,6 +398,9 @@ pub struct SolveStats {
     /// because their determined weights missed Theorem 2.1's signs
     /// (`QuinticOptions::relax_stars`).
     pub relaxed_for_signs: usize,
+    /// Consistency conditions of singular stars imposed on the edge middles
+    /// (`QuinticOptions::consistent_stars`).
+    pub consistency_conditions: usize,
 }
 
 /// A group whose equations could not be met in one pass.
@@ -405,6 +408,9 @@ struct Failure {
     stage: u8,
     points: Vec<u32>,
     message: String,
+    /// For a singular group: the conditions its known weights must meet for it to be
+    /// consistent (one per dependent equation, Σ coefficient · known slot = 0).
+    consistency: Vec<Equation>,
 }
 
 impl System {
@@ -436,6 +442,7 @@ impl System {
         pin: bool,
         joint_stars: bool,
         relax_stars: bool,
+        consistent_stars: bool,
     ) -> Result<(Vec<f64>, SolveStats)> {
         let mut level: HashMap<u32, u8> = HashMap::new();
         if joint_stars {
@@ -445,7 +452,8 @@ impl System {
                 level.insert(p, 2);
             }
         }
-        let (mut value, mut stats) = self.solve_levels(tets, jets, nt, target, &mut level, pin)?;
+        let (mut value, mut stats) =
+            self.solve_levels(tets, jets, nt, target, &mut level, pin, consistent_stars)?;
         if !relax_stars {
             return Ok((value, stats));
         }
@@ -469,7 +477,9 @@ impl System {
             if !grew {
                 break;
             }
-            let Ok((v, s)) = self.solve_levels(tets, jets, nt, target, &mut trial, pin) else {
+            let Ok((v, s)) =
+                self.solve_levels(tets, jets, nt, target, &mut trial, pin, consistent_stars)
+            else {
                 break;
             };
             let trial_misses = self.star_misses(&v);
@@ -534,20 +544,36 @@ impl System {
         target: &dyn Fn(usize, [u8; 4]) -> f64,
         level: &mut HashMap<u32, u8>,
         pin: bool,
+        consistent: bool,
     ) -> Result<(Vec<f64>, SolveStats)> {
         let mut first_failure = None;
+        let mut extra: Vec<Equation> = Vec::new();
+        let mut conditioned: std::collections::HashSet<Vec<u32>> = Default::default();
         for _pass in 0..6 {
             let (value, mut stats, failures) =
-                self.solve_pass(tets, jets, nt, target, level, false, pin);
+                self.solve_pass(tets, jets, nt, target, level, false, pin, &extra);
             if failures.is_empty() {
                 stats.relaxed_points = level.len();
+                stats.consistency_conditions = extra.len();
                 return Ok((value, stats));
             }
             if first_failure.is_none() {
                 first_failure = Some(failures[0].message.clone());
             }
             let mut bumped = false;
-            for f in &failures {
+            let last_message = failures[0].message.clone();
+            for f in failures {
+                // A singular star whose consistency conditions were not imposed yet: impose
+                // them on the weights solved before it (edge middles) instead of relaxing it.
+                if consistent
+                    && f.stage == 3
+                    && !f.consistency.is_empty()
+                    && conditioned.insert(f.points.clone())
+                {
+                    extra.extend(f.consistency);
+                    bumped = true;
+                    continue;
+                }
                 match f.stage {
                     1 => {
                         for p in &f.points {
@@ -571,7 +597,7 @@ impl System {
                 }
             }
             if !bumped {
-                first_failure = Some(failures[0].message.clone());
+                first_failure = Some(last_message);
                 break;
             }
         }
@@ -579,9 +605,10 @@ impl System {
         // number 10 system of an edge whose apexes lie in the planes of its points' faces, as on
         // cube_poly): solve every unknown at once, each connected group closest to its targets.
         let (value, mut stats, failures) =
-            self.solve_pass(tets, jets, nt, target, level, true, pin);
+            self.solve_pass(tets, jets, nt, target, level, true, pin, &extra);
         if failures.is_empty() {
             stats.relaxed_points = level.len();
+            stats.consistency_conditions = extra.len();
             stats.global = true;
             return Ok((value, stats));
         }
@@ -602,7 +629,11 @@ impl System {
         level: &HashMap<u32, u8>,
         global: bool,
         pin: bool,
+        extra: &[Equation],
     ) -> (Vec<f64>, SolveStats, Vec<Failure>) {
+        // The scheme's equations, then the consistency conditions of singular stars
+        // (`QuinticOptions::consistent_stars`).
+        let all: Vec<&Equation> = self.equations.iter().chain(extra).collect();
         let ns = self.keys.len();
         let np = self.np;
         let first_mid = np + 2 * nt;
@@ -659,7 +690,7 @@ impl System {
         }
         // Each equation is solved at the stage of its last unknown.
         let mut by_stage: Vec<Vec<usize>> = vec![Vec::new(); 7];
-        for (e, eq) in self.equations.iter().enumerate() {
+        for (e, eq) in all.iter().enumerate() {
             let st = eq
                 .terms
                 .iter()
@@ -707,7 +738,7 @@ impl System {
                 }
             }
             for &e in &by_stage[usize::from(st)] {
-                let us: Vec<u32> = self.equations[e]
+                let us: Vec<u32> = all[e]
                     .terms
                     .iter()
                     .map(|t| t.0)
@@ -728,7 +759,7 @@ impl System {
                 groups.entry(r).or_default().0.push(s);
             }
             for &e in &by_stage[usize::from(st)] {
-                let s = self.equations[e]
+                let s = all[e]
                     .terms
                     .iter()
                     .map(|t| t.0)
@@ -772,7 +803,7 @@ impl System {
                 let mut c = vec![0.0; m];
                 for (i, &e) in eqs.iter().enumerate() {
                     let mut row = Vec::new();
-                    for &(s, k) in &self.equations[e].terms {
+                    for &(s, k) in &all[e].terms {
                         match col.get(&s) {
                             Some(&j) => row.push((j, k)),
                             None => c[i] -= k * value[s as usize],
@@ -812,13 +843,55 @@ impl System {
                     let pts = where_();
                     let what = match st {
                         1 => format!("the middle of hull edge {pts:?}"),
-                        2 => format!("the star of hull point(s) {pts:?}"),
-                        3 => {
+                        // Pass stages: 2 relaxed stars, 3 stars, 4 far face weights, 5 face
+                        // middles, 6 the rest of the edge tetrahedra.
+                        2 | 3 => format!("the star of hull point(s) {pts:?}"),
+                        4 => {
                             format!("the far weights of the face tetrahedra at hull points {pts:?}")
                         }
+                        5 => format!("the face middles at hull points {pts:?}"),
                         _ => format!("the edge tetrahedra at hull points {pts:?}"),
                     };
+                    // What the known weights must meet for this group to be consistent:
+                    // the dependencies y of its rows (yᵀA = 0) applied to their known terms.
+                    let mut consistency = Vec::new();
+                    if n <= DENSE_LIMIT {
+                        let mut a = vec![0.0; m * n];
+                        for (i, row) in rows.iter().enumerate().take(m) {
+                            for &(j, k) in row {
+                                a[i * n + j] += k;
+                            }
+                        }
+                        for y in dense::dependencies(&a, m, n, 1e-11) {
+                            let mut terms: Vec<(u32, f64)> = Vec::new();
+                            for (i, &e) in eqs.iter().enumerate() {
+                                if y[i] == 0.0 {
+                                    continue;
+                                }
+                                for &(s, k) in &all[e].terms {
+                                    if !col.contains_key(&s) {
+                                        terms.push((s, y[i] * k));
+                                    }
+                                }
+                            }
+                            terms.sort_unstable_by_key(|t| t.0);
+                            let mut merged: Vec<(u32, f64)> = Vec::new();
+                            for (s, k) in terms {
+                                match merged.last_mut() {
+                                    Some(last) if last.0 == s => last.1 += k,
+                                    _ => merged.push((s, k)),
+                                }
+                            }
+                            let big = merged.iter().fold(0.0_f64, |a, t| a.max(t.1.abs()));
+                            // Cancellation of the dependency's rounding.
+                            merged.retain(|t| t.1.abs() > 1e-12 * big);
+                            if !merged.is_empty() {
+                                consistency.push(Equation { terms: merged });
+                            }
+                        }
+                    }
                     failures.push(Failure {
+                        consistency,
                         stage: st,
                         points: pts,
                         message: format!(
@@ -836,8 +909,7 @@ impl System {
             }
         }
         let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
-        stats.max_residual = self
-            .equations
+        stats.max_residual = all
             .iter()
             .map(|eq| {
                 eq.terms
