@@ -241,6 +241,31 @@ mod tests {
         assert_eq!(e.slope, DVec3::new(1.0, 2.0, 7.0));
     }
 
+    /// Nearly dependent constraints (the third point 1e-7 off the plane of the others, as on the
+    /// nut's 45° faces, relative 3e-8 of the edge): every constraint still holds to rounding
+    /// (one pass of Gram–Schmidt left errors of ~1e-10 on values of ~1e-7 there).
+    #[test]
+    fn fit_nearly_flat_holds_every_constraint() {
+        let pi = DVec3::new(100.76, -88.74, -68.21);
+        let frame = |a: f64, b: f64, c: f64| {
+            pi + a * DVec3::new(0.7071, 0.0, -0.7071)
+                + b * DVec3::Y
+                + c * DVec3::new(0.7071, 0.0, 0.7071)
+        };
+        let known = [
+            (frame(3.0, 0.2, 0.0), 3e-7),
+            (frame(1.0, 2.5, 0.0), -4e-7),
+            (frame(1.2, -2.4, 1e-7), 5e-7),
+        ];
+        let e = EdgeBlossom::fit(pi, 1e-7, &known, DVec3::new(0.3, 0.1, 0.3));
+        assert!(!e.flat);
+        for (x, v) in known {
+            // Rounding of values ~1e-7 through a slope of size ~10 at coordinates ~100: the
+            // constraint holds to ~1e-14 absolute; 1e-12 leaves room, 1e-10 was the old error.
+            assert!((e.at(x) - v).abs() < 1e-12, "{} vs {v}", e.at(x));
+        }
+    }
+
     /// The level rule puts the zero where asked: evaluate the cubic at the level.
     #[test]
     fn level_height_zero_at_level() {
