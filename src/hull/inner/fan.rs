@@ -214,10 +214,15 @@ mod tests {
             let h = e.perp_dot(c.truncate() - a) / e.length();
             // Rounding of the clipping only (1e-12).
             assert!(h >= FAN_MARGIN * e.length() - 1e-12, "{i}: {h}");
-            // Edge C_0C_i convex: a and b of one sign (both ≤ 0 here), up to rounding.
+            // Edge C_0C_i convex: a and b of one sign (both ≤ 0 here), b at least PLANE_MARGIN
+            // of the ring's size off face i's plane, up to rounding.
             let av = (moved[i] - c).dot(n);
             let bv = (c - moved[i]).dot(normals2[i]);
-            assert!(av < 0.0 && bv <= 1e-12, "{i}: a {av} b {bv}");
+            let scale = moved.iter().map(|p| p.length()).fold(0.0, f64::max);
+            assert!(
+                av < 0.0 && bv <= -PLANE_MARGIN * scale + 1e-12,
+                "{i}: a {av} b {bv}"
+            );
         }
     }
 }
