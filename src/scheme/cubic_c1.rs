@@ -217,14 +217,22 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
                 .find(|&v| v != i && v != j)
                 .unwrap_or(i)
         };
-        if let Some((a, b)) = flat::flat_coords(p[i], p[j], p[third(t0)], p[third(t1)]) {
+        let (m0, m1) = (p[third(t0)], p[third(t1)]);
+        if let Some((a, b)) = flat::flat_coords(p[i], p[j], m0, m1) {
             let ai = gradient_weight(p[i], g[i], p[j]);
             let aj = gradient_weight(p[j], g[j], p[i]);
+            // The edge blossom takes its slope across the plane from the prior (see the
+            // blossom fit below): p_m' lies off the plane by up to the flat tolerance, and
+            // A(p_m') includes that slope times its offset (the nut: 1e-10, a C¹ jump of 1e-9).
+            let across = (p[j] - p[i])
+                .cross(m0 - p[i])
+                .try_normalize()
+                .map_or(0.0, |n| ((g[i] + g[j]) / 6.0).dot(n) * n.dot(m1 - p[i]));
             flat_eqs.push(flat::FlatEquation {
                 from: t0 as usize,
                 to: t1 as usize,
                 b,
-                rhs: (1.0 - a - b) * ai + a * aj,
+                rhs: (1.0 - a - b) * ai + a * aj + across,
             });
         }
     }

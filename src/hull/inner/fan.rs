@@ -28,6 +28,14 @@ use glam::{DVec2, DVec3};
 /// fan, the nut 15 fans below it, all folded over).
 pub const FAN_MARGIN: f64 = 0.03;
 
+/// Distance C_0 keeps from the plane of every face round V when it is slid (relative to the
+/// ring's size): on that plane (the nearest point of the convex region often is) the fan
+/// triangles C_0C_iC_{i+1} through a flat face's points are coplanar with that face's triangles
+/// across edges C_0C_i that are not zero convex (C_0's normal is V's, not the face's), and the
+/// cubic scheme's flat-edge equations there have no solution (the 1994 paper's Appendix B
+/// (5'')(iii) displaces such a point; the nut's flat faces had a C¹ jump of 1.45).
+pub const PLANE_MARGIN: f64 = 0.01;
+
 /// Cut depths tried, as multiples f of t* in C_0 = V + f t* n (the paper's is f = 1 − α), when
 /// the paper's C_0 does not give an umbrella: shallower and deeper cuts, and points just
 /// outside the corner (f < 0), each with its own tangent plane π.
@@ -46,7 +54,7 @@ type HalfPlane = (DVec2, f64);
 /// projection onto π at least [`FAN_MARGIN`] times its projected base high. Otherwise the
 /// nearest point (over the depths of `DEPTHS`, sliding parallel to each π) where that holds
 /// *and* every edge C_0C_i of T is convex (Lemma 4.1: C_0 lies on the side of face i's plane
-/// that C_i lies on of π, or on the plane). When none exists, the paper's C_0.
+/// that C_i lies on of π, at least [`PLANE_MARGIN`] times the ring's size off the plane). When none exists, the paper's C_0.
 #[must_use]
 pub fn place_pseudo_centroid(
     v: DVec3,
@@ -94,7 +102,12 @@ pub fn place_pseudo_centroid(
             }
             let sigma = a.signum();
             let ni = normals[i];
-            planes.push((sigma * flat2(ni), -sigma * (c0 - ring[i]).dot(ni)));
+            // Strictly convex by PLANE_MARGIN: C_0 on face i's plane would make the fan
+            // triangles coplanar with face i's across a nonzero-convex edge (App. B (5'')(iii)).
+            planes.push((
+                sigma * flat2(ni),
+                -sigma * (c0 - ring[i]).dot(ni) + PLANE_MARGIN * scale,
+            ));
         }
         if !ok {
             continue;
@@ -201,10 +214,15 @@ mod tests {
             let h = e.perp_dot(c.truncate() - a) / e.length();
             // Rounding of the clipping only (1e-12).
             assert!(h >= FAN_MARGIN * e.length() - 1e-12, "{i}: {h}");
-            // Edge C_0C_i convex: a and b of one sign (both ≤ 0 here), up to rounding.
+            // Edge C_0C_i convex: a and b of one sign (both ≤ 0 here), b at least PLANE_MARGIN
+            // of the ring's size off face i's plane, up to rounding.
             let av = (moved[i] - c).dot(n);
             let bv = (c - moved[i]).dot(normals2[i]);
-            assert!(av < 0.0 && bv <= 1e-12, "{i}: a {av} b {bv}");
+            let scale = moved.iter().map(|p| p.length()).fold(0.0, f64::max);
+            assert!(
+                av < 0.0 && bv <= -PLANE_MARGIN * scale + 1e-12,
+                "{i}: a {av} b {bv}"
+            );
         }
     }
 }
