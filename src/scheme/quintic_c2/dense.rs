@@ -14,30 +14,28 @@ pub struct Solution {
     pub residual: f64,
 }
 
-/// Solves A x = c (A is `m`×`n`, row-major) for the x closest to `target` in the Euclidean norm:
-/// x = target + δ with δ the minimum-norm solution of A δ = c − A·target. Rows whose pivot falls
-/// below `rank_tol` × the largest row norm are treated as dependent; whether they are satisfied
-/// shows in [`Solution::residual`] (the caller decides what is consistent enough).
-#[must_use]
-pub fn solve_near(
-    a: &[f64],
-    m: usize,
-    n: usize,
-    c: &[f64],
-    target: &[f64],
-    rank_tol: f64,
-) -> Solution {
+/// Householder QR with column pivoting of M = Aᵀ (A is `m`×`n`, row-major), shared by
+/// [`solve_near`] and [`dependencies`]: Πᵀ A = Rᵀ Qᵀ.
+struct PivotedQr {
+    /// Column k of M after the reflections, in pivot order: R[i][k] = `cols[k][i]` for i ≤ k
+    /// (a column is not touched again after its own step, so `cols[k][k]` is R's diagonal);
+    /// columns past the rank hold the dependent rows' reduced coordinates.
+    cols: Vec<Vec<f64>>,
+    /// Π: pivot position → row of A.
+    perm: Vec<usize>,
+    /// Q = H_0 H_1 … H_{r−1}, each H_k = I − β v vᵀ acting on coordinates k.. as (v, β).
+    reflectors: Vec<(Vec<f64>, f64)>,
+    /// Numerical rank: pivots stop at `rank_tol` × the largest row norm.
+    rank: usize,
+}
+
+fn factor(a: &[f64], m: usize, n: usize, rank_tol: f64) -> PivotedQr {
     debug_assert_eq!(a.len(), m * n);
-    // Right-hand side of the correction.
-    let mut rhs: Vec<f64> = (0..m)
-        .map(|i| c[i] - (0..n).map(|j| a[i * n + j] * target[j]).sum::<f64>())
-        .collect();
     // M = Aᵀ stored by columns: column i of M is row i of A (length n).
     let mut cols: Vec<Vec<f64>> = (0..m).map(|i| a[i * n..(i + 1) * n].to_vec()).collect();
     let mut perm: Vec<usize> = (0..m).collect();
     let kmax = m.min(n);
     let mut reflectors: Vec<(Vec<f64>, f64)> = Vec::with_capacity(kmax);
-    let mut diag: Vec<f64> = Vec::with_capacity(kmax);
     let max_norm = cols
         .iter()
         .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
@@ -70,10 +68,41 @@ pub fn solve_near(
                 *ci -= s * vi;
             }
         }
-        diag.push(cols[k][k]);
         reflectors.push((v, beta));
         rank = k + 1;
     }
+    PivotedQr {
+        cols,
+        perm,
+        reflectors,
+        rank,
+    }
+}
+
+/// Solves A x = c (A is `m`×`n`, row-major) for the x closest to `target` in the Euclidean norm:
+/// x = target + δ with δ the minimum-norm solution of A δ = c − A·target. Rows whose pivot falls
+/// below `rank_tol` × the largest row norm are treated as dependent; whether they are satisfied
+/// shows in [`Solution::residual`] (the caller decides what is consistent enough).
+#[must_use]
+pub fn solve_near(
+    a: &[f64],
+    m: usize,
+    n: usize,
+    c: &[f64],
+    target: &[f64],
+    rank_tol: f64,
+) -> Solution {
+    debug_assert_eq!(a.len(), m * n);
+    // Right-hand side of the correction.
+    let mut rhs: Vec<f64> = (0..m)
+        .map(|i| c[i] - (0..n).map(|j| a[i * n + j] * target[j]).sum::<f64>())
+        .collect();
+    let PivotedQr {
+        cols,
+        perm,
+        reflectors,
+        rank,
+    } = factor(a, m, n, rank_tol);
     // Πᵀ A = Rᵀ Qᵀ: forward substitution Rᵀ z = Πᵀ rhs on the first `rank` permuted equations.
     let mut z = vec![0.0; n];
     for j in 0..rank {
@@ -81,7 +110,7 @@ pub fn solve_near(
         for (k, zk) in z.iter().enumerate().take(j) {
             s -= cols[j][k] * zk;
         }
-        z[j] = s / diag[j];
+        z[j] = s / cols[j][j];
     }
     // δ = Q z = H_0 H_1 … H_{r−1} z.
     for k in (0..rank).rev() {
@@ -104,40 +133,9 @@ pub fn solve_near(
 /// [`solve_near`]). A x = c is consistent exactly when yᵀc = 0 for each of them.
 #[must_use]
 pub fn dependencies(a: &[f64], m: usize, n: usize, rank_tol: f64) -> Vec<Vec<f64>> {
-    debug_assert_eq!(a.len(), m * n);
-    let mut cols: Vec<Vec<f64>> = (0..m).map(|i| a[i * n..(i + 1) * n].to_vec()).collect();
-    let mut perm: Vec<usize> = (0..m).collect();
-    let max_norm = cols
-        .iter()
-        .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
-        .fold(0.0, f64::max);
-    let mut rank = 0;
-    for k in 0..m.min(n) {
-        let (p, pn) = (k..m)
-            .map(|j| (j, cols[j][k..].iter().map(|x| x * x).sum::<f64>()))
-            .fold(
-                (k, -1.0),
-                |best, cur| if cur.1 > best.1 { cur } else { best },
-            );
-        if pn.sqrt() <= rank_tol * max_norm || pn <= 0.0 {
-            break;
-        }
-        cols.swap(k, p);
-        perm.swap(k, p);
-        let norm = pn.sqrt();
-        let alpha = if cols[k][k] >= 0.0 { -norm } else { norm };
-        let mut v = cols[k][k..].to_vec();
-        v[0] -= alpha;
-        let vv: f64 = v.iter().map(|t| t * t).sum();
-        let beta = if vv > 0.0 { 2.0 / vv } else { 0.0 };
-        for col in cols.iter_mut().skip(k) {
-            let s: f64 = beta * v.iter().zip(&col[k..]).map(|(a, b)| a * b).sum::<f64>();
-            for (ci, vi) in col[k..].iter_mut().zip(&v) {
-                *ci -= s * vi;
-            }
-        }
-        rank = k + 1;
-    }
+    let PivotedQr {
+        cols, perm, rank, ..
+    } = factor(a, m, n, rank_tol);
     // Row perm[j] (j ≥ rank) = Σ_k w_k row perm[k] with R w = (its first `rank` coordinates),
     // R upper triangular: R[i][k] = cols[k][i].
     let mut out = Vec::new();

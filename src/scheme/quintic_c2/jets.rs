@@ -126,34 +126,20 @@ mod tests {
     #[test]
     fn sphere_shape_operator() {
         let r = 2.0;
-        let dirs = [
-            DVec3::X,
-            -DVec3::X,
-            DVec3::Y,
-            -DVec3::Y,
-            DVec3::Z,
-            -DVec3::Z,
-        ];
+        // The regular octahedron on the unit axes: its vertices are its sphere normals.
+        let (dirs, triangles) = crate::fixtures::octahedron();
         let hull = SimplicialHull {
             points: dirs.iter().map(|d| *d * r).collect(),
-            normals: dirs.to_vec(),
+            normals: dirs,
             origins: vec![PointOrigin::Other; 6],
-            triangles: vec![
-                [0, 2, 4],
-                [2, 1, 4],
-                [1, 3, 4],
-                [3, 0, 4],
-                [2, 0, 5],
-                [1, 2, 5],
-                [3, 1, 5],
-                [0, 3, 5],
-            ],
+            triangles,
             apexes: vec![[None, None]; 8],
             element: vec![0; 8],
         };
         let jets = estimate(&hull, 1.0);
         for (k, j) in jets.iter().enumerate() {
-            let expect = (DMat3::IDENTITY - outer(dirs[k], dirs[k])) * (1.0 / r);
+            let d = hull.normals[k];
+            let expect = (DMat3::IDENTITY - outer(d, d)) * (1.0 / r);
             let diff = (j.h - expect).to_cols_array();
             // Exact data, a 3×3 solve: rounding only.
             assert!(diff.iter().all(|d| d.abs() < 1e-12), "{k}: {:?}", j.h);
