@@ -467,20 +467,6 @@ pub const J_LINE_RES: usize = 12;
 /// sufficient condition, like `check`'s lattice of j-lines).
 fn j_line_height(w: &[f64; 20], sigma: f64) -> f64 {
     const RES: usize = J_LINE_RES;
-    let base_max = (0..3)
-        .flat_map(|k| (0..3).map(move |l| (k, l)))
-        .map(|(k, l)| w[ix(e3(k, k, l))].abs())
-        .fold(w[ix([1, 1, 1, 0])].abs(), f64::max);
-    // By the convex hull property of Bernstein coefficients, F(b) can only have the apex's
-    // sign where some base weight has it, and B(b, b, q) only the other sign where some
-    // λ3 = 1 weight has; without both no lattice point can raise the bound (this skips the
-    // lattice on the ordinary, one-signed bases: same result, far less work).
-    let base_apex_sign =
-        (0..3).any(|k| (0..3).any(|l| (0..3).any(|m| sigma * w[ix(e3(k, l, m))] > 0.0)));
-    let level1_other_sign = (0..3).any(|k| (0..3).any(|l| sigma * w[ix(e3(k, l, 3))] < 0.0));
-    if !base_apex_sign || !level1_other_sign {
-        return 0.0;
-    }
     // The weights in the lattice sums' order, looked up once.
     let mut w0 = [0.0; 27];
     let mut w1 = [0.0; 9];
@@ -492,6 +478,17 @@ fn j_line_height(w: &[f64; 20], sigma: f64) -> f64 {
             w1[3 * k + l] = w[ix(e3(k, l, 3))];
         }
     }
+    // By the convex hull property of Bernstein coefficients, F(b) can only have the apex's
+    // sign where some base weight has it, and B(b, b, q) only the other sign where some
+    // λ3 = 1 weight has; without both no lattice point can raise the bound (this skips the
+    // lattice on the ordinary, one-signed bases: same result, far less work).
+    if !w0.iter().any(|&x| sigma * x > 0.0) || !w1.iter().any(|&x| sigma * x < 0.0) {
+        return 0.0;
+    }
+    let base_max = (0..3)
+        .flat_map(|k| (0..3).map(move |l| (k, l)))
+        .map(|(k, l)| w[ix(e3(k, k, l))].abs())
+        .fold(w[ix([1, 1, 1, 0])].abs(), f64::max);
     let mut need: f64 = 0.0;
     for i in 0..=RES {
         for j in 0..=RES - i {
