@@ -605,8 +605,41 @@ pub struct MeshBuildInfo {
 pub fn build_complex_with_info(
     scene: &Scene,
 ) -> anyhow::Result<(PatchComplex, Option<MeshBuildInfo>)> {
+    let built = build_scene(scene)?;
+    Ok((built.complex, built.info))
+}
+
+/// A scene's patch complex with what its build loaded and made on the way, so that reports
+/// (`apatch check`) reuse them instead of loading the mesh and building the hull again.
+#[derive(Clone, Debug)]
+pub struct BuiltScene {
+    /// The patches.
+    pub complex: PatchComplex,
+    /// What the 2001 scheme's mesh pipeline did (`rational-c1` mesh scenes; `None` otherwise).
+    pub info: Option<MeshBuildInfo>,
+    /// The mesh as loaded (after `model.weld`, before triangulation and subdivision); `None`
+    /// for patch files.
+    pub mesh: Option<mesh::Mesh>,
+    /// The inner simplicial hull (1994) the patches fill (`cubic-c1`, `quintic-c2`), the same
+    /// value [`inner_hull`] rebuilds: for `cubic-c1` after the scheme's apex changes
+    /// ([`crate::scheme::cubic_c1::prepare_hull`]), for `quintic-c2` as the hull builder made it
+    /// (the scheme completes L-U pairs internally). `None` for other scenes.
+    pub hull: Option<crate::hull::simplicial::SimplicialHull>,
+}
+
+/// [`build_complex`], returning the loaded mesh and the hull beside the complex
+/// ([`BuiltScene`]): the mesh is loaded once and the 1994 hull built once.
+///
+/// # Errors
+/// As [`build_complex`].
+pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
     match &scene.model {
-        Model::Patches(p) => Ok((read_patches(p)?, None)),
+        Model::Patches(p) => Ok(BuiltScene {
+            complex: read_patches(p)?,
+            info: None,
+            mesh: None,
+            hull: None,
+        }),
         Model::Mesh {
             file,
             normals,
@@ -663,7 +696,12 @@ pub fn build_complex_with_info(
                         subdivided_triangles: triangles.len(),
                         refined_edges: built.refined_edges,
                     };
-                    Ok((built.complex, Some(info)))
+                    Ok(BuiltScene {
+                        complex: built.complex,
+                        info: Some(info),
+                        mesh: Some(m),
+                        hull: None,
+                    })
                 }
                 "cubic-c1" | "quintic-c2" => {
                     let method: NormalMethod = normals.parse().map_err(|e: String| {
@@ -672,16 +710,14 @@ pub fn build_complex_with_info(
                     let (m, report) = mesh::load(file)?;
                     report.require(true)?;
                     let vn = mesh::vertex_normals(&m, method)?;
-                    let build = if ty == "cubic-c1" {
-                        crate::scheme::cubic_c1::build_from_scene
-                    } else {
-                        crate::scheme::quintic_c2::build_from_scene
-                    };
-                    Ok((
-                        build(&m, &vn, scheme, &scene.path)
-                            .with_context(|| format!("{}", file.display()))?,
-                        None,
-                    ))
+                    let (complex, hull) = build_1994(ty, &m, &vn, scheme, &scene.path)
+                        .with_context(|| format!("{}", file.display()))?;
+                    Ok(BuiltScene {
+                        complex,
+                        info: None,
+                        mesh: Some(m),
+                        hull: Some(hull),
+                    })
                 }
                 _ => bail!(
                     "{}: `scheme.type`: `{ty}` is not one of rational-c1, cubic-c1, quintic-c2",
@@ -696,6 +732,7 @@ pub fn build_complex_with_info(
 /// scene's normals and hull options; `None` for other scenes. Lets `check` verify the hull
 /// (Definition 3.6) beside the patches. For `cubic-c1` it is the hull after the scheme's own
 /// changes to the apexes ([`crate::scheme::cubic_c1::prepare_hull`]), the one its patches fill.
+/// Loads the mesh and builds the hull anew: after a build, [`BuiltScene::hull`] is this value.
 ///
 /// # Errors
 /// Unreadable meshes, bad options, and hulls that cannot be built, naming the file.
@@ -732,6 +769,47 @@ pub fn inner_hull(
         ));
     }
     Ok(Some(hull))
+}
+
+/// Builds a `cubic-c1` or `quintic-c2` complex as the schemes' `build_from_scene` do (same
+/// options, hull, patches and errors), returning the hull the patches fill beside it.
+fn build_1994(
+    ty: &str,
+    m: &mesh::Mesh,
+    vn: &[DVec3],
+    scheme: &toml::Table,
+    scene: &Path,
+) -> anyhow::Result<(PatchComplex, crate::hull::simplicial::SimplicialHull)> {
+    use crate::scheme::{cubic_c1, quintic_c2};
+    let at = || format!("{}", scene.display());
+    if ty == "cubic-c1" {
+        let (options, inner) = cubic_c1::options_from_toml(scheme, scene)?;
+        let hull = crate::hull::inner::build(m, vn, &inner).with_context(at)?;
+        Ok(cubic_on_prepared(&hull, &options).with_context(at)?)
+    } else {
+        let options = quintic_c2::QuinticOptions::from_toml(scheme, scene)?;
+        let inner = crate::hull::inner::InnerOptions::from_toml(scheme, scene)?;
+        let hull = crate::hull::inner::build(m, vn, &inner)?;
+        let complex = quintic_c2::build(&hull, &options)?;
+        Ok((complex, hull))
+    }
+}
+
+/// [`crate::scheme::cubic_c1::build`] on `hull`, returning the hull its patches fill: the
+/// scheme's apex changes ([`crate::scheme::cubic_c1::prepare_hull`]) are made here, once, and
+/// the build is told not to make them again (the same patches as `build(hull, options)`).
+fn cubic_on_prepared(
+    hull: &crate::hull::simplicial::SimplicialHull,
+    options: &crate::scheme::cubic_c1::CubicOptions,
+) -> crate::error::Result<(PatchComplex, crate::hull::simplicial::SimplicialHull)> {
+    use crate::scheme::cubic_c1;
+    let prepared = cubic_c1::prepare_hull(hull, options).hull;
+    let once = cubic_c1::CubicOptions {
+        complete_lu_pairs: false,
+        contain_tangents: false,
+        ..options.clone()
+    };
+    Ok((cubic_c1::build(&prepared, &once)?, prepared))
 }
 
 /// Reads a patch complex JSON file (as written by `apatch export patches`) with the validating
@@ -873,6 +951,155 @@ irradiance = 2.0
         let s = parse(&text, Path::new("s.toml")).unwrap();
         let e = format!("{:#}", build_complex(&s).unwrap_err());
         assert!(e.contains("s.toml") && e.contains("bezier-c9"), "{e}");
+    }
+
+    use crate::hull::simplicial::{Side, SimplicialHull};
+    use crate::scheme::{cubic_c1, quintic_c2};
+
+    /// Each tetrahedron as its corners' bits, sorted, and the list sorted: two lists are equal
+    /// exactly when they hold the same tetrahedra (in any order, with any corner order).
+    fn tet_keys(tets: impl Iterator<Item = [[f64; 3]; 4]>) -> Vec<[[u64; 3]; 4]> {
+        let mut keys: Vec<[[u64; 3]; 4]> = tets
+            .map(|t| {
+                let mut k = t.map(|p| p.map(f64::to_bits));
+                k.sort_unstable();
+                k
+            })
+            .collect();
+        keys.sort_unstable();
+        keys
+    }
+
+    /// The face and edge tetrahedra of `hull`: the cells a 1994 scheme puts one patch in each.
+    fn hull_tets(hull: &SimplicialHull) -> Vec<[[u64; 3]; 4]> {
+        let faces = (0..hull.triangles.len())
+            .flat_map(|t| Side::BOTH.map(|side| hull.face_tet(t, side)))
+            .flatten();
+        let edges = hull.edge_tets().unwrap().into_iter().map(|e| e.tet);
+        tet_keys(faces.chain(edges).map(|t| t.map(|p| p.to_array())))
+    }
+
+    fn patch_tets(c: &PatchComplex) -> Vec<[[u64; 3]; 4]> {
+        tet_keys(c.patches.iter().map(|p| p.tet))
+    }
+
+    /// Every field of two hulls equal (`SimplicialHull` has no `PartialEq`).
+    fn same_hull(a: &SimplicialHull, b: &SimplicialHull) -> bool {
+        a.points == b.points
+            && a.normals == b.normals
+            && a.origins == b.origins
+            && a.triangles == b.triangles
+            && a.apexes == b.apexes
+            && a.element == b.element
+    }
+
+    fn paper1994(name: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/paper1994/{name}.toml"))
+    }
+
+    /// `build_scene` returns the mesh it loaded and the very hull its patches fill (what
+    /// `apatch check` verifies and measures the distance to): the patches are exactly that
+    /// hull's face and edge tetrahedra, the hull is the one `inner_hull` builds anew, and the
+    /// patches are the schemes' own `build_from_scene`'s, bit for bit. Scenes with shape options
+    /// (an icosahedron with `alpha`, whose hull the option changes; the hallway corner's
+    /// `levels`), both schemes.
+    #[test]
+    fn built_scene_returns_the_mesh_and_the_hull_its_patches_fill() {
+        let ico = std::fs::read_to_string(paper1994("icosahedron")).unwrap();
+        let shaped = ico.replace(
+            "type = \"cubic-c1\"",
+            "type = \"cubic-c1\"\nalpha = 0.3\ntrihedral_level = 0.7",
+        );
+        assert_ne!(shaped, ico);
+        let shaped = parse(&shaped, &paper1994("icosahedron")).unwrap();
+        let default_hull = inner_hull(&load(&paper1994("icosahedron")).unwrap())
+            .unwrap()
+            .unwrap();
+        let mut scenes = vec![shaped];
+        for name in ["cube", "hallway_corner", "cube_quintic", "l_prism_quintic"] {
+            scenes.push(load(&paper1994(name)).unwrap());
+        }
+        for (k, sc) in scenes.iter().enumerate() {
+            let name = sc.path.display();
+            let built = build_scene(sc).unwrap();
+            let hull = built.hull.as_ref().expect("1994 scenes return their hull");
+            if k == 0 {
+                // The premise: `alpha` changes the hull, so a hull built with the wrong
+                // options would not match the patches below.
+                assert!(!same_hull(hull, &default_hull));
+            }
+            let quintic = built.complex.scheme == "quintic-c2";
+            // The quintic scheme completes L-U pairs inside its build.
+            let filled = if quintic {
+                cubic_c1::sided::complete_lu_pairs(hull).0
+            } else {
+                hull.clone()
+            };
+            assert_eq!(
+                built.complex.patches.len(),
+                hull_tets(&filled).len(),
+                "{name}"
+            );
+            assert_eq!(patch_tets(&built.complex), hull_tets(&filled), "{name}");
+            assert!(same_hull(hull, &inner_hull(sc).unwrap().unwrap()), "{name}");
+            let Model::Mesh {
+                file,
+                normals,
+                scheme,
+                ..
+            } = &sc.model
+            else {
+                panic!("{name}: a mesh scene");
+            };
+            let (m, _) = mesh::load(file).unwrap();
+            assert_eq!(built.mesh.as_ref(), Some(&m), "{name}");
+            assert!(built.info.is_none(), "{name}");
+            let vn = mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+            let own = if quintic {
+                quintic_c2::build_from_scene(&m, &vn, scheme, &sc.path)
+            } else {
+                cubic_c1::build_from_scene(&m, &vn, scheme, &sc.path)
+            };
+            assert_eq!(built.complex, own.unwrap(), "{name}");
+        }
+    }
+
+    /// Where the cubic scheme's own apex changes do change the hull (the 12×8 torus with the
+    /// inner apexes of its non-convex triangles taken away again: `complete_lu_pairs` gives
+    /// them back), the hull returned is the changed one, its tetrahedra are the patches', and
+    /// the patches are those of `cubic_c1::build` on the unchanged hull (the changes made once,
+    /// not twice).
+    #[test]
+    fn cubic_apex_changes_are_made_once_on_the_hull_returned() {
+        let sc = load(&paper1994("torus_quad12x8")).unwrap();
+        let Model::Mesh {
+            file,
+            normals,
+            scheme,
+            ..
+        } = &sc.model
+        else {
+            panic!("a mesh scene");
+        };
+        let (m, _) = mesh::load(file).unwrap();
+        let vn = mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+        let (options, inner) = cubic_c1::options_from_toml(scheme, &sc.path).unwrap();
+        let mut hull = crate::hull::inner::build(&m, &vn, &inner).unwrap();
+        for t in 0..hull.triangles.len() {
+            if hull.apexes[t].iter().all(Option::is_some)
+                && !cubic_c1::sided::convex_for(&hull, t, Side::Outer)
+            {
+                hull.apexes[t][Side::Inner as usize] = None;
+            }
+        }
+        let prepared = cubic_c1::prepare_hull(&hull, &options);
+        // The premise: the changes add tetrahedra.
+        assert!(!prepared.lu_completed.is_empty());
+        let (complex, filled) = cubic_on_prepared(&hull, &options).unwrap();
+        assert!(same_hull(&filled, &prepared.hull));
+        assert_eq!(patch_tets(&complex), hull_tets(&filled));
+        assert_ne!(patch_tets(&complex), hull_tets(&hull));
+        assert_eq!(complex, cubic_c1::build(&hull, &options).unwrap());
     }
 
     #[test]

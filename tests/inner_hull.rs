@@ -2,6 +2,7 @@
 //! quads and random convex solids, checked by `verify` (Definition 3.6, Lemmas 4.1–4.3); `verify`
 //! itself caught on broken hulls; Appendix C's normal repair; scene options.
 
+use apatch::fixtures::Lcg;
 use apatch::hull::inner::verify::euler_characteristic;
 use apatch::hull::inner::{self, InnerOptions, ViolationKind};
 use apatch::hull::simplicial::{PointOrigin, Side, SimplicialHull};
@@ -141,23 +142,14 @@ fn octahedron_pseudo_centroids_follow_alpha() {
     }
 }
 
-/// A tiny deterministic generator (64-bit LCG, top 53 bits).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn on_sphere(&mut self) -> DVec3 {
-        loop {
-            let p = DVec3::new(self.next(), self.next(), self.next()) * 2.0 - 1.0;
-            let l = p.length();
-            if l > 0.1 && l <= 1.0 {
-                return p / l;
-            }
+/// A point on the unit sphere from the seeded generator: rejection sampling in the unit ball
+/// (points nearer the centre than 0.1 rejected, so normalising is well conditioned).
+fn on_sphere(rng: &mut Lcg) -> DVec3 {
+    loop {
+        let p = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - 1.0;
+        let l = p.length();
+        if l > 0.1 && l <= 1.0 {
+            return p / l;
         }
     }
 }
@@ -204,9 +196,9 @@ fn random_convex(triangulated: bool) {
     let mut rng = Lcg(0x1994);
     for trial in 0..6 {
         let count = 12 + 4 * trial;
-        let pts: Vec<DVec3> = (0..count).map(|_| rng.on_sphere()).collect();
+        let pts: Vec<DVec3> = (0..count).map(|_| on_sphere(&mut rng)).collect();
         let tris = sphere_hull(&pts);
-        let radii = DVec3::new(1.0 + rng.next(), 1.0, 0.5 + rng.next());
+        let radii = DVec3::new(1.0 + rng.uniform(), 1.0, 0.5 + rng.uniform());
         // Hull of the points, mapped onto the ellipsoid (affine maps keep convexity).
         let (m, _) = mesh::from_polygons(
             pts.iter().map(|&p| p * radii).collect(),

@@ -62,22 +62,41 @@ pub fn load_complex(path: &Path) -> anyhow::Result<PatchComplex> {
 pub fn load_complex_with_info(
     path: &Path,
 ) -> anyhow::Result<(PatchComplex, Option<apatch::scene::MeshBuildInfo>)> {
+    let (built, _) = load_built(path)?;
+    Ok((built.complex, built.info))
+}
+
+/// [`load_complex`], returning everything the build loaded and made
+/// ([`apatch::scene::BuiltScene`]: the mesh, the 1994 hull the patches fill) and the scene when
+/// `path` is one, so that reports reuse them rather than loading and building them again.
+///
+/// # Errors
+/// As [`load_complex`].
+pub fn load_built(
+    path: &Path,
+) -> anyhow::Result<(apatch::scene::BuiltScene, Option<apatch::scene::Scene>)> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
+    let only = |complex| apatch::scene::BuiltScene {
+        complex,
+        info: None,
+        mesh: None,
+        hull: None,
+    };
     match ext.as_str() {
-        "json" => Ok((apatch::complex_io::read_json_file(path)?, None)),
+        "json" => Ok((only(apatch::complex_io::read_json_file(path)?), None)),
         "toml" => {
             let scene = apatch::scene::load(path)?;
             if let apatch::scene::Model::Patches(json) = &scene.model {
-                return Ok((apatch::complex_io::read_json_file(json)?, None));
+                return Ok((only(apatch::complex_io::read_json_file(json)?), Some(scene)));
             }
-            let (complex, info) = apatch::scene::build_complex_with_info(&scene)?;
-            apatch::complex_io::validate(&complex)
+            let built = apatch::scene::build_scene(&scene)?;
+            apatch::complex_io::validate(&built.complex)
                 .map_err(|m| anyhow::anyhow!("{}: {m}", path.display()))?;
-            Ok((complex, info))
+            Ok((built, Some(scene)))
         }
         "obj" | "off" => {
             if !path.exists() {
@@ -96,33 +115,20 @@ pub fn load_complex_with_info(
     }
 }
 
-/// The scene of `input` when it is a `.toml` scene of a 1994 scheme (`cubic-c1`, `quintic-c2`:
-/// the surface approximates the polyhedron and lives on an inner hull), else `None`.
-fn scene_1994(
-    input: &Path,
-    complex: &PatchComplex,
-) -> anyhow::Result<Option<apatch::scene::Scene>> {
-    let is_toml = input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-    if !is_toml || !matches!(complex.scheme.as_str(), "cubic-c1" | "quintic-c2") {
-        return Ok(None);
-    }
-    Ok(Some(apatch::scene::load(input)?))
+/// Whether `complex` comes from a 1994 scheme (`cubic-c1`, `quintic-c2`: the surface
+/// approximates the polyhedron and lives on an inner hull).
+fn is_1994(complex: &PatchComplex) -> bool {
+    matches!(complex.scheme.as_str(), "cubic-c1" | "quintic-c2")
 }
 
 /// The scene's opt-in pre-subdivision (`model.subdivide`) when `input` is such a scene: the
 /// surface then interpolates the subdivided mesh, not the input, and the report says so.
 /// Also the scene's weld tolerance (`model.weld`), which changes the mesh the same way.
-fn mesh_repairs(input: &Path) -> (Option<apatch::mesh::Subdivision>, Option<f64>) {
-    let is_toml = input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-    if !is_toml {
-        return (None, None);
-    }
-    match apatch::scene::load(input).map(|s| s.model) {
-        Ok(apatch::scene::Model::Mesh {
+fn mesh_repairs(
+    scene: Option<&apatch::scene::Scene>,
+) -> (Option<apatch::mesh::Subdivision>, Option<f64>) {
+    match scene.map(|s| &s.model) {
+        Some(apatch::scene::Model::Mesh {
             subdivide, weld, ..
         }) => (
             subdivide.filter(|s| s.levels > 0),
@@ -132,31 +138,15 @@ fn mesh_repairs(input: &Path) -> (Option<apatch::mesh::Subdivision>, Option<f64>
     }
 }
 
-/// The distance of the surface to the scene's polyhedron (1994 scenes).
+/// The distance of the surface to the polyhedron `mesh` (1994 scenes: the mesh the build
+/// loaded).
 fn polyhedron_distance(
-    scene: &apatch::scene::Scene,
+    mesh: &apatch::mesh::Mesh,
     complex: &PatchComplex,
-) -> anyhow::Result<Option<check::distance::DistanceStats>> {
-    let apatch::scene::Model::Mesh { file, .. } = &scene.model else {
-        return Ok(None);
-    };
-    let (m, _) = apatch::mesh::load(file)?;
-    let tri = apatch::mesh::triangulate(&m);
+) -> check::distance::DistanceStats {
+    let tri = apatch::mesh::triangulate(mesh);
     let faces: Vec<[u32; 3]> = tri.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
-    Ok(Some(check::distance::distance_to_polyhedron(
-        complex,
-        &tri.positions,
-        &faces,
-        6,
-    )))
-}
-
-/// The inner simplicial hull a 1994 scene is built on, checked against Definition 3.6 and
-/// Lemmas 4.1–4.3 (`hull::inner::verify`): the violations, empty when valid.
-fn hull_violations(
-    scene: &apatch::scene::Scene,
-) -> anyhow::Result<Option<Vec<apatch::hull::inner::HullViolation>>> {
-    Ok(apatch::scene::inner_hull(scene)?.map(|h| apatch::hull::inner::verify(&h)))
+    check::distance::distance_to_polyhedron(complex, &tri.positions, &faces, 6)
 }
 
 /// One line per hull violation: the condition, the triangle of T, the detail.
@@ -169,7 +159,8 @@ fn violation_line(v: &apatch::hull::inner::HullViolation) -> String {
 
 /// Runs `apatch check`.
 pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
-    let (complex, build_info) = load_complex_with_info(&args.input)?;
+    let (built, scene) = load_built(&args.input)?;
+    let (complex, build_info) = (&built.complex, built.info);
     let opts = CheckOptions {
         continuity: args.continuity,
         jump_tolerance: args.jump_tolerance,
@@ -180,14 +171,18 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         single_sheet: args.single_sheet,
         ..CheckOptions::default()
     };
-    let report = check::check(&complex, &opts);
-    let scene = scene_1994(&args.input, &complex)?;
-    let (distance, hull) = match &scene {
-        Some(s) => (polyhedron_distance(s, &complex)?, hull_violations(s)?),
-        None => (None, None),
+    let report = check::check(complex, &opts);
+    // 1994 scenes: the distance to the very mesh and the verdict on the very hull (Definition
+    // 3.6, Lemmas 4.1-4.3: `hull::inner::verify`) the build used.
+    let (distance, hull) = match &built.mesh {
+        Some(m) if is_1994(complex) => (
+            Some(polyhedron_distance(m, complex)),
+            built.hull.as_ref().map(apatch::hull::inner::verify),
+        ),
+        _ => (None, None),
     };
     let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);
-    let (subdivided, welded) = mesh_repairs(&args.input);
+    let (subdivided, welded) = mesh_repairs(scene.as_ref());
     let passed = report.passed() && hull_valid;
     if args.json {
         // The verdict first, then every measure.

@@ -126,13 +126,15 @@ pub fn complete_lu_pairs(hull: &SimplicialHull) -> (SimplicialHull, Vec<usize>) 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::hull::simplicial::PointOrigin;
 
-    /// One triangle in z = 0 with an outer apex; normals tilted by `tilt` at the vertices 1
-    /// and 2 (towards each other when positive: the edge [1 2] runs above their tangent planes).
-    fn hull(tilt: f64) -> SimplicialHull {
+    /// One triangle [0 1 2] of the points 0, x, y in z = 0 (element 0) with the outer apex
+    /// (0.3, 0.3, 0.5) and `inner_apex` as its partner; normal z at point 0 and normals tilted by
+    /// `tilt` at the points 1 and 2 (towards each other when positive: the edge [1 2] runs above
+    /// their tangent planes). Also the fixture of [`super::super::tangent`]'s tests.
+    pub(crate) fn tilted_triangle(tilt: f64, inner_apex: Option<DVec3>) -> SimplicialHull {
         SimplicialHull {
             points: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
             normals: vec![
@@ -142,9 +144,14 @@ mod tests {
             ],
             origins: vec![PointOrigin::Other; 3],
             triangles: vec![[0, 1, 2]],
-            apexes: vec![[Some(DVec3::new(0.3, 0.3, 0.5)), None]],
+            apexes: vec![[Some(DVec3::new(0.3, 0.3, 0.5)), inner_apex]],
             element: vec![0],
         }
+    }
+
+    /// The single-sided triangle (outer apex only) with normals tilted by `tilt`.
+    fn hull(tilt: f64) -> SimplicialHull {
+        tilted_triangle(tilt, None)
     }
 
     #[test]

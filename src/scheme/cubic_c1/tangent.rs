@@ -133,23 +133,11 @@ pub fn contain_tangents(hull: &SimplicialHull) -> (SimplicialHull, Vec<(usize, S
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hull::simplicial::PointOrigin;
 
     /// One triangle in z = 0, normals tilted towards each other at the points 1 and 2, an
     /// L-U pair whose inner apex lies just below the plane: above the tangent planes at 1 and 2.
     fn hull(inner_apex: DVec3) -> SimplicialHull {
-        SimplicialHull {
-            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
-            normals: vec![
-                DVec3::Z,
-                DVec3::new(-0.4, 0.4, 1.0).normalize(),
-                DVec3::new(0.4, -0.4, 1.0).normalize(),
-            ],
-            origins: vec![PointOrigin::Other; 3],
-            triangles: vec![[0, 1, 2]],
-            apexes: vec![[Some(DVec3::new(0.3, 0.3, 0.5)), Some(inner_apex)]],
-            element: vec![0],
-        }
+        super::super::sided::tests::tilted_triangle(0.4, Some(inner_apex))
     }
 
     /// The shallow inner apex is beyond the tangent planes (its slopes are checked
