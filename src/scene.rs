@@ -670,7 +670,7 @@ pub fn build_complex_with_info(
                         anyhow!("{}: `model.normals`: {e}", scene.path.display())
                     })?;
                     let (m, report) = mesh::load(file)?;
-                    report.require(true)?;
+                    crate::hull::inner::closed::require_closed(&m, &report)?;
                     let vn = mesh::vertex_normals(&m, method)?;
                     let build = if ty == "cubic-c1" {
                         crate::scheme::cubic_c1::build_from_scene
