@@ -708,7 +708,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                         anyhow!("{}: `model.normals`: {e}", scene.path.display())
                     })?;
                     let (m, report) = mesh::load(file)?;
-                    report.require(true)?;
+                    crate::hull::inner::closed::require_closed(&m, &report)?;
                     let vn = mesh::vertex_normals(&m, method)?;
                     let (complex, hull) = build_1994(ty, &m, &vn, scheme, &scene.path)
                         .with_context(|| format!("{}", file.display()))?;

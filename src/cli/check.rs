@@ -149,6 +149,22 @@ fn polyhedron_distance(
     check::distance::distance_to_polyhedron(complex, &tri.positions, &faces, 6)
 }
 
+/// What the 1994 schemes' planar split (`hull::inner::planar`) does to the scene's mesh: the
+/// tolerance and the split, `None` when nothing is split (or the scene is no mesh scene).
+fn planar_split(
+    scene: &apatch::scene::Scene,
+) -> anyhow::Result<Option<(f64, apatch::hull::inner::planar::PlanarSplit)>> {
+    let apatch::scene::Model::Mesh { file, scheme, .. } = &scene.model else {
+        return Ok(None);
+    };
+    let options = apatch::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
+    let (m, _) = apatch::mesh::load(file)?;
+    Ok(
+        apatch::hull::inner::planar::split_nonplanar(&m, options.planar_tolerance)
+            .map(|s| (options.planar_tolerance, s)),
+    )
+}
+
 /// One line per hull violation: the condition, the triangle of T, the detail.
 fn violation_line(v: &apatch::hull::inner::HullViolation) -> String {
     match v.triangle {
@@ -181,6 +197,10 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         ),
         _ => (None, None),
     };
+    let split = match &scene {
+        Some(s) => planar_split(s)?,
+        None => None,
+    };
     let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);
     let (subdivided, welded) = mesh_repairs(scene.as_ref());
     let passed = report.passed() && hull_valid;
@@ -203,6 +223,17 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         if let Some(info) = &build_info {
             out.insert("mesh_build".into(), serde_json::to_value(info)?);
+        }
+        if let Some((tolerance, sp)) = &split {
+            out.insert(
+                "planar_split".into(),
+                serde_json::json!({
+                    "tolerance": tolerance,
+                    "faces": sp.faces,
+                    "triangles": sp.faces.iter().map(|f| f.triangles).sum::<usize>(),
+                    "kept": sp.kept,
+                }),
+            );
         }
         if let Some(v) = &hull {
             let list: Vec<String> = v.iter().map(violation_line).collect();
@@ -244,6 +275,23 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                     String::new()
                 },
                 info.refined_edges
+            );
+        }
+        if let Some((tolerance, sp)) = &split {
+            println!(
+                "planar split     {} non-planar polygons (beyond {tolerance:e} of their size) split \
+                 into {} triangles before the hull (`scheme.planar_tolerance`){}  info",
+                sp.faces.len(),
+                sp.faces.iter().map(|f| f.triangles).sum::<usize>(),
+                if sp.kept.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; {} kept whole (no proper triangulation: faces {:?})",
+                        sp.kept.len(),
+                        sp.kept
+                    )
+                }
             );
         }
         print!("{report}");

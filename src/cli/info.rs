@@ -32,10 +32,37 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         .normals
         .unwrap_or_else(|| NormalMethod::default_for(&m));
     let s = mesh::summary(&m, &report, method);
+    let tolerance = apatch::hull::inner::planar::DEFAULT_TOLERANCE;
+    let split = apatch::hull::inner::planar::split_nonplanar(&m, tolerance);
+    let (split_faces, split_triangles) = split.as_ref().map_or((0, 0), |sp| {
+        (
+            sp.faces.len(),
+            sp.faces.iter().map(|f| f.triangles).sum::<usize>(),
+        )
+    });
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&s)?);
+        let mut v = serde_json::to_value(&s)?;
+        if let serde_json::Value::Object(fields) = &mut v {
+            fields.insert(
+                "planar_split_1994".into(),
+                serde_json::json!({
+                    "tolerance": tolerance,
+                    "faces": split_faces,
+                    "triangles": split_triangles,
+                    "kept": split.as_ref().map_or(Vec::new(), |sp| sp.kept.clone()),
+                }),
+            );
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         print_text(&args.input, &s);
+        if split_faces > 0 {
+            println!(
+                "  1994 planar split {split_faces} polygons non-planar beyond {tolerance:e} of \
+                 their size, split into {split_triangles} triangles for the 1994 schemes \
+                 (`scheme.planar_tolerance`)"
+            );
+        }
     }
     Ok(if report.has_warnings() || s.normals_error.is_some() {
         ExitCode::from(1)

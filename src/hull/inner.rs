@@ -49,12 +49,14 @@
 
 pub mod above;
 pub mod clearance;
+pub mod closed;
 pub mod coplanar;
 pub mod corner;
 pub mod decompose;
 pub mod degenerate;
 pub mod fan;
 pub mod guardnet;
+pub mod planar;
 pub mod remesh;
 pub mod sides;
 pub mod unfold;
@@ -82,6 +84,10 @@ pub struct InnerOptions {
     /// Rotate vertex normals that are not "above face" (Appendix C); when false such normals
     /// are errors.
     pub fix_normals: bool,
+    /// Polygons deviating from their plane by more than this share of their size are split
+    /// into triangles before the hull ([`planar`]; default [`planar::DEFAULT_TOLERANCE`]).
+    /// `f64::INFINITY` turns the split off.
+    pub planar_tolerance: f64,
 }
 
 impl Default for InnerOptions {
@@ -90,16 +96,22 @@ impl Default for InnerOptions {
             alpha: 0.5,
             trihedral_level: 0.5,
             fix_normals: true,
+            planar_tolerance: planar::DEFAULT_TOLERANCE,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 3] = ["alpha", "trihedral_level", "fix_normals"];
+    pub const KEYS: [&'static str; 4] = [
+        "alpha",
+        "trihedral_level",
+        "fix_normals",
+        "planar_tolerance",
+    ];
 
-    /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]) and `fix_normals`
-    /// (boolean) from a scene's `[scheme]` table; absent keys keep their defaults, other keys
+    /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
+    /// (boolean) and `planar_tolerance` (number ≥ 0, or `false` for no split) from a scene's `[scheme]` table; absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -137,6 +149,27 @@ impl InnerOptions {
             }
             o.trihedral_level = l;
         }
+        match table.get("planar_tolerance") {
+            None => {}
+            Some(toml::Value::Boolean(false)) => o.planar_tolerance = f64::INFINITY,
+            Some(v) => {
+                let t = v
+                    .as_float()
+                    .or_else(|| v.as_integer().map(|i| i as f64))
+                    .ok_or_else(|| {
+                        bad(format!(
+                            "`scheme.planar_tolerance`: expected a number or false, found {}",
+                            v.type_str()
+                        ))
+                    })?;
+                if t.is_nan() || t < 0.0 {
+                    return Err(bad(format!(
+                        "`scheme.planar_tolerance` = {t}: must be a number ≥ 0 (or false)"
+                    )));
+                }
+                o.planar_tolerance = t;
+            }
+        }
         match table.get("fix_normals") {
             None => {}
             Some(toml::Value::Boolean(b)) => o.fix_normals = *b,
@@ -166,6 +199,9 @@ pub struct InnerReport {
     pub cases: corner::CaseCounts,
     /// Triangles whose sides were settled from the convexity of their edges ([`sides`]).
     pub sides: sides::SideCounts,
+    /// Non-planar polygons split into triangles before the hull ([`planar`]); face indices
+    /// are the input mesh's.
+    pub planar_split: Vec<planar::SplitFace>,
     /// Corners re-meshed before the hull because no direction was above all their faces
     /// (Appendix C, [`remesh`]); vertex indices of the re-meshed mesh follow the input's.
     pub remeshed: Vec<remesh::RemeshedCorner>,
@@ -218,6 +254,15 @@ pub fn build_with_report(
         )));
     }
     let mut report = InnerReport::default();
+    // Polygons that are not planar are split into triangles (no vertex moves).
+    let split = planar::split_nonplanar(mesh, options.planar_tolerance);
+    let mesh = match &split {
+        Some(s) => {
+            report.planar_split.clone_from(&s.faces);
+            &s.mesh
+        }
+        None => mesh,
+    };
     // Appendix C: corners round which no direction is above every face are re-meshed first.
     let remeshed = if options.fix_normals {
         remesh::remesh_corners(mesh, normals)?

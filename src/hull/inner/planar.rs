@@ -1,0 +1,477 @@
+//! Planar faces for the 1994 schemes: non-planar polygons are split into triangles before the
+//! inner hull, without moving a vertex.
+//!
+//! The inner hull (Algorithm 1) takes every face as planar: one centroid, one normal, and
+//! corners whose faces lie in those planes. A subdivision control cage (spot_control_cage: 168
+//! of its 180 quads deviate by up to 0.34 of their size) is no polyhedron in that sense, and its
+//! hull overlaps itself. Splitting each polygon that deviates from its plane by more than a
+//! tolerance (relative to the face size, [`crate::mesh::geometry::planarity_deviation`]) into
+//! triangles makes it one; the vertices, and so the points the surface interpolates, stay.
+//!
+//! Which diagonals: a non-planar polygon folds along whichever diagonals it is cut by, and the
+//! fold's sense matters. A new edge that is reflex where the polyhedron round it is convex makes
+//! a saddle that needs L-U pairs in T, and its two triangles tilt so that a corner's faces can
+//! wrap round more than a hemisphere (no "above face" normal, Appendix C). So every
+//! triangulation of the polygon is scored ([`triangulations`], all of them up to
+//! [`MAX_ENUMERATED`] corners, else ear clipping): its triangles must be positively oriented
+//! about the polygon's area normal (a proper triangulation in projection), and its diagonals
+//! should fold the way the polygon's own edges fold against their neighbours (the sign of the
+//! sum of their signed dihedral sines: convex where the polyhedron is locally convex). For a
+//! quad, one diagonal folds convex and the other reflex; in a convex region the convex one is
+//! taken. Last, corners that still have no above-face direction ([`super::remesh`]) get their
+//! faces' triangulations changed where that gives every corner of the face a direction (or
+//! improves the worst one), a few passes over the failing corners ([`REPAIR_PASSES`]).
+
+use super::above::{clearance, most_above, ABOVE_MARGIN};
+use crate::mesh::geometry::{area_vector, face_size, planarity_deviation};
+use crate::mesh::{ear_clip, Mesh, Topology};
+use glam::DVec3;
+
+/// Default of the scene key `scheme.planar_tolerance`: polygons deviating from their plane by
+/// more than this share of their size are split. Above the rounding of OBJ files printed with
+/// 6–7 significant digits (the planar polygons of double_torus_poly and mpi_poly deviate by up
+/// to 4.7e-6 and 5.0e-6), below the smallest deviation of spot_control_cage's bent quads
+/// (5.5e-5).
+pub const DEFAULT_TOLERANCE: f64 = 1e-5;
+
+/// Polygons with at most this many corners are triangulated by trying every triangulation
+/// (Catalan(7) = 429 for 9 corners); larger ones are ear-clipped in their mean plane.
+pub const MAX_ENUMERATED: usize = 9;
+
+/// Passes of the above-face repair over the corners that still fail.
+pub const REPAIR_PASSES: usize = 3;
+
+/// One polygon split by [`split_nonplanar`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SplitFace {
+    /// The face (index in the mesh handed in).
+    pub face: u32,
+    /// Its 1-based file line (0 when not from a file).
+    pub line: u32,
+    /// Its deviation from its plane, relative to its size.
+    pub deviation: f64,
+    /// Triangles it was split into.
+    pub triangles: usize,
+    /// New edges (diagonals) that fold against the sense of the polygon's own edges (reflex
+    /// in a convex region, or convex in a concave one).
+    pub against: usize,
+}
+
+/// A mesh with its non-planar polygons split, and what was split.
+#[derive(Clone, Debug)]
+pub struct PlanarSplit {
+    /// The new mesh: same vertices, planar polygons kept (in order), each split polygon
+    /// replaced in place by its triangles. `face_parent` and `face_lines` of the triangles are
+    /// their polygon's.
+    pub mesh: Mesh,
+    /// The split polygons, by face index.
+    pub faces: Vec<SplitFace>,
+    /// Non-trihedral corners of the split mesh still without an above-face direction (left to
+    /// Appendix C's re-meshing, [`super::remesh`]).
+    pub corners_without_above: Vec<u32>,
+    /// Non-planar polygons left whole because no triangulation of them is proper (they
+    /// overlap themselves in their mean plane: twisted slivers, bow ties).
+    pub kept: Vec<u32>,
+}
+
+/// All triangulations of a convex-position polygon with corners `0..n` by diagonals, each as a
+/// list of `n − 2` triangles (local corner indices, in the polygon's orientation). Catalan(n − 2)
+/// of them; call only for small n.
+#[must_use]
+pub fn triangulations(n: usize) -> Vec<Vec<[usize; 3]>> {
+    fn rec(idx: &[usize]) -> Vec<Vec<[usize; 3]>> {
+        let m = idx.len();
+        if m < 3 {
+            return vec![Vec::new()];
+        }
+        let mut out = Vec::new();
+        for k in 1..m - 1 {
+            let left = rec(&idx[..=k]);
+            let right = rec(&idx[k..]);
+            for l in &left {
+                for r in &right {
+                    let mut t = Vec::with_capacity(m - 2);
+                    t.push([idx[0], idx[k], idx[m - 1]]);
+                    t.extend_from_slice(l);
+                    t.extend_from_slice(r);
+                    out.push(t);
+                }
+            }
+        }
+        out
+    }
+    let idx: Vec<usize> = (0..n).collect();
+    rec(&idx)
+}
+
+/// Signed sine of the fold between two faces with unit outward normals `n1`, `n2` along the
+/// unit edge direction `e` (oriented as in the first face): positive for a convex fold (as
+/// seen from outside), negative for a reflex one.
+fn fold(n1: DVec3, n2: DVec3, e: DVec3) -> f64 {
+    n1.cross(n2).dot(e)
+}
+
+/// The sense the polygon `f`'s diagonals should fold: +1 (convex) or −1 (reflex), the sign of
+/// the sum of the signed fold sines of its edges against their neighbouring faces (+1 when it
+/// has none).
+fn wanted_sense(mesh: &Mesh, topo: &Topology, f: usize) -> f64 {
+    let face = &mesh.faces[f];
+    let nf = area_vector(&mesh.positions, face).normalize_or_zero();
+    let start = topo.face_start[f] as usize;
+    let mut sum = 0.0;
+    for k in 0..face.len() {
+        let mate = topo.corner_mate[start + k];
+        if mate == u32::MAX {
+            continue;
+        }
+        let g = topo.corner_face[mate as usize] as usize;
+        let ng = area_vector(&mesh.positions, &mesh.faces[g]).normalize_or_zero();
+        let (a, b) = (face[k], face[(k + 1) % face.len()]);
+        let e = (mesh.positions[b as usize] - mesh.positions[a as usize]).normalize_or_zero();
+        sum += fold(nf, ng, e);
+    }
+    if sum >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// A candidate triangulation of one polygon, with its score (smaller is better).
+#[derive(Clone, Debug)]
+struct Candidate {
+    /// Triangles as global vertex indices.
+    triangles: Vec<[u32; 3]>,
+    /// Diagonals folding against the wanted sense.
+    against: usize,
+    /// Sum of the fold sines against the wanted sense (≥ 0).
+    against_sum: f64,
+    /// Smallest positive projected area share (n_t · N / |n_t|) of its triangles: larger is
+    /// better shaped.
+    min_upright: f64,
+}
+
+/// The valid triangulations of polygon `face` (global vertex indices), best first by the
+/// score of the module documentation. Triangles must be oriented like the polygon about its
+/// area normal (n_t · N > 1e-9 |n_t|, and area above 1e-12 of the size squared: no folded or
+/// needle triangles). Empty when none is (then the caller ear-clips).
+fn candidates(positions: &[DVec3], face: &[u32], sense: f64) -> Vec<Candidate> {
+    let n = face.len();
+    let normal = area_vector(positions, face).normalize_or_zero();
+    let size = face_size(positions, face);
+    let p = |i: usize| positions[face[i] as usize];
+    let mut out = Vec::new();
+    'next: for tri in triangulations(n) {
+        let mut normals = Vec::with_capacity(tri.len());
+        let mut min_upright = f64::INFINITY;
+        for t in &tri {
+            let a = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+            let len = a.length();
+            if len.is_nan() || len <= 1e-12 * size * size {
+                continue 'next;
+            }
+            let up = a.dot(normal) / len;
+            if up <= 1e-9 {
+                continue 'next;
+            }
+            min_upright = min_upright.min(up);
+            normals.push(a / len);
+        }
+        // Diagonals: pairs of triangles sharing two corners.
+        let (mut against, mut against_sum) = (0, 0.0);
+        for i in 0..tri.len() {
+            for j in i + 1..tri.len() {
+                for k in 0..3 {
+                    let (a, b) = (tri[i][k], tri[i][(k + 1) % 3]);
+                    let shared = (0..3).any(|l| tri[j][l] == b && tri[j][(l + 1) % 3] == a);
+                    if shared {
+                        let e = (p(b) - p(a)).normalize_or_zero();
+                        let s = sense * fold(normals[i], normals[j], e);
+                        if s < 0.0 {
+                            against += 1;
+                            against_sum -= s;
+                        }
+                    }
+                }
+            }
+        }
+        out.push(Candidate {
+            triangles: tri.iter().map(|t| t.map(|i| face[i])).collect(),
+            against,
+            against_sum,
+            min_upright,
+        });
+    }
+    out.sort_by(|x, y| {
+        x.against
+            .cmp(&y.against)
+            .then(x.against_sum.total_cmp(&y.against_sum))
+            .then(y.min_upright.total_cmp(&x.min_upright))
+    });
+    out
+}
+
+/// Best clearance (min over its faces of n · n_f for the best n) of every vertex with other
+/// than three faces, from the faces `faces` (`None` for trihedral or unused vertices).
+fn vertex_clearances(positions: &[DVec3], faces: &[Vec<u32>]) -> Vec<Option<f64>> {
+    let mut around: Vec<Vec<DVec3>> = vec![Vec::new(); positions.len()];
+    for f in faces {
+        let n = area_vector(positions, f).normalize_or_zero();
+        for &v in f {
+            around[v as usize].push(n);
+        }
+    }
+    around
+        .iter()
+        .map(|ns| (!ns.is_empty() && ns.len() != 3).then(|| vertex_best(ns)))
+        .collect()
+}
+
+/// min_f n · n_f for the most-above direction n of unit face normals `ns`.
+fn vertex_best(ns: &[DVec3]) -> f64 {
+    clearance(most_above(ns), ns)
+}
+
+/// Splits every polygon of `mesh` that deviates from its plane by more than `tolerance`
+/// (relative to its size) into triangles, as the module documentation describes. `None` when
+/// no polygon does (the mesh is used as it is). Zero-area polygons are left alone (the hull
+/// names them).
+#[must_use]
+pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
+    let bent: Vec<(usize, f64)> = mesh
+        .faces
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.len() > 3)
+        .filter_map(|(i, f)| {
+            let d = planarity_deviation(&mesh.positions, f)?;
+            (d > tolerance).then_some((i, d))
+        })
+        .collect();
+    if bent.is_empty() {
+        return None;
+    }
+    let topo = Topology::new(mesh.positions.len(), &mesh.faces);
+    // Per bent face: its candidates (best first) and the one chosen.
+    let mut options: Vec<Vec<Candidate>> = Vec::with_capacity(bent.len());
+    let mut kept = Vec::new();
+    for &(f, _) in &bent {
+        let face = &mesh.faces[f];
+        let c = if face.len() <= MAX_ENUMERATED {
+            candidates(&mesh.positions, face, wanted_sense(mesh, &topo, f))
+        } else {
+            Vec::new()
+        };
+        let c = if !c.is_empty() {
+            c
+        } else if face.len() > MAX_ENUMERATED {
+            let mut out = Vec::new();
+            ear_clip(&mesh.positions, face, &mut Vec::new(), &mut out);
+            vec![Candidate {
+                triangles: out.iter().map(|t| [t[0], t[1], t[2]]).collect(),
+                against: 0,
+                against_sum: 0.0,
+                min_upright: 0.0,
+            }]
+        } else {
+            // No triangulation is proper: the polygon overlaps itself in its mean plane (a
+            // twisted sliver, a bow tie). Splitting it would fold the surface back on itself;
+            // it is kept whole and listed.
+            kept.push(f as u32);
+            Vec::new()
+        };
+        options.push(c);
+    }
+    let bent: Vec<(usize, f64)> = bent
+        .into_iter()
+        .zip(&options)
+        .filter(|(_, c)| !c.is_empty())
+        .map(|(b, _)| b)
+        .collect();
+    options.retain(|c| !c.is_empty());
+    if bent.is_empty() {
+        return None;
+    }
+    let mut chosen = vec![0usize; bent.len()];
+    let assemble = |chosen: &[usize]| -> Vec<Vec<u32>> {
+        let mut out = Vec::with_capacity(mesh.faces.len() + 2 * bent.len());
+        let mut slot = 0;
+        for (f, face) in mesh.faces.iter().enumerate() {
+            if slot < bent.len() && bent[slot].0 == f {
+                out.extend(
+                    options[slot][chosen[slot]]
+                        .triangles
+                        .iter()
+                        .map(|t| t.to_vec()),
+                );
+                slot += 1;
+            } else {
+                out.push(face.clone());
+            }
+        }
+        out
+    };
+    // Above-face repair: at a failing corner, try the other triangulations of its bent faces.
+    let failing = |faces: &[Vec<u32>]| -> Vec<(u32, f64)> {
+        vertex_clearances(&mesh.positions, faces)
+            .iter()
+            .enumerate()
+            .filter_map(|(v, c)| c.filter(|&c| c < ABOVE_MARGIN).map(|c| (v as u32, c)))
+            .collect()
+    };
+    let worst_at = |faces: &[Vec<u32>], verts: &[u32]| -> (usize, f64) {
+        let cl = vertex_clearances(&mesh.positions, faces);
+        let mut bad = 0;
+        let mut worst = f64::INFINITY;
+        for &v in verts {
+            if let Some(c) = cl[v as usize] {
+                bad += usize::from(c < ABOVE_MARGIN);
+                worst = worst.min(c);
+            }
+        }
+        (bad, worst)
+    };
+    let mut faces = assemble(&chosen);
+    for _ in 0..REPAIR_PASSES {
+        let fail = failing(&faces);
+        if fail.is_empty() {
+            break;
+        }
+        let mut changed = false;
+        for &(v, _) in &fail {
+            for k in 0..bent.len() {
+                let f = bent[k].0;
+                if !mesh.faces[f].contains(&v) || options[k].len() < 2 {
+                    continue;
+                }
+                // Judge by the corners of this polygon and their edge neighbours' corners.
+                let verts: Vec<u32> = mesh.faces[f].clone();
+                let mut best = (worst_at(&faces, &verts), chosen[k]);
+                for alt in 0..options[k].len() {
+                    if alt == chosen[k] {
+                        continue;
+                    }
+                    let mut trial = chosen.clone();
+                    trial[k] = alt;
+                    let tf = assemble(&trial);
+                    let score = worst_at(&tf, &verts);
+                    if score.0 < best.0 .0 || (score.0 == best.0 .0 && score.1 > best.0 .1) {
+                        best = (score, alt);
+                    }
+                }
+                if best.1 != chosen[k] {
+                    chosen[k] = best.1;
+                    faces = assemble(&chosen);
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    let corners_without_above = failing(&faces).iter().map(|c| c.0).collect();
+    // Rebuild the mesh with lines and parents.
+    let mut out = Mesh {
+        positions: mesh.positions.clone(),
+        faces: Vec::with_capacity(faces.len()),
+        file_normals: mesh.file_normals.clone(),
+        vertex_lines: mesh.vertex_lines.clone(),
+        face_lines: Vec::with_capacity(faces.len()),
+        face_parent: Vec::with_capacity(faces.len()),
+    };
+    let mut report = Vec::with_capacity(bent.len());
+    let mut slot = 0;
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let pieces: Vec<Vec<u32>> = if slot < bent.len() && bent[slot].0 == f {
+            let c = &options[slot][chosen[slot]];
+            report.push(SplitFace {
+                face: f as u32,
+                line: mesh.face_lines.get(f).copied().unwrap_or(0),
+                deviation: bent[slot].1,
+                triangles: c.triangles.len(),
+                against: c.against,
+            });
+            slot += 1;
+            c.triangles.iter().map(|t| t.to_vec()).collect()
+        } else {
+            vec![face.clone()]
+        };
+        for p in pieces {
+            out.faces.push(p);
+            out.face_lines
+                .push(mesh.face_lines.get(f).copied().unwrap_or(0));
+            out.face_parent
+                .push(mesh.face_parent.get(f).copied().unwrap_or(f as u32));
+        }
+    }
+    Some(PlanarSplit {
+        mesh: out,
+        faces: report,
+        corners_without_above,
+        kept,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Catalan numbers: 1, 2, 5, 14, 42 triangulations of 3…7 corners, each with n − 2
+    /// triangles, all distinct.
+    #[test]
+    fn triangulation_counts_are_catalan() {
+        for (n, c) in [(3, 1), (4, 2), (5, 5), (6, 14), (7, 42)] {
+            let t = triangulations(n);
+            assert_eq!(t.len(), c, "n = {n}");
+            assert!(t.iter().all(|x| x.len() == n - 2));
+            let mut sorted: Vec<Vec<[usize; 3]>> = t
+                .iter()
+                .map(|x| {
+                    let mut y = x.clone();
+                    y.sort_unstable();
+                    y
+                })
+                .collect();
+            sorted.sort();
+            sorted.dedup();
+            assert_eq!(sorted.len(), c);
+        }
+    }
+
+    /// A quad bent along one diagonal: the convex diagonal is chosen when its neighbours are
+    /// convex (a roof over a box), whichever vertex the quad starts at.
+    #[test]
+    fn bent_quad_takes_the_convex_diagonal() {
+        // Unit box with its top quad's corners 0 and 2 raised: the fold along 0–2 is convex.
+        let mut positions = vec![
+            DVec3::new(0.0, 0.0, 1.3),
+            DVec3::new(1.0, 0.0, 1.0),
+            DVec3::new(1.0, 1.0, 1.3),
+            DVec3::new(0.0, 1.0, 1.0),
+        ];
+        positions.extend(positions.clone().iter().map(|p| DVec3::new(p.x, p.y, 0.0)));
+        for rot in 0..4 {
+            let top: Vec<u32> = (0..4).map(|k| ((k + rot) % 4) as u32).collect();
+            let faces = vec![
+                top,
+                vec![4, 7, 6, 5],
+                vec![0, 4, 5, 1],
+                vec![1, 5, 6, 2],
+                vec![2, 6, 7, 3],
+                vec![3, 7, 4, 0],
+            ];
+            let m = Mesh::new(positions.clone(), faces);
+            let s = split_nonplanar(&m, DEFAULT_TOLERANCE).unwrap();
+            // Only the top is bent (the sides are trapezoids in vertical planes).
+            assert_eq!(s.faces.len(), 1);
+            let tris: Vec<&Vec<u32>> = s.mesh.faces.iter().filter(|f| f.len() == 3).collect();
+            assert_eq!(tris.len(), 2);
+            assert!(
+                tris.iter().all(|t| t.contains(&0) && t.contains(&2)),
+                "{tris:?}"
+            );
+            assert_eq!(s.faces[0].against, 0);
+        }
+    }
+}
