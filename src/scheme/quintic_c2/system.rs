@@ -31,7 +31,7 @@
 
 use super::jets::Jet;
 use super::signs::{self, SignStats};
-use super::{dense, sparse};
+use super::{cholesky, dense, sparse};
 use crate::bb::{multi_indices, Tet};
 use crate::complex::Role;
 use crate::error::{Error, Result};
@@ -43,12 +43,10 @@ use std::collections::HashMap;
 pub const N: usize = 5;
 /// Weights per patch: C(8, 3).
 pub const NW: usize = 56;
-/// Largest group solved by the dense QR ([`dense`]); larger ones go to [`sparse`].
+/// Largest group solved by the dense QR ([`dense`]); larger ones go to [`cholesky`].
 pub const DENSE_LIMIT: usize = 1000;
 /// Rounds of relaxing the stars whose weights miss Theorem 2.1's signs ([`System::solve`]).
 const RELAX_ROUNDS: usize = 4;
-/// Iteration limit of a [`sparse`] solve.
-const SPARSE_ITERATIONS: usize = 50_000;
 
 /// One tetrahedron of the hull with its vertices as global ids.
 #[derive(Clone, Debug)]
@@ -387,7 +385,7 @@ pub struct SolveStats {
     /// Whether the staged solve failed and every weight was solved at once (one group per
     /// connected component of the equations), see [`System::solve`].
     pub global: bool,
-    /// Groups above [`DENSE_LIMIT`] unknowns, solved by [`sparse`].
+    /// Groups above [`DENSE_LIMIT`] unknowns, solved by [`cholesky`] (sparse direct).
     pub sparse_groups: usize,
     /// How the weights meet Theorem 2.1's sign conditions ([`signs`]).
     pub signs: SignStats,
@@ -1043,7 +1041,7 @@ fn consistent(sol: &dense::Solution, scale: f64) -> bool {
 }
 
 /// A group's weights closest to `tgt` subject to `rows`·x = `c`: dense up to
-/// [`DENSE_LIMIT`] unknowns, else sparse.
+/// [`DENSE_LIMIT`] unknowns, else sparse direct ([`cholesky`]).
 fn solve_rows(
     rows: &[sparse::Row],
     n: usize,
@@ -1061,7 +1059,9 @@ fn solve_rows(
         }
         dense::solve_near(&a, m, n, c, tgt, 1e-11)
     } else {
-        sparse::solve_near(rows, n, c, tgt, 1e-13 * scale, SPARSE_ITERATIONS)
+        // Sparse direct: minimum-degree Cholesky of Â Âᵀ with refinement (Craig's method,
+        // `sparse`, needed thousands of iterations on the knot's coupled groups).
+        cholesky::solve_near(rows, n, c, tgt, 1e-13 * scale)
     }
 }
 
