@@ -997,6 +997,22 @@ irradiance = 2.0
         Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/paper1994/{name}.toml"))
     }
 
+    /// A mesh scene's mesh (loaded anew), its normals and its `[scheme]` table.
+    fn mesh_of(sc: &Scene) -> (mesh::Mesh, Vec<DVec3>, &toml::Table) {
+        let Model::Mesh {
+            file,
+            normals,
+            scheme,
+            ..
+        } = &sc.model
+        else {
+            panic!("{}: a mesh scene", sc.path.display());
+        };
+        let (m, _) = mesh::load(file).unwrap();
+        let vn = mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+        (m, vn, scheme)
+    }
+
     /// `build_scene` returns the mesh it loaded and the very hull its patches fill (what
     /// `apatch check` verifies and measures the distance to): the patches are exactly that
     /// hull's face and edge tetrahedra, the hull is the one `inner_hull` builds anew, and the
@@ -1042,19 +1058,9 @@ irradiance = 2.0
             );
             assert_eq!(patch_tets(&built.complex), hull_tets(&filled), "{name}");
             assert!(same_hull(hull, &inner_hull(sc).unwrap().unwrap()), "{name}");
-            let Model::Mesh {
-                file,
-                normals,
-                scheme,
-                ..
-            } = &sc.model
-            else {
-                panic!("{name}: a mesh scene");
-            };
-            let (m, _) = mesh::load(file).unwrap();
+            let (m, vn, scheme) = mesh_of(sc);
             assert_eq!(built.mesh.as_ref(), Some(&m), "{name}");
             assert!(built.info.is_none(), "{name}");
-            let vn = mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
             let own = if quintic {
                 quintic_c2::build_from_scene(&m, &vn, scheme, &sc.path)
             } else {
@@ -1072,17 +1078,7 @@ irradiance = 2.0
     #[test]
     fn cubic_apex_changes_are_made_once_on_the_hull_returned() {
         let sc = load(&paper1994("torus_quad12x8")).unwrap();
-        let Model::Mesh {
-            file,
-            normals,
-            scheme,
-            ..
-        } = &sc.model
-        else {
-            panic!("a mesh scene");
-        };
-        let (m, _) = mesh::load(file).unwrap();
-        let vn = mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+        let (m, vn, scheme) = mesh_of(&sc);
         let (options, inner) = cubic_c1::options_from_toml(scheme, &sc.path).unwrap();
         let mut hull = crate::hull::inner::build(&m, &vn, &inner).unwrap();
         for t in 0..hull.triangles.len() {
