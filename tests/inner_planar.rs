@@ -142,6 +142,9 @@ fn spot_control_cage_split_leaves_every_corner_above_face() {
     let s = planar::split_nonplanar(&m, planar::DEFAULT_TOLERANCE).unwrap();
     assert_eq!(s.faces.len(), 170);
     assert_eq!(s.kept, [60, 150]);
+    // The best-scored diagonals alone leave corners without a direction; the repair changes
+    // some polygons' triangulations (4 when this was written).
+    assert!(s.repaired > 0);
     assert!(s.corners_without_above.is_empty());
     // Independent of the module's bookkeeping: the detector of Appendix C finds no corner.
     assert!(remesh::corners_without_above(&s.mesh).is_empty());

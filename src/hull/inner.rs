@@ -3,6 +3,10 @@
 //! ([`SimplicialHull`], Definition 3.6).
 //!
 //! Pipeline ([`build_with_report`]):
+//! 0. [`planar`]: polygons that are not planar (beyond [`InnerOptions::planar_tolerance`] of
+//!    their size: subdivision control cages) are split into triangles, no vertex moved, with
+//!    diagonals that fold like their neighbouring edges. (The mesh must be a closed 2-manifold;
+//!    [`closed::require_closed`] says why one is not, for the scenes.)
 //! 1. [`coplanar`]: edge-adjacent coplanar faces are merged into one polygon (one face per
 //!    plane, as the paper's polyhedra have; Appendix B's coplanarity treated at its source).
 //! 2. [`decompose`]: corner guards (§5, Algorithm 2 step (1)). A star-shaped non-convex polygon

@@ -72,6 +72,9 @@ pub struct PlanarSplit {
     /// Non-planar polygons left whole because no triangulation of them is proper (they
     /// overlap themselves in their mean plane: twisted slivers, bow ties).
     pub kept: Vec<u32>,
+    /// Split polygons whose triangulation the above-face repair changed from the best-scored
+    /// one.
+    pub repaired: usize,
 }
 
 /// All triangulations of a convex-position polygon with corners `0..n` by diagonals, each as a
@@ -211,25 +214,136 @@ fn candidates(positions: &[DVec3], face: &[u32], sense: f64) -> Vec<Candidate> {
     out
 }
 
-/// Best clearance (min over its faces of n · n_f for the best n) of every vertex with other
-/// than three faces, from the faces `faces` (`None` for trihedral or unused vertices).
-fn vertex_clearances(positions: &[DVec3], faces: &[Vec<u32>]) -> Vec<Option<f64>> {
-    let mut around: Vec<Vec<DVec3>> = vec![Vec::new(); positions.len()];
-    for f in faces {
-        let n = area_vector(positions, f).normalize_or_zero();
-        for &v in f {
-            around[v as usize].push(n);
-        }
-    }
-    around
-        .iter()
-        .map(|ns| (!ns.is_empty() && ns.len() != 3).then(|| vertex_best(ns)))
-        .collect()
+/// The faces round every vertex, for clearances under changing triangulations.
+struct Around {
+    /// For every vertex, the unit normals of the faces holding it that are not split.
+    fixed: Vec<Vec<DVec3>>,
+    /// For every vertex, the bent polygons (indices into `bent`) that hold it.
+    bent: Vec<Vec<usize>>,
 }
 
-/// min_f n · n_f for the most-above direction n of unit face normals `ns`.
-fn vertex_best(ns: &[DVec3]) -> f64 {
-    clearance(most_above(ns), ns)
+impl Around {
+    fn new(mesh: &Mesh, bent: &[(usize, f64)]) -> Around {
+        let n = mesh.positions.len();
+        let (mut fixed, mut by) = (vec![Vec::new(); n], vec![Vec::new(); n]);
+        let mut k = 0;
+        for (f, face) in mesh.faces.iter().enumerate() {
+            if k < bent.len() && bent[k].0 == f {
+                for &v in face {
+                    by[v as usize].push(k);
+                }
+                k += 1;
+            } else {
+                let nf = area_vector(&mesh.positions, face).normalize_or_zero();
+                for &v in face {
+                    fixed[v as usize].push(nf);
+                }
+            }
+        }
+        Around { fixed, bent: by }
+    }
+
+    /// Best clearance of vertex `v` (min over its faces of n · n_f for the most-above n) with
+    /// the triangulations `choice` of the bent polygons: its other faces as they are, and from
+    /// each bent polygon the chosen triangles that hold `v`. `None` for trihedral or unused
+    /// vertices (Algorithm 1 step (3) needs no above-face normal).
+    fn clearance(
+        &self,
+        mesh: &Mesh,
+        options: &[Vec<Candidate>],
+        choice: &[usize],
+        v: usize,
+    ) -> Option<f64> {
+        let mut normals = self.fixed[v].clone();
+        for &k in &self.bent[v] {
+            for t in &options[k][choice[k]].triangles {
+                if t.contains(&(v as u32)) {
+                    let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                    normals.push((b - a).cross(c - a).normalize_or_zero());
+                }
+            }
+        }
+        (!normals.is_empty() && normals.len() != 3)
+            .then(|| clearance(most_above(&normals), &normals))
+    }
+}
+
+/// The triangulation chosen for every bent polygon.
+struct Choice {
+    /// Index into each bent polygon's candidates.
+    choice: Vec<usize>,
+    /// Polygons whose choice the repair changed.
+    repaired: usize,
+}
+
+/// The above-face repair of the module documentation: starting from every bent polygon's
+/// best-scored triangulation, each corner without an above-face direction tries the other
+/// triangulations of its bent polygons, keeping one when fewer of that polygon's corners fail
+/// (or, as many failing, the worst clearance among them rises). [`REPAIR_PASSES`] passes.
+fn repair_above_face(
+    mesh: &Mesh,
+    bent: &[(usize, f64)],
+    options: &[Vec<Candidate>],
+    around: &Around,
+) -> Choice {
+    let mut choice = vec![0usize; bent.len()];
+    let original = choice.clone();
+    // Only corners of bent polygons change; the others keep their clearance.
+    let corners: Vec<usize> = (0..mesh.positions.len())
+        .filter(|&v| !around.bent[v].is_empty())
+        .collect();
+    for _ in 0..REPAIR_PASSES {
+        let failing: Vec<usize> = corners
+            .iter()
+            .copied()
+            .filter(|&v| {
+                around
+                    .clearance(mesh, options, &choice, v)
+                    .is_some_and(|c| c < ABOVE_MARGIN)
+            })
+            .collect();
+        let mut changed = false;
+        for v in failing {
+            for &k in &around.bent[v] {
+                if options[k].len() < 2 {
+                    continue;
+                }
+                let verts = &mesh.faces[bent[k].0];
+                let score = |choice: &[usize]| {
+                    let mut bad = 0usize;
+                    let mut worst = f64::INFINITY;
+                    for &w in verts {
+                        if let Some(c) = around.clearance(mesh, options, choice, w as usize) {
+                            bad += usize::from(c < ABOVE_MARGIN);
+                            worst = worst.min(c);
+                        }
+                    }
+                    (bad, worst)
+                };
+                let mut best = (score(&choice), choice[k]);
+                for alt in 0..options[k].len() {
+                    if alt == choice[k] {
+                        continue;
+                    }
+                    let mut trial = choice.clone();
+                    trial[k] = alt;
+                    let sc = score(&trial);
+                    if sc.0 < best.0 .0 || (sc.0 == best.0 .0 && sc.1 > best.0 .1) {
+                        best = (sc, alt);
+                    }
+                }
+                if best.1 != choice[k] {
+                    choice[k] = best.1;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    let repaired = choice.iter().zip(&original).filter(|(a, b)| a != b).count();
+    Choice { choice, repaired }
 }
 
 /// Splits every polygon of `mesh` that deviates from its plane by more than `tolerance`
@@ -292,93 +406,27 @@ pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
     if bent.is_empty() {
         return None;
     }
-    let mut chosen = vec![0usize; bent.len()];
-    let assemble = |chosen: &[usize]| -> Vec<Vec<u32>> {
-        let mut out = Vec::with_capacity(mesh.faces.len() + 2 * bent.len());
-        let mut slot = 0;
-        for (f, face) in mesh.faces.iter().enumerate() {
-            if slot < bent.len() && bent[slot].0 == f {
-                out.extend(
-                    options[slot][chosen[slot]]
-                        .triangles
-                        .iter()
-                        .map(|t| t.to_vec()),
-                );
-                slot += 1;
-            } else {
-                out.push(face.clone());
-            }
-        }
-        out
-    };
-    // Above-face repair: at a failing corner, try the other triangulations of its bent faces.
-    let failing = |faces: &[Vec<u32>]| -> Vec<(u32, f64)> {
-        vertex_clearances(&mesh.positions, faces)
-            .iter()
-            .enumerate()
-            .filter_map(|(v, c)| c.filter(|&c| c < ABOVE_MARGIN).map(|c| (v as u32, c)))
-            .collect()
-    };
-    let worst_at = |faces: &[Vec<u32>], verts: &[u32]| -> (usize, f64) {
-        let cl = vertex_clearances(&mesh.positions, faces);
-        let mut bad = 0;
-        let mut worst = f64::INFINITY;
-        for &v in verts {
-            if let Some(c) = cl[v as usize] {
-                bad += usize::from(c < ABOVE_MARGIN);
-                worst = worst.min(c);
-            }
-        }
-        (bad, worst)
-    };
-    let mut faces = assemble(&chosen);
-    for _ in 0..REPAIR_PASSES {
-        let fail = failing(&faces);
-        if fail.is_empty() {
-            break;
-        }
-        let mut changed = false;
-        for &(v, _) in &fail {
-            for k in 0..bent.len() {
-                let f = bent[k].0;
-                if !mesh.faces[f].contains(&v) || options[k].len() < 2 {
-                    continue;
-                }
-                // Judge by the corners of this polygon and their edge neighbours' corners.
-                let verts: Vec<u32> = mesh.faces[f].clone();
-                let mut best = (worst_at(&faces, &verts), chosen[k]);
-                for alt in 0..options[k].len() {
-                    if alt == chosen[k] {
-                        continue;
-                    }
-                    let mut trial = chosen.clone();
-                    trial[k] = alt;
-                    let tf = assemble(&trial);
-                    let score = worst_at(&tf, &verts);
-                    if score.0 < best.0 .0 || (score.0 == best.0 .0 && score.1 > best.0 .1) {
-                        best = (score, alt);
-                    }
-                }
-                if best.1 != chosen[k] {
-                    chosen[k] = best.1;
-                    faces = assemble(&chosen);
-                    changed = true;
-                }
-            }
-        }
-        if !changed {
-            break;
-        }
-    }
-    let corners_without_above = failing(&faces).iter().map(|c| c.0).collect();
+    let around = Around::new(mesh, &bent);
+    let chosen = repair_above_face(mesh, &bent, &options, &around);
+    let corners_without_above = (0..mesh.positions.len())
+        .filter(|&v| {
+            around
+                .clearance(mesh, &options, &chosen.choice, v)
+                .is_some_and(|c| c < ABOVE_MARGIN)
+        })
+        .map(|v| v as u32)
+        .collect();
+    let repaired = chosen.repaired;
+    let chosen = chosen.choice;
     // Rebuild the mesh with lines and parents.
+    let count = mesh.faces.len() + bent.len();
     let mut out = Mesh {
         positions: mesh.positions.clone(),
-        faces: Vec::with_capacity(faces.len()),
+        faces: Vec::with_capacity(count),
         file_normals: mesh.file_normals.clone(),
         vertex_lines: mesh.vertex_lines.clone(),
-        face_lines: Vec::with_capacity(faces.len()),
-        face_parent: Vec::with_capacity(faces.len()),
+        face_lines: Vec::with_capacity(count),
+        face_parent: Vec::with_capacity(count),
     };
     let mut report = Vec::with_capacity(bent.len());
     let mut slot = 0;
@@ -410,6 +458,7 @@ pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
         faces: report,
         corners_without_above,
         kept,
+        repaired,
     })
 }
 
