@@ -1061,7 +1061,18 @@ fn solve_rows(
     } else {
         // Sparse direct: minimum-degree Cholesky of Â Âᵀ with refinement (Craig's method,
         // `sparse`, needed thousands of iterations on the knot's coupled groups).
-        cholesky::solve_near(rows, n, c, tgt, 1e-13 * scale)
+        let t = std::time::Instant::now();
+        let sol = cholesky::solve_near(rows, n, c, tgt, 1e-13 * scale);
+        if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
+            // Opt-in timing of the large groups on stderr (exploration; results unaffected).
+            eprintln!(
+                "quintic-c2 sparse group: {m} equations, {n} unknowns, rank {}, residual {:.2e} (scale {scale:.2e}), {:.2} s",
+                sol.rank,
+                sol.residual,
+                t.elapsed().as_secs_f64()
+            );
+        }
+        sol
     }
 }
 
