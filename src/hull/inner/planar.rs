@@ -21,6 +21,12 @@
 //! taken. Last, corners that still have no above-face direction ([`super::remesh`]) get their
 //! faces' triangulations changed where that gives every corner of the face a direction (or
 //! improves the worst one), a few passes over the failing corners ([`REPAIR_PASSES`]).
+//!
+//! A polygon none of whose triangulations is proper overlaps itself in its mean plane (a
+//! twisted sliver whose projection is a bow tie: spot_control_cage's quads 60 and 150 at the
+//! horn bases). Any split of it folds the surface back on itself (a triangle facing the other
+//! way, whose corners then have no above-face direction and which Appendix C's re-meshing
+//! cannot repair either), so it is kept whole and listed ([`PlanarSplit::kept`]).
 
 use super::above::{clearance, most_above, ABOVE_MARGIN};
 use crate::mesh::geometry::{area_vector, face_size, planarity_deviation};
@@ -53,7 +59,8 @@ pub struct SplitFace {
     /// Triangles it was split into.
     pub triangles: usize,
     /// New edges (diagonals) that fold against the sense of the polygon's own edges (reflex
-    /// in a convex region, or convex in a concave one).
+    /// in a convex region, or convex in a concave one); 0 for polygons of more than
+    /// [`MAX_ENUMERATED`] corners, which are ear-clipped unscored.
     pub against: usize,
 }
 
@@ -348,8 +355,8 @@ fn repair_above_face(
 
 /// Splits every polygon of `mesh` that deviates from its plane by more than `tolerance`
 /// (relative to its size) into triangles, as the module documentation describes. `None` when
-/// no polygon does (the mesh is used as it is). Zero-area polygons are left alone (the hull
-/// names them).
+/// no polygon deviates (the mesh is used as it is). Zero-area polygons are left alone (the
+/// hull names them).
 #[must_use]
 pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
     let bent: Vec<(usize, f64)> = mesh
@@ -403,9 +410,6 @@ pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
         .map(|(b, _)| b)
         .collect();
     options.retain(|c| !c.is_empty());
-    if bent.is_empty() {
-        return None;
-    }
     let around = Around::new(mesh, &bent);
     let chosen = repair_above_face(mesh, &bent, &options, &around);
     let corners_without_above = (0..mesh.positions.len())
