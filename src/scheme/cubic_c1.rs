@@ -21,6 +21,7 @@
 //! levels = { "7" = 0.9 } # per input element (vertex) overrides of `level` (§7 free weights)
 //! ```
 
+pub mod fairness;
 pub mod flat;
 pub mod pocket;
 pub mod sided;
