@@ -164,12 +164,7 @@ pub fn fairness(complex: &PatchComplex) -> Fairness {
                     let n = (1.0 - u) * ni + u * nj;
                     for j in 0..=res {
                         let s = j as f64 / res as f64;
-                        sample(
-                            [1.0 - u, u, 0.0, 0.0],
-                            [0.0, 0.0, 1.0 - s, s],
-                            n,
-                            &mut edge,
-                        );
+                        sample([1.0 - u, u, 0.0, 0.0], [0.0, 0.0, 1.0 - s, s], n, &mut edge);
                     }
                 }
             }
