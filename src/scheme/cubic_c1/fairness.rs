@@ -184,8 +184,8 @@ mod tests {
     use super::*;
     use crate::complex::{Patch, SheetRule};
 
-    /// One face patch F = z − ε·(bump) over the triangle z = 0 with normals +z: with ε = 0 the
-    /// surface is the plane and the deviation is 0 everywhere; with a bump it is not.
+    /// One face patch over the triangle z = 0 with normals +z whose surface is the plane
+    /// z = 0.3: the deviation is 0 everywhere; with a bump it is not.
     #[test]
     fn flat_patch_has_no_deviation_and_a_bump_has() {
         let tet = [
@@ -195,11 +195,12 @@ mod tests {
             [0.3, 0.3, 1.0],
         ];
         let make = |bump: f64| {
-            // F = z (linear: weight = λ3 share of the apex height) − bump·λ0λ1λ2·27.
+            // F = λ3 − 0.3 (linear; zero on the plane z = 0.3, normal +z), minus a bump on
+            // the base's middle weight.
             let weights = crate::bb::multi_indices(3)
                 .iter()
                 .map(|l| {
-                    let z = f64::from(l[3]) / 3.0;
+                    let z = f64::from(l[3]) / 3.0 - 0.3;
                     if *l == [1, 1, 1, 0] {
                         z - bump
                     } else {
