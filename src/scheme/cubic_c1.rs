@@ -19,8 +19,19 @@
 //! level = 0.5            # where the surface crosses centroid → apex in face tetrahedra (§7.1)
 //! center = 1.0           # number 2 weights: this × the quadratic-precision value
 //! levels = { "7" = 0.9 } # per input element (vertex) overrides of `level` (§7 free weights)
+//! free = "fair"          # numbers 4 and 6: "fair" (default without `level`) or "level"
 //! ```
+//!
+//! Free weights (issue 7): by default the numbers 4 and 6 of every face tetrahedron standing
+//! on a pseudo-centroid (a non-trihedral corner, where the apex is a construction of the hull)
+//! start from the fair target of [`fair`] (the blend of the quadratic Taylor polynomials at T's
+//! points) instead of the `level` rule, which ties the bulge of each triangle to its apex's
+//! distance and made the surfaces lumpy; trihedral corner triangles (apex = the polyhedron's
+//! vertex, §7.1's shape control) and elements in `levels` keep the level rule, and a scene that
+//! sets `level` gets the level rule everywhere. [`fairness`] measures the result.
 
+pub mod fair;
+pub mod fairness;
 pub mod flat;
 pub mod pocket;
 pub mod sided;
@@ -60,6 +71,8 @@ pub struct CubicOptions {
     /// tetrahedron of an L-U pair (Definition 3.6 (4); [`sided`]) before building. Without it the
     /// surface leaves the hull through their bases (holes).
     pub complete_lu_pairs: bool,
+    /// How the free weights of numbers 4 and 6 are chosen (see the module documentation).
+    pub free: FreeWeights,
     /// Move apexes that lie beyond a tangent plane at one of their triangle's points (allowed
     /// for L-U pairs by Definition 3.5) to their own side of all three ([`tangent`]). Without
     /// it the surface leaves the hull through the edge tetrahedra's outer faces there (holes).
@@ -75,8 +88,21 @@ impl Default for CubicOptions {
             gradient_scale: 1.0,
             complete_lu_pairs: true,
             contain_tangents: true,
+            free: FreeWeights::Fair,
         }
     }
+}
+
+/// The choice of the free weights a_e_k+2e_q (number 4) and F(q) (number 6) of the face
+/// tetrahedra, before the sign conditions raise them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FreeWeights {
+    /// From the fair target ([`fair::FairTarget`]) on face tetrahedra standing on a
+    /// pseudo-centroid, the level rule elsewhere (trihedral corners, elements in `levels`).
+    Fair,
+    /// The level rule everywhere: one value per face tetrahedron putting the zero of F at
+    /// `level` on the segment from the base's centroid to the apex (§7.1).
+    Level,
 }
 
 /// What [`build`] made, besides the complex.
@@ -105,6 +131,8 @@ pub struct CubicBuild {
     /// Apexes beyond a tangent plane that could not be moved (a vertex normal nearly in the
     /// triangle's plane).
     pub tangent_stuck: usize,
+    /// Face tetrahedra whose numbers 4 and 6 started from the fair target ([`FreeWeights::Fair`]).
+    pub fair_faces: usize,
 }
 
 /// Weights of the face tetrahedron of one (triangle, side).
@@ -182,6 +210,7 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
         pocket_constraints: 0,
         tangent_moved: prepared.tangent_moved,
         tangent_stuck: prepared.tangent_stuck,
+        fair_faces: 0,
     };
 
     // Number 2: a_1110 per triangle (shared by both sides of an L-U pair), quadratic precision.
@@ -201,6 +230,7 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
             options.center * s / 4.0
         })
         .collect();
+    let target = (options.free == FreeWeights::Fair).then(|| fair::FairTarget::new(hull, c));
 
     // Number 2 where T is flat at an edge: the least change making the blossoms exist.
     let mut flat_eqs = Vec::new();
@@ -301,6 +331,29 @@ pub fn build_full(hull: &SimplicialHull, options: &CubicOptions) -> Result<Cubic
                 w[ix(e3(k, 3, 3))] = h;
             }
             w[ix([0, 0, 0, 3])] = h;
+            // The fair target where the apex is the hull's construction (a pseudo-centroid's
+            // triangles), each weight kept at least as high (σ-wise) as the level rule's
+            // floors: the j-line bound (which holds for any levels ≥ 2 above it) and h_min.
+            let pseudo = tri.iter().any(|&v| {
+                matches!(
+                    hull.origins.get(v as usize),
+                    Some(crate::hull::simplicial::PointOrigin::PseudoCentroid { .. })
+                )
+            });
+            if let (Some(target), true) = (
+                &target,
+                pseudo && !options.levels.contains_key(&hull.element[t]),
+            ) {
+                out.fair_faces += 1;
+                let floor = h_min.max(j_line_height(&w, sigma));
+                for k in 0..3 {
+                    let pts: Vec<(u32, u8)> = (0..3).map(|l| (tri[l], u8::from(l == k))).collect();
+                    let v = target.weight([tet[k], q, q], &pts);
+                    w[ix(e3(k, 3, 3))] = sigma * (sigma * v).max(floor);
+                }
+                let v = target.weight([q, q, q], &tri.map(|l| (l, 0)));
+                w[ix([0, 0, 0, 3])] = sigma * (sigma * v).max(floor);
+            }
             faces[t][side as usize] = Some(FaceWeights { w });
         }
     }
@@ -583,9 +636,10 @@ fn validate(hull: &SimplicialHull, options: &CubicOptions) -> Result<()> {
 
 /// Reads the scheme options from a scene's `[scheme]` table: the hull's keys
 /// ([`InnerOptions::KEYS`]) by [`InnerOptions::from_toml`], and this scheme's `level`, `center`,
-/// `gradient_scale`, `levels`. Without `level`, the hull's `trihedral_level` (in [0, 1]) is used,
-/// kept 0.02 away from the bottom and the top (a level of exactly 0 or 1 puts the zero on a
-/// boundary of the tetrahedron).
+/// `gradient_scale`, `levels`, `free` (`"fair"` or `"level"`, [`FreeWeights`]). Without `level`,
+/// the hull's `trihedral_level` (in [0, 1]) is used, kept 0.02 away from the bottom and the top
+/// (a level of exactly 0 or 1 puts the zero on a boundary of the tetrahedron). A table that sets
+/// `level` and not `free` gets [`FreeWeights::Level`].
 ///
 /// # Errors
 /// Unknown keys and bad values, naming the scene file and the key.
@@ -616,6 +670,17 @@ pub fn options_from_toml(
             "level" => o.level = num(k, v)?,
             "center" => o.center = num(k, v)?,
             "gradient_scale" => o.gradient_scale = num(k, v)?,
+            "free" => {
+                o.free = match v.as_str() {
+                    Some("fair") => FreeWeights::Fair,
+                    Some("level") => FreeWeights::Level,
+                    _ => {
+                        return Err(bad(format!(
+                            "`scheme.free`: expected \"fair\" or \"level\", found {v}"
+                        )))
+                    }
+                };
+            }
             "levels" => {
                 let t = v.as_table().ok_or_else(|| {
                     bad("`scheme.levels` must be a table { \"element\" = level }".into())
@@ -630,10 +695,15 @@ pub fn options_from_toml(
             _ => {
                 return Err(bad(format!(
                     "unknown key `scheme.{k}` (cubic-c1 has alpha, trihedral_level, fix_normals, \
-                     level, center, gradient_scale, levels)"
+                     level, center, gradient_scale, levels, free)"
                 )))
             }
         }
+    }
+    // A scene that asks for a `level` asks for the level rule (§7.1's shape control), unless it
+    // names `free` itself.
+    if table.contains_key("level") && !table.contains_key("free") {
+        o.free = FreeWeights::Level;
     }
     Ok((o, inner))
 }

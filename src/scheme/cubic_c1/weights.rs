@@ -11,9 +11,9 @@
 //! | a_2e_k+e_l, w_2100, w_2010, w_2001, … | number 1 | (2.5): (v_l − v_k)·∇F(v_k)/3; those toward an apex have its side's sign because apexes beyond a tangent plane were moved first ([`super::tangent`]) |
 //! | a_1110 | number 2 (free) | `center` × the quadratic-precision value Σ(6 edge weights)/4, then the least change keeping the blossom of an edge convex for the other side only at the side's apexes with the edge's sign ([`super::pocket`]) |
 //! | a_e_k+e_l+e_q, w_1110, w_1101 | number 3 | (2.8) across [p_i p_j q], (2.10) across [p_i p_j s] and (2.8) across an L-U pair's triangle: all are values A_e(x) of one affine "edge blossom" per edge e of T ([`EdgeBlossom`]) |
-//! | a_e_k+2e_q | number 4 (free) | the `level` rule, raised for the sign conditions |
+//! | a_e_k+2e_q | number 4 (free) | the fair target ([`super::fair`]) on a pseudo-centroid's triangles, else the `level` rule; raised for the sign conditions |
 //! | w_1011, w_0111 | number 5 | (2.8) across [p_i p_j q] |
-//! | a_3e_q = F(q) | number 6 (free) | the `level` rule, raised for the sign conditions |
+//! | a_3e_q = F(q) | number 6 (free) | as number 4 |
 //! | w_0021 | number 7 | (2.8) across [p_i p_j q] (the paper writes (2.10)) |
 //! | w_1002, w_0102, w_0003 | remaining, λ ≤ 1 toward the partner | (2.10): the average of the pair's w_1011 (w_0111, w_0012) |
 //! | w_0012 | remaining (free) | = w_0021 of the same tetrahedron |
