@@ -729,10 +729,11 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
 }
 
 /// The inner simplicial hull (1994) a `cubic-c1` or `quintic-c2` scene is built on, with the
-/// scene's normals and hull options; `None` for other scenes. Lets `check` verify the hull
-/// (Definition 3.6) beside the patches. For `cubic-c1` it is the hull after the scheme's own
-/// changes to the apexes ([`crate::scheme::cubic_c1::prepare_hull`]), the one its patches fill.
-/// Loads the mesh and builds the hull anew: after a build, [`BuiltScene::hull`] is this value.
+/// scene's normals and hull options; `None` for other scenes: the hull (Definition 3.6) without
+/// the patches. For `cubic-c1` it is the hull after the scheme's own changes to the apexes
+/// ([`crate::scheme::cubic_c1::prepare_hull`]), the one its patches fill. Loads the mesh and
+/// builds the hull anew: after a build, [`BuiltScene::hull`] is this value (`apatch check`
+/// reads that).
 ///
 /// # Errors
 /// Unreadable meshes, bad options, and hulls that cannot be built, naming the file.
