@@ -8,8 +8,8 @@ use std::path::Path;
 
 /// The scheme's defaults, with `LIFT=x`, `CURV=x`, `SIGNS=1`, `LU=0` and `JOINT=1` in the
 /// environment overriding the lift, the curvature, the sign pins, the L-U completion and the
-/// joint stars, `RELAX=0` turning off the relaxed stars and `CONSISTENT=1` the consistent
-/// stars (to explore).
+/// joint stars, `RELAX=0` turning off the relaxed stars, `CONSISTENT=1` the consistent
+/// stars and `HSIGNS=1` the Hessian sign fit (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -25,6 +25,7 @@ fn options() -> QuinticOptions {
         joint_stars: std::env::var("JOINT").is_ok_and(|s| s == "1"),
         relax_stars: std::env::var("RELAX").map_or(true, |s| s != "0"),
         consistent_stars: std::env::var("CONSISTENT").is_ok_and(|s| s == "1"),
+        hessian_signs: std::env::var("HSIGNS").is_ok_and(|s| s == "1"),
     }
 }
 
@@ -650,4 +651,129 @@ fn boundary_faces_crossed(c: &apatch::complex::PatchComplex) -> usize {
         }
     }
     crossed
+}
+
+/// Exploration: every boundary face of a scene's complex that the surface crosses (as in
+/// `boundary_faces_crossed`), with the weights on it that miss Theorem 2.1's sign (k = 1,
+/// the patch's apex-side sign from its apex weight), each with its multi-index, level, value
+/// and the largest multiplicity of a point of T in it (≥ 3: a jet weight, fixed by the data).
+#[test]
+#[ignore = "exploration: SCENE=path"]
+fn boundary_crossing_causes() {
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    let sc = apatch::scene::load(&path).unwrap();
+    let c = apatch::scene::build_complex(&sc).unwrap();
+    let key = |v: [f64; 3]| v.map(f64::to_bits);
+    let mut users: std::collections::HashMap<[[u64; 3]; 3], usize> =
+        std::collections::HashMap::new();
+    let face_key = |p: &apatch::complex::Patch, opp: usize| {
+        let mut f: Vec<[u64; 3]> = (0..4)
+            .filter(|&k| k != opp)
+            .map(|k| key(p.tet[k]))
+            .collect();
+        f.sort_unstable();
+        [f[0], f[1], f[2]]
+    };
+    for p in &c.patches {
+        for opp in 0..4 {
+            *users.entry(face_key(p, opp)).or_insert(0) += 1;
+        }
+    }
+    let wmax = c
+        .patches
+        .iter()
+        .flat_map(|p| p.weights.iter())
+        .fold(0.0_f64, |a, w| a.max(w.abs()));
+    let mi = apatch::bb::multi_indices(5);
+    let mut by_kind: std::collections::BTreeMap<String, usize> = Default::default();
+    for (k, p) in c.patches.iter().enumerate() {
+        let edge = p.role == apatch::complex::Role::Edge;
+        let n_t = if edge { 2 } else { 3 };
+        let s = p.weights[apatch::bb::index_of([0, 0, 0, 5])].signum();
+        for opp in 0..4 {
+            if users[&face_key(p, opp)] != 1 {
+                continue;
+            }
+            let m = 15;
+            let (mut pos, mut neg) = (false, false);
+            for i in 0..=m {
+                for j in 0..=m - i {
+                    let mut b = [0.0; 4];
+                    let others: Vec<usize> = (0..4).filter(|&k| k != opp).collect();
+                    b[others[0]] = i as f64 / m as f64;
+                    b[others[1]] = j as f64 / m as f64;
+                    b[others[2]] = (m - i - j) as f64 / m as f64;
+                    let f = p.value_bary(b);
+                    pos |= f > 1e-12 * wmax;
+                    neg |= f < -1e-12 * wmax;
+                }
+            }
+            if !(pos && neg) {
+                continue;
+            }
+            let mut misses = String::new();
+            for (i, l) in mi.iter().enumerate() {
+                if l[opp] != 0 {
+                    continue;
+                }
+                let level = if edge { l[2] + l[3] } else { l[3] };
+                let w = p.weights[i];
+                let bad =
+                    (level == 0 && w * s > 1e-12 * wmax) || (level >= 2 && w * s < -1e-12 * wmax);
+                if bad {
+                    let mult = l[..n_t].iter().max().copied().unwrap_or(0);
+                    let kind = match mult {
+                        3.. => "jet",
+                        2 if l[..n_t].iter().filter(|&&x| x == 2).count() == 2 => "edge-middle",
+                        2 => "star",
+                        _ => "far",
+                    };
+                    *by_kind
+                        .entry(format!("{:?} opp {opp} level {level} {kind}", p.role))
+                        .or_insert(0) += 1;
+                    misses += &format!(" {l:?}={w:.2e}({kind})");
+                }
+            }
+            eprintln!(
+                "patch {k} {:?} el {} face opp {opp} crossed; misses{misses}",
+                p.role, p.element
+            );
+        }
+    }
+    eprintln!("{by_kind:#?}");
+}
+
+/// letter_P_poly (annular caps, L-U pairs next to single-sided triangles): the estimated
+/// shape operator bends the surface out through flat bases of the hull (number 2 weights of
+/// the base edges with the apex's sign). With `hessian_signs` (each point's Hessian moved,
+/// least, so its number 2 weights meet Theorem 2.1) and the scene's curvature scale, the
+/// surface crosses no boundary face and no j-line twice, and stays C2; the same build without
+/// the fit crosses bases (an independent count by sampling F on every boundary face).
+#[test]
+fn letter_p_hessian_signs_close_the_holes() {
+    let path = Path::new("scenes/models/letter_P_poly.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+    let mut crossed = Vec::new();
+    for fit in [false, true] {
+        let o = QuinticOptions {
+            hessian_signs: fit,
+            curvature: 0.4,
+            ..QuinticOptions::default()
+        };
+        let (c, stats) = build_with_stats(&hull, &o).unwrap();
+        let r = check(&c, &CheckOptions::default());
+        // The checker's C2 acceptance of the issue (relative jumps).
+        assert!(r.gradient_jump.worst <= 1e-9, "{:?}", r.gradient_jump);
+        assert!(r.hessian_jump.worst <= 1e-7, "{:?}", r.hessian_jump);
+        if fit {
+            assert!(stats.hessian_fit.moved > 0, "{stats:?}");
+            assert!(r.passed(), "{:?}", r.failures());
+            assert_eq!(r.sheets.j_multi_patches, 0);
+        }
+        crossed.push(boundary_faces_crossed(&c));
+    }
+    assert!(crossed[0] > 0, "{crossed:?}");
+    assert_eq!(crossed[1], 0, "{crossed:?}");
 }

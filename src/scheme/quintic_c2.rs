@@ -57,6 +57,11 @@ pub struct QuinticOptions {
     /// Enforce Theorem 2.1's sign conditions (k = 1, [`signs`]) on the weights the C2
     /// constraints leave free, by pinning the ones whose targets miss their sign.
     pub signs: bool,
+    /// Move each point's estimated Hessian, as little as possible, so that the number 2
+    /// weights meet Theorem 2.1's signs ([`signs::fit_hessians`]): the estimate follows the
+    /// neighbours' normals and can bend the surface out through a flat base or back before
+    /// an apex.
+    pub hessian_signs: bool,
 }
 
 impl Default for QuinticOptions {
@@ -69,6 +74,7 @@ impl Default for QuinticOptions {
             joint_stars: false,
             relax_stars: true,
             consistent_stars: false,
+            hessian_signs: false,
         }
     }
 }
@@ -126,6 +132,13 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "hessian_signs" => match v.as_bool() {
+                    Some(b) => o.hessian_signs = b,
+                    None => bail!(
+                        "{}: `scheme.hessian_signs` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => match v.as_bool() {
                     Some(b) => o.signs = b,
                     None => bail!(
@@ -144,7 +157,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `alpha`, `trihedral_level`, `fix_normals`)",
                     scene.display()
                 ),
             }
@@ -182,9 +195,14 @@ pub fn build_with_stats(
     let hull = &completed;
     let np = hull.points.len() as u32;
     let nt = hull.triangles.len() as u32;
-    let jets = jets::estimate(hull, options.curvature);
+    let mut jets = jets::estimate(hull, options.curvature);
     let (tets, _pos) = system::tetrahedra(hull)?;
     let sys = system::assemble(&tets, np)?;
+    let hessian_fit = if options.hessian_signs {
+        signs::fit_hessians(&tets, np, &mut jets, &|t, l| sys.required_sign(t, l))
+    } else {
+        signs::HessianFit::default()
+    };
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
     let (value, mut stats) = sys.solve(
         &tets,
@@ -195,9 +213,11 @@ pub fn build_with_stats(
         options.joint_stars,
         options.relax_stars,
         options.consistent_stars,
+        options.hessian_signs,
     )?;
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
     stats.lu_completed = lu_completed.len();
+    stats.hessian_fit = hessian_fit;
     let mut complex = PatchComplex::new("quintic-c2");
     complex.continuity = Some(2);
     complex.vertices = hull.points.iter().map(|p| p.to_array()).collect();

@@ -154,6 +154,221 @@ pub fn base_conflicts(hull: &SimplicialHull) -> Vec<BaseConflict> {
     out
 }
 
+/// What [`fit_hessians`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct HessianFit {
+    /// Points of T whose estimated Hessian missed a sign condition and was moved.
+    pub moved: usize,
+    /// Sign conditions on number 2 weights (after C0 sharing, counted per tetrahedron).
+    pub conditions: usize,
+    /// Conditions the fitted Hessians still miss: where a point's conditions contradict each
+    /// other, the ones missed by most are dropped one at a time until the rest can be met.
+    pub missed: usize,
+}
+
+/// One sign condition on a Hessian in tangent coordinates: `row`·u ≥ `rhs`, u = (A, √2·B, C)
+/// for H = A t1t1ᵀ + B (t1t2ᵀ + t2t1ᵀ) + C t2t2ᵀ (so |Δu| is the Frobenius distance).
+struct HalfSpace {
+    row: [f64; 3],
+    rhs: f64,
+}
+
+/// Moves the Hessian of every point of T, as little as possible (Frobenius norm, tangent
+/// tensors kept tangent), so that the number 2 weights (one point of T at multiplicity 3)
+/// meet Theorem 2.1's signs (k = 1).
+///
+/// With the 2-jet (0, g, H) at p, the weight at the domain point p³ab is the blossom of the
+/// Taylor polynomial, g·(a − p + b − p)/5 + (a − p)ᵀH(b − p)/20: linear in H. The estimated
+/// shape operator follows the normals of the neighbouring points and knows nothing of the
+/// hull, so on flat stars next to folds its curvature along a base edge can put that edge on
+/// the apex's side of the surface (F > 0 on an outer base: the surface leaves the hull through
+/// the base, a hole), or its curvature toward an apex bend the surface back before it (a
+/// second crossing). Each point's conditions are half-spaces in the three entries of its
+/// tangent tensor; the closest tensor in their intersection is found by Dykstra's alternating
+/// projections. `sign(t, l)` is the sign the weight at multi-index `l` of `tets[t]` must have
+/// (+1, −1, or 0 for none: combined over the tetrahedra that share it).
+pub fn fit_hessians(
+    tets: &[HullTet],
+    np: u32,
+    jets: &mut [super::jets::Jet],
+    sign: &dyn Fn(usize, [u8; 4]) -> i8,
+) -> HessianFit {
+    let mut conds: Vec<Vec<(glam::DVec3, glam::DVec3, f64)>> = vec![Vec::new(); jets.len()];
+    for (t, tet) in tets.iter().enumerate() {
+        for k in 0..4 {
+            if tet.gid[k] >= np {
+                continue;
+            }
+            let p = tet.pts[k];
+            for l in crate::bb::multi_indices(5) {
+                if l[k] != 3 {
+                    continue;
+                }
+                let g = jets[tet.gid[k] as usize].g;
+                let mut other = Vec::with_capacity(2);
+                let mut other_t = Vec::with_capacity(2);
+                for (i, &m) in l.iter().enumerate() {
+                    if i != k {
+                        for _ in 0..m {
+                            other.push(tet.pts[i] - p);
+                            other_t.push(tet.gid[i] < np);
+                        }
+                    }
+                }
+                let (a, b) = (other[0], other[1]);
+                // Rounding of a unit normal's dot product with an edge.
+                let tiny = |d: glam::DVec3| 1e-12 * d.length();
+                let r = sign(t, l);
+                let r = if r == CONFLICT && other_t[0] && other_t[1] && a == b {
+                    // On an edge [p p_j] of T with tetrahedra of both sides (next to an L-U
+                    // pair): keep F along the edge on the side its number 1 weight
+                    // n_p·(p_j − p)/5 already gives it (zero on a flat edge: both signs).
+                    let gd = g.dot(a);
+                    if gd.abs() <= tiny(a) {
+                        conds[tet.gid[k] as usize].push((a, b, 1.0));
+                        -1
+                    } else {
+                        gd.signum() as i8
+                    }
+                } else {
+                    r
+                };
+                if r != 1 && r != -1 {
+                    continue;
+                }
+                // A weight between p and a point of T whose number 1 weight has the wrong sign
+                // (the edge runs to the other side of p's tangent plane: a base conflict, or a
+                // face next to one): F has the wrong sign near p there whatever H is.
+                let hopeless =
+                    (0..2).any(|i| other_t[i] && f64::from(r) * g.dot(other[i]) < -tiny(other[i]));
+                if hopeless {
+                    continue;
+                }
+                conds[tet.gid[k] as usize].push((a, b, f64::from(r)));
+            }
+        }
+    }
+    let mut fit = HessianFit::default();
+    for (jet, cs) in jets.iter_mut().zip(&conds) {
+        fit.conditions += cs.len();
+        if cs.is_empty() {
+            continue;
+        }
+        let (t1, t2) = jet.g.any_orthonormal_pair();
+        let coords = |m: glam::DMat3| {
+            [
+                t1.dot(m * t1),
+                std::f64::consts::SQRT_2 * t1.dot(m * t2),
+                t2.dot(m * t2),
+            ]
+        };
+        // σ·(g·(a + b)/5 + aᵀHb/20) ≥ 0 with aᵀHb = A·a1b1 + B·(a1b2 + a2b1) + C·a2b2.
+        let spaces: Vec<HalfSpace> = cs
+            .iter()
+            .map(|&(a, b, s)| {
+                let (a1, a2, b1, b2) = (a.dot(t1), a.dot(t2), b.dot(t1), b.dot(t2));
+                let row = [
+                    s * a1 * b1 / 20.0,
+                    s * (a1 * b2 + a2 * b1) / (20.0 * std::f64::consts::SQRT_2),
+                    s * a2 * b2 / 20.0,
+                ];
+                HalfSpace {
+                    row,
+                    rhs: -s * jet.g.dot(a + b) / 5.0,
+                }
+            })
+            .collect();
+        let u0 = coords(jet.h);
+        // Rounding of the conditions' products: a tensor this close meets them.
+        let scale = spaces
+            .iter()
+            .map(|h| h.rhs.abs() + h.row.iter().map(|x| x.abs()).sum::<f64>())
+            .fold(0.0_f64, f64::max)
+            .max(f64::MIN_POSITIVE);
+        let tol = 1e-13 * scale * (1.0 + u0.iter().map(|x| x.abs()).sum::<f64>());
+        let miss = |u: &[f64; 3]| {
+            spaces
+                .iter()
+                .filter(|h| dot3(h.row, *u) < h.rhs - tol)
+                .count()
+        };
+        if miss(&u0) == 0 {
+            continue;
+        }
+        // The closest tensor meeting every condition; where they contradict each other, the
+        // condition missed by most at the compromise is dropped and the rest tried again.
+        let mut active: Vec<usize> = (0..spaces.len()).collect();
+        let u = loop {
+            let sub: Vec<&HalfSpace> = active.iter().map(|&i| &spaces[i]).collect();
+            let u = dykstra(&sub, u0, tol);
+            let worst = active
+                .iter()
+                .enumerate()
+                .map(|(pos, &i)| {
+                    let h = &spaces[i];
+                    let n = dot3(h.row, h.row).sqrt().max(f64::MIN_POSITIVE);
+                    (pos, (h.rhs - dot3(h.row, u)) / n)
+                })
+                .max_by(|x, y| x.1.total_cmp(&y.1));
+            match worst {
+                Some((pos, v)) if v > tol => {
+                    active.remove(pos);
+                }
+                _ => break u,
+            }
+        };
+        fit.moved += 1;
+        fit.missed += miss(&u);
+        // Back to the tensor: the normal part of the estimate (zero) is kept.
+        let (a, b, c) = (u[0], u[1] / std::f64::consts::SQRT_2, u[2]);
+        let o = |x: glam::DVec3, y: glam::DVec3| glam::DMat3::from_cols(x * y.x, x * y.y, x * y.z);
+        jet.h = a * o(t1, t1) + b * (o(t1, t2) + o(t2, t1)) + c * o(t2, t2);
+    }
+    fit
+}
+
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Sweeps of [`dykstra`] at most.
+const DYKSTRA_SWEEPS: usize = 5000;
+
+/// The point of the intersection of `spaces` closest to `u0` (Dykstra's alternating
+/// projections; on an empty intersection, after [`DYKSTRA_SWEEPS`] sweeps, a point between
+/// them). Stops when a sweep moves nothing by more than `tol` and every half-space is met to
+/// `tol`.
+fn dykstra(spaces: &[&HalfSpace], u0: [f64; 3], tol: f64) -> [f64; 3] {
+    let mut x = u0;
+    let mut q = vec![[0.0; 3]; spaces.len()];
+    for _ in 0..DYKSTRA_SWEEPS {
+        let mut moved = 0.0_f64;
+        for (h, qi) in spaces.iter().zip(q.iter_mut()) {
+            let y = [x[0] + qi[0], x[1] + qi[1], x[2] + qi[2]];
+            let nn = dot3(h.row, h.row);
+            let gap = h.rhs - dot3(h.row, y);
+            let z = if gap > 0.0 && nn > 0.0 {
+                let f = gap / nn;
+                [
+                    y[0] + f * h.row[0],
+                    y[1] + f * h.row[1],
+                    y[2] + f * h.row[2],
+                ]
+            } else {
+                y
+            };
+            *qi = [y[0] - z[0], y[1] - z[1], y[2] - z[2]];
+            moved = moved.max((0..3).map(|i| (z[i] - x[i]).abs()).fold(0.0, f64::max));
+            x = z;
+        }
+        let feasible = spaces.iter().all(|h| dot3(h.row, x) >= h.rhs - tol);
+        if feasible && moved <= tol {
+            break;
+        }
+    }
+    x
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -190,5 +405,103 @@ mod tests {
         assert_eq!(combine(1, -1), CONFLICT);
         assert_eq!(combine(CONFLICT, 1), CONFLICT);
         assert_eq!(combine(-1, -1), -1);
+    }
+
+    /// A flat outer base with a convex estimated Hessian at one corner: F > 0 along the base
+    /// edges (the surface would leave through the base). The fit meets every condition of the
+    /// tetrahedron's number 2 weights, moves only that corner, and no tangent tensor on a grid
+    /// that meets them is closer to the estimate (brute force).
+    #[test]
+    fn fit_hessians_meets_the_signs_closest_to_the_estimate() {
+        use super::super::jets::Jet;
+        use glam::DMat3;
+        let pts = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.2, 0.9, 0.0),
+            DVec3::new(0.4, 0.3, 0.5),
+        ];
+        let t = HullTet {
+            gid: [0, 1, 2, 3],
+            pts,
+            role: Role::Face,
+            element: 0,
+            triangle: 0,
+            side: Side::Outer,
+        };
+        let n = DVec3::Z;
+        let h0 = DMat3::from_diagonal(DVec3::new(1.0, 0.6, 0.0))
+            + DMat3::from_cols(
+                DVec3::new(0.0, 0.3, 0.0),
+                DVec3::new(0.3, 0.0, 0.0),
+                DVec3::ZERO,
+            );
+        let mut jets = vec![
+            Jet {
+                p: pts[0],
+                g: n,
+                h: h0,
+            },
+            Jet {
+                p: pts[1],
+                g: n,
+                h: DMat3::ZERO,
+            },
+            Jet {
+                p: pts[2],
+                g: n,
+                h: DMat3::ZERO,
+            },
+        ];
+        let tets = [t.clone()];
+        let sign = |_: usize, l: [u8; 4]| required(&t, l, false);
+        let fit = fit_hessians(&tets, 3, &mut jets, &sign);
+        assert_eq!((fit.moved, fit.missed), (1, 0), "{fit:?}");
+        assert_eq!(jets[1].h, DMat3::ZERO);
+        // The conditions at point 0, evaluated on the weights themselves.
+        let weights_ok = |h: DMat3| {
+            let jet = Jet { p: pts[0], g: n, h };
+            crate::bb::multi_indices(5)
+                .into_iter()
+                .filter(|l| l[0] == 3)
+                .all(|l| {
+                    let mut args = [DVec3::ZERO; 5];
+                    let mut c = 0;
+                    for (i, &m) in l.iter().enumerate() {
+                        for _ in 0..m {
+                            args[c] = pts[i];
+                            c += 1;
+                        }
+                    }
+                    // Rounding of the fit (1e-13 of the conditions' scale).
+                    f64::from(required(&t, l, false)) * jet.blossom5(&args) >= -1e-12
+                })
+        };
+        assert!(!weights_ok(h0));
+        let h = jets[0].h;
+        assert!(weights_ok(h), "{h:?}");
+        // Still tangent: nothing along the normal.
+        assert!((h * n).length() < 1e-15 && (h.transpose() * n).length() < 1e-15);
+        let dist = |m: DMat3| {
+            let d = (m - h0).to_cols_array();
+            d.iter().map(|x| x * x).sum::<f64>().sqrt()
+        };
+        let best = dist(h);
+        let steps = 60;
+        for i in 0..=steps {
+            for j in 0..=steps {
+                for k in 0..=steps {
+                    let v = |x: usize| -1.5 + 3.0 * x as f64 / steps as f64;
+                    let (a, b, c) = (v(i), v(j), v(k));
+                    let m =
+                        DMat3::from_cols(DVec3::new(a, b, 0.0), DVec3::new(b, c, 0.0), DVec3::ZERO);
+                    if weights_ok(m) {
+                        // Grid rounding: no grid tensor is closer than the fit by more than
+                        // rounding.
+                        assert!(dist(m) >= best - 1e-9, "{m:?} {} < {best}", dist(m));
+                    }
+                }
+            }
+        }
     }
 }

@@ -399,6 +399,8 @@ pub struct SolveStats {
     /// Consistency conditions of singular stars imposed on the edge middles
     /// (`QuinticOptions::consistent_stars`).
     pub consistency_conditions: usize,
+    /// What [`signs::fit_hessians`] changed (`QuinticOptions::hessian_signs`).
+    pub hessian_fit: signs::HessianFit,
 }
 
 /// A group whose equations could not be met in one pass.
@@ -424,7 +426,9 @@ impl System {
     /// at once instead, closest to its target ([`SolveStats::global`]).
     ///
     /// With `pin`, Theorem 2.1's signs are enforced where the groups allow ([`pin_signs`]);
-    /// with `joint_stars`, every point starts relaxed at level 2; with `relax_stars`, points
+    /// with `joint_stars`, every point starts relaxed at level 2; with `consistent_faces`, a
+    /// singular face-middle or edge-tetrahedron group that the weights before it make
+    /// inconsistent imposes its consistency conditions on them before the global fallback; with `relax_stars`, points
     /// whose star weights miss Theorem 2.1's signs are relaxed the same way and the whole
     /// solve repeated, while the number of misses falls (at most `RELAX_ROUNDS` rounds).
     ///
@@ -441,6 +445,7 @@ impl System {
         joint_stars: bool,
         relax_stars: bool,
         consistent_stars: bool,
+        consistent_faces: bool,
     ) -> Result<(Vec<f64>, SolveStats)> {
         let mut level: HashMap<u32, u8> = HashMap::new();
         if joint_stars {
@@ -450,8 +455,15 @@ impl System {
                 level.insert(p, 2);
             }
         }
-        let (mut value, mut stats) =
-            self.solve_levels(tets, jets, nt, target, &mut level, pin, consistent_stars)?;
+        let (mut value, mut stats) = self.solve_levels(
+            tets,
+            jets,
+            nt,
+            target,
+            &mut level,
+            pin,
+            (consistent_stars, consistent_faces),
+        )?;
         if !relax_stars {
             return Ok((value, stats));
         }
@@ -475,9 +487,15 @@ impl System {
             if !grew {
                 break;
             }
-            let Ok((v, s)) =
-                self.solve_levels(tets, jets, nt, target, &mut trial, pin, consistent_stars)
-            else {
+            let Ok((v, s)) = self.solve_levels(
+                tets,
+                jets,
+                nt,
+                target,
+                &mut trial,
+                pin,
+                (consistent_stars, consistent_faces),
+            ) else {
                 break;
             };
             let trial_misses = self.star_misses(&v);
@@ -542,7 +560,7 @@ impl System {
         target: &dyn Fn(usize, [u8; 4]) -> f64,
         level: &mut HashMap<u32, u8>,
         pin: bool,
-        consistent: bool,
+        (consistent, consistent_faces): (bool, bool),
     ) -> Result<(Vec<f64>, SolveStats)> {
         let mut first_failure = None;
         let mut extra: Vec<Equation> = Vec::new();
@@ -565,6 +583,19 @@ impl System {
                 // them on the weights solved before it (edge middles) instead of relaxing it.
                 if consistent
                     && f.stage == 3
+                    && !f.consistency.is_empty()
+                    && conditioned.insert(f.points.clone())
+                {
+                    extra.extend(f.consistency);
+                    bumped = true;
+                    continue;
+                }
+                // A singular later group (face middles, far face weights, edge tetrahedra)
+                // whose right-hand side the weights solved before it miss: impose its
+                // consistency conditions on those weights (they join the groups of their last
+                // unknowns) instead of solving everything at once.
+                if consistent_faces
+                    && f.stage >= 4
                     && !f.consistency.is_empty()
                     && conditioned.insert(f.points.clone())
                 {
@@ -1025,6 +1056,13 @@ impl System {
             .filter(|slots| slots.iter().any(|&s| bad[s as usize]))
             .count();
         st
+    }
+
+    /// The sign Theorem 2.1 asks of the weight at multi-index `l` of tetrahedron `t`, combined
+    /// over every tetrahedron sharing it: +1, −1, 0 for none, or [`signs::CONFLICT`].
+    #[must_use]
+    pub fn required_sign(&self, t: usize, l: [u8; 4]) -> i8 {
+        self.req[self.slot_of[t][crate::bb::index_of(l)] as usize]
     }
 
     /// The 56 weights of tetrahedron `t` from the slot values.
