@@ -4,7 +4,11 @@
 //! guard, the centroid of its kernel ([`kernel_guard`]) — "for a convex polygon or a star-shaped
 //! polygon, a minimum corner guard set consists of just a single point" (§2). Its reflex
 //! corners then stay trihedral and become Algorithm 2's hallway corners (step (3'), in
-//! [`super::corner`]).
+//! [`super::corner`]). Unless that guard is far from a corner ([`guard_is_near`]: more than
+//! [`GUARD_REACH`] times the corner's longer edge; mpi_poly's face 7, kernel 14 % of an L
+//! whose arm ends 18 away): long thin triangles of T from such a corner to the guard overlap
+//! their neighbours, so the polygon is split like the others below and gets a corner guard net
+//! with guards near their corners ([`super::guardnet`]; Appendix B's corner guard circles).
 //!
 //! Other non-convex polygons are split, as the paper allows (§4, after Theorem 4.1: "the convex
 //! face restriction can be enforced by subdividing nonconvex faces into convex ones"): every
