@@ -4,7 +4,11 @@
 //! guard, the centroid of its kernel ([`kernel_guard`]) — "for a convex polygon or a star-shaped
 //! polygon, a minimum corner guard set consists of just a single point" (§2). Its reflex
 //! corners then stay trihedral and become Algorithm 2's hallway corners (step (3'), in
-//! [`super::corner`]).
+//! [`super::corner`]). Unless that guard is far from a corner ([`guard_is_near`]: more than
+//! [`GUARD_REACH`] times the corner's longer edge; mpi_poly's face 7, kernel 14 % of an L
+//! whose arm ends 18 away): long thin triangles of T from such a corner to the guard overlap
+//! their neighbours, so the polygon is split like the others below and gets a corner guard net
+//! with guards near their corners ([`super::guardnet`]; Appendix B's corner guard circles).
 //!
 //! Other non-convex polygons are split, as the paper allows (§4, after Theorem 4.1: "the convex
 //! face restriction can be enforced by subdividing nonconvex faces into convex ones"): every
@@ -79,7 +83,9 @@ pub fn convex_pieces(mesh: &Mesh) -> Result<Pieces> {
             out.center.push(mean);
             continue;
         }
-        if let Some(g) = kernel_guard(&mesh.positions, face, normal) {
+        if let Some(g) = kernel_guard(&mesh.positions, face, normal)
+            .filter(|&g| guard_is_near(&mesh.positions, face, g))
+        {
             // Corner guards lie exactly in the polygon's plane (through its vertex mean).
             let g = g - normal.dot(g - mean) * normal;
             out.faces.push(face.clone());
@@ -104,6 +110,23 @@ pub fn convex_pieces(mesh: &Mesh) -> Result<Pieces> {
         }
     }
     Ok(out)
+}
+
+/// How far a single corner guard may lie from a corner it serves, in units of the longer of
+/// the corner's two edges.
+pub const GUARD_REACH: f64 = 5.0;
+
+/// True when every corner of `face` lies within [`GUARD_REACH`] of its longer edge's length of
+/// the guard `g`.
+#[must_use]
+pub fn guard_is_near(positions: &[DVec3], face: &[u32], g: DVec3) -> bool {
+    let n = face.len();
+    (0..n).all(|k| {
+        let p = |i: usize| positions[face[i % n] as usize];
+        let v = p(k);
+        let e = (p(k + 1) - v).length().max((p(k + n - 1) - v).length());
+        (v - g).length() <= GUARD_REACH * e
+    })
 }
 
 /// The centroid of the kernel of a star-shaped polygon (the points that see all of it: the

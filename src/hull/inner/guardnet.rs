@@ -610,6 +610,10 @@ fn assign(
         .collect();
     // Candidate pieces per corner: those whose kernel meets the corner's wedge.
     let wedge = |c: &RegionCorner| [(f(c.u), f(c.v)), (f(c.v), f(c.w))];
+    let diameter = boundary
+        .iter()
+        .flat_map(|&(a, _)| boundary.iter().map(move |&(b, _)| (a - b).length()))
+        .fold(0.0, f64::max);
     let mut cands: Vec<Vec<u32>> = Vec::with_capacity(corners.len());
     for c in corners {
         let mut ok = Vec::new();
@@ -678,7 +682,13 @@ fn assign(
             if k.len() < 3 || polygon_area(&k) < MIN_KERNEL_AREA * area[&p] {
                 return None;
             }
-            let gp = centroid(&k);
+            let served: Vec<[DVec2; 3]> = corners
+                .iter()
+                .zip(pick)
+                .filter(|&(_, &g)| g == p)
+                .map(|(c, _)| [f(c.u), f(c.v), f(c.w)])
+                .collect();
+            let gp = near_guard(&k, &served);
             guard.insert(p, gp);
             out.push((p, plane.lift(gp)));
         }
@@ -700,7 +710,18 @@ fn assign(
                 }
             }
         }
+        // Corners served from too far ([`too_far`]) weigh far more than net length: guards
+        // near their corners first, then the shortest net.
         let mut length2 = 0.0;
+        for (c, &g) in corners.iter().zip(pick) {
+            let (pu, pv, pw) = (f(c.u), f(c.v), f(c.w));
+            let e = (pu - pv).length().max((pw - pv).length());
+            let d = (guard[&g] - pv).length();
+            let beyond = d - super::decompose::GUARD_REACH * e;
+            if too_far(d, e, diameter) {
+                length2 += FAR_WEIGHT * beyond * beyond;
+            }
+        }
         for (i, &g) in pick.iter().enumerate() {
             let h = pick[next[i]];
             if g != h {
@@ -715,6 +736,10 @@ fn assign(
     st.run(0, &mut check);
     st.best.map(|(_, pick, centers)| (pick, centers))
 }
+
+/// Weight of the squared distance by which a corner's guard lies beyond
+/// [`super::decompose::GUARD_REACH`] in an assignment's cost, against the squared net length.
+const FAR_WEIGHT: f64 = 1e3;
 
 /// The geometric test of a complete assignment: guard positions of the pieces used and the
 /// assignment's cost (the sum of the squared net edge lengths), or `None`.
@@ -811,6 +836,54 @@ fn clip(k: &[DVec2], a: DVec2, b: DVec2) -> Vec<DVec2> {
         }
     }
     out
+}
+
+/// How far (as a share of the way to the kernel's edge) a guard moves from its clipped kernel's
+/// centroid towards the corners it serves when the centroid is too far from them
+/// ([`near_guard`]); the rest keeps it off the kernel's boundary.
+pub const GUARD_PULL: f64 = 0.8;
+
+/// The guard of one piece, in its kernel `k` (already clipped by the wedges of the corners it
+/// serves, each given as U, V, W). The centroid of `k` when every served corner V lies within
+/// [`super::decompose::GUARD_REACH`] of its longer edge's length from it; otherwise the point
+/// [`GUARD_PULL`] of the way from the centroid to where the segment towards the corners' mean
+/// leaves `k` (Appendix B's corner guard circles: any point of the kernel serves, so one near
+/// its corners keeps T's triangles there short; a long L's arm end was served from its elbow).
+fn near_guard(k: &[DVec2], served: &[[DVec2; 3]]) -> DVec2 {
+    let c = centroid(k);
+    let far = served.iter().any(|&[u, v, w]| {
+        let e = (u - v).length().max((w - v).length());
+        (v - c).length() > super::decompose::GUARD_REACH * e
+    });
+    if !far || served.is_empty() {
+        return c;
+    }
+    let m = served.iter().map(|x| x[1]).sum::<DVec2>() / served.len() as f64;
+    let d = m - c;
+    // Largest t ≤ 1 with c + t·d inside the convex, counter-clockwise k.
+    let mut t: f64 = 1.0;
+    for i in 0..k.len() {
+        let (a, b) = (k[i], k[(i + 1) % k.len()]);
+        let side = (b - a).perp_dot(c - a);
+        let rate = (b - a).perp_dot(d);
+        if rate < 0.0 {
+            t = t.min(side / -rate);
+        }
+    }
+    c + GUARD_PULL * t.max(0.0) * d
+}
+
+/// Share of its region's diameter beyond which a guard counts as far from a corner (with
+/// [`super::decompose::GUARD_REACH`]): corners with tiny edges (mpi_poly's slivers, 0.02 wide)
+/// cannot have guards within a few edge lengths, and moving guards for them only shuffles
+/// the net.
+pub const FAR_SHARE: f64 = 0.5;
+
+/// A guard at distance `d` from a corner whose longer edge is `e`, in a region of diameter
+/// `diameter`, is too far when `d` exceeds both [`super::decompose::GUARD_REACH`] × `e` and
+/// [`FAR_SHARE`] × `diameter`.
+fn too_far(d: f64, e: f64, diameter: f64) -> bool {
+    d > super::decompose::GUARD_REACH * e && d > FAR_SHARE * diameter
 }
 
 /// Area centroid of a convex polygon of positive area.
