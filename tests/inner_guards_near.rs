@@ -97,3 +97,31 @@ fn chamfered_l_hull_verifies() {
     );
     assert_eq!(euler_characteristic(&hull), Some(2));
 }
+
+/// The far kernel guards are remembered (`Pieces::far_star`), and `restore_stars` (used when
+/// no guard net is found) puts such a polygon back whole with that guard.
+#[test]
+fn far_star_faces_can_be_restored_whole() {
+    let (m, outline) = chamfered_l();
+    let merged = coplanar::merge_coplanar(&m);
+    let pieces = decompose::convex_pieces(&merged).unwrap();
+    let far: Vec<u32> = pieces.far_star.iter().map(|&(f, _)| f).collect();
+    assert_eq!(far, vec![0, 1]);
+    let restored = pieces.restore_stars(&merged, &[1]);
+    assert_eq!(restored.far_star.len(), 1);
+    assert_eq!(restored.split.len(), 1);
+    let whole: Vec<usize> = (0..restored.faces.len())
+        .filter(|&p| restored.parent[p] == 1)
+        .collect();
+    assert_eq!(whole.len(), 1);
+    let p = whole[0];
+    assert_eq!(restored.faces[p].len(), outline.len());
+    // The kernel guard of the top cap: (0.5, 0.5, 1) up to the clipping's rounding.
+    assert!((restored.center[p] - DVec3::new(0.5, 0.5, 1.0)).length() < 1e-9);
+    assert!(restored.star.iter().any(|&(f, _)| f == 1));
+    // Every other piece is kept as it was.
+    assert_eq!(
+        restored.faces.len(),
+        pieces.faces.len() - pieces.split.iter().find(|s| s.0 == 1).unwrap().1 + 1
+    );
+}

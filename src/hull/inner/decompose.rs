@@ -49,6 +49,59 @@ pub struct Pieces {
     /// Non-convex input polygons kept whole because they are star shaped, with their single
     /// corner guard (a point in the interior of the kernel, which sees every corner).
     pub star: Vec<(u32, DVec3)>,
+    /// Star-shaped polygons split anyway because their kernel guard is far from a corner
+    /// ([`guard_is_near`]), with that guard (kept if no corner guard net is found).
+    pub far_star: Vec<(u32, DVec3)>,
+}
+
+impl Pieces {
+    /// The pieces with every polygon of `faces` (indices of `mesh`'s faces, listed in
+    /// [`Pieces::far_star`]) whole again, with its kernel guard, as [`convex_pieces`] keeps a
+    /// star-shaped polygon.
+    #[must_use]
+    pub fn restore_stars(&self, mesh: &Mesh, faces: &[u32]) -> Pieces {
+        let mut out = Pieces {
+            split: self
+                .split
+                .iter()
+                .filter(|(f, _)| !faces.contains(f))
+                .copied()
+                .collect(),
+            star: self.star.clone(),
+            far_star: self
+                .far_star
+                .iter()
+                .filter(|(f, _)| !faces.contains(f))
+                .copied()
+                .collect(),
+            ..Pieces::default()
+        };
+        for p in 0..self.faces.len() {
+            if faces.contains(&self.parent[p]) {
+                continue;
+            }
+            out.faces.push(self.faces[p].clone());
+            out.parent.push(self.parent[p]);
+            out.normal.push(self.normal[p]);
+            out.guard.push(self.guard[p]);
+            out.center.push(self.center[p]);
+        }
+        for &(f, g) in &self.far_star {
+            if !faces.contains(&f) {
+                continue;
+            }
+            let Some(p) = self.parent.iter().position(|&x| x == f) else {
+                continue;
+            };
+            out.faces.push(mesh.faces[f as usize].clone());
+            out.parent.push(f);
+            out.normal.push(self.normal[p]);
+            out.guard.push(true);
+            out.center.push(g);
+            out.star.push((f, g));
+        }
+        out
+    }
 }
 
 /// Smallest kernel area, relative to the polygon's area, for which a star-shaped polygon keeps
@@ -83,11 +136,13 @@ pub fn convex_pieces(mesh: &Mesh) -> Result<Pieces> {
             out.center.push(mean);
             continue;
         }
-        if let Some(g) = kernel_guard(&mesh.positions, face, normal)
-            .filter(|&g| guard_is_near(&mesh.positions, face, g))
-        {
+        let kernel = kernel_guard(&mesh.positions, face, normal)
             // Corner guards lie exactly in the polygon's plane (through its vertex mean).
-            let g = g - normal.dot(g - mean) * normal;
+            .map(|g| g - normal.dot(g - mean) * normal);
+        if let Some(g) = kernel.filter(|&g| !guard_is_near(&mesh.positions, face, g)) {
+            out.far_star.push((f as u32, g));
+        }
+        if let Some(g) = kernel.filter(|&g| guard_is_near(&mesh.positions, face, g)) {
             out.faces.push(face.clone());
             out.parent.push(f as u32);
             out.normal.push(normal);

@@ -97,10 +97,28 @@ impl GuardNet {
     /// separate faces, as before guard nets.
     #[must_use]
     pub fn build(mesh: &Mesh, pieces: Pieces) -> GuardNet {
-        let first = GuardNet::build_skipping(mesh, pieces.clone(), &[]);
+        let mut first = GuardNet::build_skipping(mesh, pieces.clone(), &[]);
         if first.failed.is_empty() {
             return first;
         }
+        // Star faces split only because their kernel guard was far keep that guard when no net
+        // is found: separate coplanar pieces are worse (fandisk's face 1912: flat T, C1 broke).
+        let restore: Vec<u32> = first
+            .fallback
+            .iter()
+            .copied()
+            .filter(|f| pieces.far_star.iter().any(|&(g, _)| g == *f))
+            .collect();
+        let pieces = if restore.is_empty() {
+            pieces
+        } else {
+            let restored = pieces.restore_stars(mesh, &restore);
+            first = GuardNet::build_skipping(mesh, restored.clone(), &[]);
+            if first.failed.is_empty() {
+                return first;
+            }
+            restored
+        };
         let failed = first.failed.clone();
         let mut second = GuardNet::build_skipping(mesh, pieces, &failed);
         second.fallback = first.fallback;
