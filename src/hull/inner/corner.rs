@@ -153,6 +153,16 @@ fn saddle_apex(
     slot[other] = Some((a + b + c) / 3.0 + sign * super::sides::MIN_HEIGHT * len * nn);
 }
 
+/// Longest move along −e of an apex that [`build_corner`] brings to V's side of the plane Π
+/// through C_1, C_2 and M (Lemma 4.3), relative to |e|. Where Π nearly contains e (C_1, C_2
+/// and e almost coplanar: a diagonal of a planar-split polygon, spot_control_cage's udder
+/// saddles 12/121) the rate along −e is tiny and the unclamped move sent an apex 0.93 away
+/// from V over a triangle 0.21 long (edge tetrahedra overlapping the whole corner's). Beyond
+/// 0.5|e| the apex is past V, where the move no longer serves Lemma 4.3. On every scene of
+/// `scenes/paper1994` the clamped apexes are rebuilt later ([`super::sides::settle`]) and the
+/// hulls are bit-identical with and without the clamp.
+pub const KEEP_SIDE_REACH: f64 = 0.5;
+
 /// Offset δ along n_V of the pseudo-centroid C_0 = V + δ n_V of an unseparable vertex (the paper
 /// puts C_0 = V). The edge C_0G_i of T is convex (Definition 3.1) when
 /// (C_0 − G_i)·n_{G_i} has the sign of t_i = (G_i − V)·n_V or is zero; with C_0 = V the first
@@ -294,7 +304,7 @@ pub fn build_corner(
             let gq = pi_n.dot(q - m);
             let rate = pi_n.dot(along);
             if g_min > 0.0 && gq < g_min && rate > 1e-9 {
-                q + (g_min - gq) / rate * along
+                q + ((g_min - gq) / rate).min(KEEP_SIDE_REACH * d.length()) * along
             } else {
                 q
             }
