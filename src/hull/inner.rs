@@ -36,6 +36,8 @@
 //!    outer faces), and [`degenerate`] rebuilds over the base any face tetrahedron that
 //!    is still degenerate (far apexes from nearly parallel intersections), or names the
 //!    element in an error.
+//!    Between steps 4 and 5, [`normals`] may turn pseudo-centroid normals towards their large
+//!    faces (opt-in `ring_normals`: flat faces stay flat, the bend moves to the edges).
 //! 7. Step (6), the edge tetrahedra, is derived by [`SimplicialHull::edge_tets`].
 //!
 //! In step 4, [`fan`] places the pseudo-centroid C_0 of a separable vertex where its fan
@@ -60,6 +62,7 @@ pub mod decompose;
 pub mod degenerate;
 pub mod fan;
 pub mod guardnet;
+pub mod normals;
 pub mod planar;
 pub mod remesh;
 pub mod sides;
@@ -92,6 +95,10 @@ pub struct InnerOptions {
     /// into triangles before the hull ([`planar`]; default [`planar::DEFAULT_TOLERANCE`]).
     /// `f64::INFINITY` turns the split off.
     pub planar_tolerance: f64,
+    /// How far pseudo-centroid normals turn towards their large faces' normals, in [0, 1]
+    /// ([`normals::flatten_ring_normals`]; default 0, the paper's n_V). Flattens large planar
+    /// faces (the nut's sides); on curved models it can make the surface less fair.
+    pub ring_normals: f64,
 }
 
 impl Default for InnerOptions {
@@ -101,21 +108,24 @@ impl Default for InnerOptions {
             trihedral_level: 0.5,
             fix_normals: true,
             planar_tolerance: planar::DEFAULT_TOLERANCE,
+            ring_normals: 0.0,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 4] = [
+    pub const KEYS: [&'static str; 5] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
         "planar_tolerance",
+        "ring_normals",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
-    /// (boolean) and `planar_tolerance` (number ≥ 0, or `false` for no split) from a scene's `[scheme]` table; absent keys keep their defaults, other keys
+    /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
+    /// (number in [0, 1]) from a scene's `[scheme]` table; absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -152,6 +162,14 @@ impl InnerOptions {
                 )));
             }
             o.trihedral_level = l;
+        }
+        if let Some(b) = number("ring_normals")? {
+            if !(0.0..=1.0).contains(&b) {
+                return Err(bad(format!(
+                    "`scheme.ring_normals` = {b}: must lie in [0, 1]"
+                )));
+            }
+            o.ring_normals = b;
         }
         match table.get("planar_tolerance") {
             None => {}
@@ -211,6 +229,8 @@ pub struct InnerReport {
     pub remeshed: Vec<remesh::RemeshedCorner>,
     /// Triangles whose degenerate face tetrahedra were rebuilt over their base ([`degenerate`]).
     pub degenerate_repaired: usize,
+    /// Pseudo-centroid normals turned towards their large faces ([`normals`], `ring_normals`).
+    pub ring_normals: usize,
     /// Apexes moved back inside the wedge of a fold of T ([`wedge`]).
     pub wedged: usize,
     /// Folded-back edges of T between pseudo-centroid pairs replaced by the other diagonal
@@ -391,6 +411,7 @@ pub fn build_with_report(
     }
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
+    report.ring_normals = normals::flatten_ring_normals(&mut hull, options.ring_normals);
     report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
     report.wedged = wedge::keep_in_wedges(&mut hull);
