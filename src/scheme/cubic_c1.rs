@@ -694,8 +694,9 @@ pub fn options_from_toml(
             }
             _ => {
                 return Err(bad(format!(
-                    "unknown key `scheme.{k}` (cubic-c1 has alpha, trihedral_level, fix_normals, \
-                     level, center, gradient_scale, levels, free)"
+                    "unknown key `scheme.{k}` (cubic-c1 has {}, level, center, gradient_scale, \
+                     levels, free)",
+                    InnerOptions::KEYS.join(", ")
                 )))
             }
         }
@@ -729,6 +730,33 @@ pub fn build_from_scene(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An unknown `[scheme]` key is an error naming the key and listing every key the scheme
+    /// accepts, the hull's included (they were listed by hand and missed `planar_tolerance`).
+    #[test]
+    fn unknown_key_error_lists_every_accepted_key() {
+        let table: toml::Table = toml::from_str("levl = 0.4").unwrap();
+        let err = options_from_toml(&table, Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("scheme.levl"), "{err}");
+        for k in InnerOptions::KEYS
+            .iter()
+            .chain(&["level", "center", "levels", "free"])
+        {
+            assert!(err.contains(k), "`{k}` missing from: {err}");
+        }
+        let quintic =
+            crate::scheme::quintic_c2::QuinticOptions::from_toml(&table, Path::new("s.toml"))
+                .unwrap_err()
+                .to_string();
+        for k in InnerOptions::KEYS
+            .iter()
+            .chain(&["curvature", "hessian_signs"])
+        {
+            assert!(quintic.contains(k), "`{k}` missing from: {quintic}");
+        }
+    }
 
     /// Sign changes of the cubic with Bernstein coefficients `c` sampled at 400 points of
     /// (0, 1) (values within 1e-14 of zero skipped: rounding of weights of size 1).
