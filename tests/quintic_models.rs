@@ -604,6 +604,12 @@ fn relaxed_stars_close_the_torus_holes() {
 /// (the surface crosses the face). Values within 1e-12 of the largest weight count as zero
 /// (F = 0 at the points of T, which lie on the faces).
 fn boundary_faces_crossed(c: &apatch::complex::PatchComplex) -> usize {
+    crossed_boundary_faces(c).0.len()
+}
+
+/// The crossed boundary faces of [`boundary_faces_crossed`], each as (patch, opposite corner),
+/// with the largest weight magnitude that scales "zero".
+fn crossed_boundary_faces(c: &apatch::complex::PatchComplex) -> (Vec<(usize, usize)>, f64) {
     let key = |v: [f64; 3]| v.map(f64::to_bits);
     let mut users: std::collections::HashMap<[[u64; 3]; 3], usize> =
         std::collections::HashMap::new();
@@ -625,8 +631,8 @@ fn boundary_faces_crossed(c: &apatch::complex::PatchComplex) -> usize {
         .iter()
         .flat_map(|p| p.weights.iter())
         .fold(0.0_f64, |a, w| a.max(w.abs()));
-    let mut crossed = 0;
-    for p in &c.patches {
+    let mut crossed = Vec::new();
+    for (k, p) in c.patches.iter().enumerate() {
         for opp in 0..4 {
             if users[&face_key(p, opp)] != 1 {
                 continue;
@@ -646,11 +652,11 @@ fn boundary_faces_crossed(c: &apatch::complex::PatchComplex) -> usize {
                 }
             }
             if pos && neg {
-                crossed += 1;
+                crossed.push((k, opp));
             }
         }
     }
-    crossed
+    (crossed, wmax)
 }
 
 /// Exploration: every boundary face of a scene's complex that the surface crosses (as in
@@ -663,82 +669,40 @@ fn boundary_crossing_causes() {
     let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
     let sc = apatch::scene::load(&path).unwrap();
     let c = apatch::scene::build_complex(&sc).unwrap();
-    let key = |v: [f64; 3]| v.map(f64::to_bits);
-    let mut users: std::collections::HashMap<[[u64; 3]; 3], usize> =
-        std::collections::HashMap::new();
-    let face_key = |p: &apatch::complex::Patch, opp: usize| {
-        let mut f: Vec<[u64; 3]> = (0..4)
-            .filter(|&k| k != opp)
-            .map(|k| key(p.tet[k]))
-            .collect();
-        f.sort_unstable();
-        [f[0], f[1], f[2]]
-    };
-    for p in &c.patches {
-        for opp in 0..4 {
-            *users.entry(face_key(p, opp)).or_insert(0) += 1;
-        }
-    }
-    let wmax = c
-        .patches
-        .iter()
-        .flat_map(|p| p.weights.iter())
-        .fold(0.0_f64, |a, w| a.max(w.abs()));
+    let (crossed, wmax) = crossed_boundary_faces(&c);
     let mi = apatch::bb::multi_indices(5);
     let mut by_kind: std::collections::BTreeMap<String, usize> = Default::default();
-    for (k, p) in c.patches.iter().enumerate() {
+    for (k, opp) in crossed {
+        let p = &c.patches[k];
         let edge = p.role == apatch::complex::Role::Edge;
         let n_t = if edge { 2 } else { 3 };
         let s = p.weights[apatch::bb::index_of([0, 0, 0, 5])].signum();
-        for opp in 0..4 {
-            if users[&face_key(p, opp)] != 1 {
+        let mut misses = String::new();
+        for (i, l) in mi.iter().enumerate() {
+            if l[opp] != 0 {
                 continue;
             }
-            let m = 15;
-            let (mut pos, mut neg) = (false, false);
-            for i in 0..=m {
-                for j in 0..=m - i {
-                    let mut b = [0.0; 4];
-                    let others: Vec<usize> = (0..4).filter(|&k| k != opp).collect();
-                    b[others[0]] = i as f64 / m as f64;
-                    b[others[1]] = j as f64 / m as f64;
-                    b[others[2]] = (m - i - j) as f64 / m as f64;
-                    let f = p.value_bary(b);
-                    pos |= f > 1e-12 * wmax;
-                    neg |= f < -1e-12 * wmax;
-                }
+            let level = if edge { l[2] + l[3] } else { l[3] };
+            let w = p.weights[i];
+            let bad = (level == 0 && w * s > 1e-12 * wmax) || (level >= 2 && w * s < -1e-12 * wmax);
+            if bad {
+                let mult = l[..n_t].iter().max().copied().unwrap_or(0);
+                let kind = match mult {
+                    3.. => "jet",
+                    2 if l[..n_t].iter().filter(|&&x| x == 2).count() == 2 => "edge-middle",
+                    2 => "star",
+                    _ => "far",
+                };
+                *by_kind
+                    .entry(format!("{:?} opp {opp} level {level} {kind}", p.role))
+                    .or_insert(0) += 1;
+                misses += &format!(" {l:?}={w:.2e}({kind})");
             }
-            if !(pos && neg) {
-                continue;
-            }
-            let mut misses = String::new();
-            for (i, l) in mi.iter().enumerate() {
-                if l[opp] != 0 {
-                    continue;
-                }
-                let level = if edge { l[2] + l[3] } else { l[3] };
-                let w = p.weights[i];
-                let bad =
-                    (level == 0 && w * s > 1e-12 * wmax) || (level >= 2 && w * s < -1e-12 * wmax);
-                if bad {
-                    let mult = l[..n_t].iter().max().copied().unwrap_or(0);
-                    let kind = match mult {
-                        3.. => "jet",
-                        2 if l[..n_t].iter().filter(|&&x| x == 2).count() == 2 => "edge-middle",
-                        2 => "star",
-                        _ => "far",
-                    };
-                    *by_kind
-                        .entry(format!("{:?} opp {opp} level {level} {kind}", p.role))
-                        .or_insert(0) += 1;
-                    misses += &format!(" {l:?}={w:.2e}({kind})");
-                }
-            }
-            eprintln!(
-                "patch {k} {:?} el {} face opp {opp} crossed; misses{misses}",
-                p.role, p.element
-            );
         }
+        eprintln!(
+            "patch {k} {:?} el {} face opp {opp} crossed; misses{misses}",
+            p.role, p.element
+        );
     }
     eprintln!("{by_kind:#?}");
 }
