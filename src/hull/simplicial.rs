@@ -90,6 +90,26 @@ pub struct EdgeTet {
 }
 
 impl SimplicialHull {
+    /// The points of T joined to each point by an edge of T, each once, in the order the
+    /// triangles first name them (callers that sum over neighbours rely on that order).
+    #[must_use]
+    pub fn point_neighbours(&self) -> Vec<Vec<u32>> {
+        let mut nbrs: Vec<Vec<u32>> = vec![Vec::new(); self.points.len()];
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3]);
+                if !nbrs[a].contains(&b) {
+                    nbrs[a].push(b);
+                }
+                let (a, b) = (t[(k + 1) % 3] as usize, t[k]);
+                if !nbrs[a].contains(&b) {
+                    nbrs[a].push(b);
+                }
+            }
+        }
+        nbrs
+    }
+
     /// The face tetrahedron `[p_i p_j p_k q]` of `triangle` on `side`, if built.
     #[must_use]
     pub fn face_tet(&self, triangle: usize, side: Side) -> Option<[DVec3; 4]> {

@@ -27,19 +27,7 @@ pub fn flatten_ring_normals(hull: &mut SimplicialHull, beta: f64) -> usize {
         return 0;
     }
     let n = hull.points.len();
-    let mut nbrs: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for t in &hull.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3]);
-            if !nbrs[a].contains(&b) {
-                nbrs[a].push(b);
-            }
-            let (a, b) = (t[(k + 1) % 3] as usize, t[k]);
-            if !nbrs[a].contains(&b) {
-                nbrs[a].push(b);
-            }
-        }
-    }
+    let nbrs = hull.point_neighbours();
     let mut changed = 0;
     #[allow(clippy::needless_range_loop)] // i indexes points, normals, origins and nbrs
     for i in 0..n {

@@ -182,7 +182,6 @@ pub fn fairness(complex: &PatchComplex) -> Fairness {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::complex::{Patch, SheetRule};
 
     /// One face patch over the triangle z = 0 with normals +z whose surface is the plane
     /// z = 0.3: the deviation is 0 everywhere; with a bump it is not.
@@ -211,17 +210,10 @@ mod tests {
             let mut c = PatchComplex::new("test");
             c.vertices = tet[..3].to_vec();
             c.normals = vec![[0.0, 0.0, 1.0]; 3];
-            c.patches.push(Patch {
-                tet,
-                degree: 3,
-                weights,
-                rational: Vec::new(),
-                sheet: SheetRule::Any,
-                role: Role::Face,
-                element: 0,
-                jvertex: Some(3),
-                jedge: None,
-            });
+            let mut p = crate::fixtures::plain_patch(tet.map(DVec3::from), 3, weights);
+            p.role = Role::Face;
+            p.jvertex = Some(3);
+            c.patches.push(p);
             c
         };
         let flat = fairness(&make(0.0));

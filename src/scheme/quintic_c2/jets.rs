@@ -48,19 +48,7 @@ impl Jet {
 #[must_use]
 pub fn estimate(hull: &SimplicialHull, curvature: f64) -> Vec<Jet> {
     let np = hull.points.len();
-    let mut nbrs: Vec<Vec<u32>> = vec![Vec::new(); np];
-    for t in &hull.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3]);
-            if !nbrs[a].contains(&b) {
-                nbrs[a].push(b);
-            }
-            let (a, b) = (t[(k + 1) % 3] as usize, t[k]);
-            if !nbrs[a].contains(&b) {
-                nbrs[a].push(b);
-            }
-        }
-    }
+    let nbrs = hull.point_neighbours();
     (0..np)
         .map(|i| {
             let p = hull.points[i];
