@@ -14,6 +14,8 @@ import argparse
 import pathlib
 import subprocess
 
+from cut_distances import with_keys  # same [scheme] rewriting as the distance table
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SCENE = ROOT / "scenes/paper1994/octahedron.toml"
 OUT = ROOT / "renders/paper1994/shape_control_octahedron.png"
@@ -25,23 +27,6 @@ PANELS = [
     ("alpha07", {"alpha": "0.7"}),
     ("levels", {"levels": '{ "0" = 0.8, "1" = 0.8 }'}),
 ]
-
-
-def with_keys(text, keys):
-    """The scene text with `keys` set in its [scheme] table."""
-    out, in_scheme = [], False
-    for line in text.splitlines():
-        stripped = line.strip()
-        if stripped.startswith("["):
-            in_scheme = stripped == "[scheme]"
-            out.append(line)
-            if in_scheme:
-                out.extend(f"{k} = {v}" for k, v in keys.items())
-            continue
-        if in_scheme and stripped.split("=")[0].strip() in keys:
-            continue
-        out.append(line)
-    return "\n".join(out) + "\n"
 
 
 def main():
