@@ -149,20 +149,37 @@ fn polyhedron_distance(
     check::distance::distance_to_polyhedron(complex, &tri.positions, &faces, 6)
 }
 
-/// What the 1994 schemes' planar split (`hull::inner::planar`) does to the scene's mesh: the
-/// tolerance and the split, `None` when nothing is split (or the scene is no mesh scene).
-fn planar_split(
-    scene: &apatch::scene::Scene,
-) -> anyhow::Result<Option<(f64, apatch::hull::inner::planar::PlanarSplit)>> {
+/// The 1994 schemes' mesh repairs before the hull.
+type HullRepairs = (
+    Option<(f64, apatch::hull::inner::close::CloseMerge)>,
+    Option<(f64, apatch::hull::inner::planar::PlanarSplit)>,
+);
+
+/// What the 1994 schemes' close-vertex merge (`hull::inner::close`, opt-in) and planar split
+/// (`hull::inner::planar`) do to the scene's mesh: each with its threshold, `None` when it
+/// changes nothing (or the scene is no mesh scene). The split's faces are the input's.
+fn hull_repairs(scene: &apatch::scene::Scene) -> anyhow::Result<HullRepairs> {
     let apatch::scene::Model::Mesh { file, scheme, .. } = &scene.model else {
-        return Ok(None);
+        return Ok((None, None));
     };
     let options = apatch::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
     let (m, _) = apatch::mesh::load(file)?;
-    Ok(
-        apatch::hull::inner::planar::split_nonplanar(&m, options.planar_tolerance)
-            .map(|s| (options.planar_tolerance, s)),
-    )
+    let merged = apatch::hull::inner::close::merge_close_vertices(&m, &[], options.merge_close)?;
+    let mesh = merged.as_ref().map_or(&m, |c| &c.mesh);
+    let split = apatch::hull::inner::planar::split_nonplanar(mesh, options.planar_tolerance).map(
+        |mut s| {
+            if merged.is_some() {
+                for f in &mut s.faces {
+                    f.face = mesh.face_parent[f.face as usize];
+                }
+                for f in &mut s.kept {
+                    *f = mesh.face_parent[*f as usize];
+                }
+            }
+            (options.planar_tolerance, s)
+        },
+    );
+    Ok((merged.map(|c| (options.merge_close, c)), split))
 }
 
 /// One line per hull violation: the condition, the triangle of T, the detail.
@@ -197,9 +214,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         ),
         _ => (None, None),
     };
-    let split = match &scene {
-        Some(s) => planar_split(s)?,
-        None => None,
+    let (merged, split) = match &scene {
+        Some(s) => hull_repairs(s)?,
+        None => (None, None),
     };
     let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);
     let (subdivided, welded) = mesh_repairs(scene.as_ref());
@@ -223,6 +240,16 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         if let Some(info) = &build_info {
             out.insert("mesh_build".into(), serde_json::to_value(info)?);
+        }
+        if let Some((t, c)) = &merged {
+            out.insert(
+                "merge_close".into(),
+                serde_json::json!({
+                    "threshold": t,
+                    "clusters": c.clusters,
+                    "dropped_faces": c.dropped_faces,
+                }),
+            );
         }
         if let Some((tolerance, sp)) = &split {
             out.insert(
@@ -275,6 +302,15 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                     String::new()
                 },
                 info.refined_edges
+            );
+        }
+        if let Some((t, c)) = &merged {
+            println!(
+                "close merge      {} clusters of vertices closer than {t:e} of the bounding-box \
+                 diagonal made one corner of T each, {} sliver faces dropped before the hull \
+                 (`scheme.merge_close`)  info",
+                c.clusters.len(),
+                c.dropped_faces.len()
             );
         }
         if let Some((tolerance, sp)) = &split {

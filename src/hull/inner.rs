@@ -3,7 +3,10 @@
 //! ([`SimplicialHull`], Definition 3.6).
 //!
 //! Pipeline ([`build_with_report`]):
-//! 0. [`planar`]: polygons that are not planar (beyond [`InnerOptions::planar_tolerance`] of
+//! 0. [`close`] (opt-in, [`InnerOptions::merge_close`]): vertices of one polygon closer than a
+//!    share of the bounding-box diagonal become one corner of T (near-duplicate crease rings of
+//!    control cages; no vertex moves, the sliver faces between them drop out).
+//!    [`planar`]: polygons that are not planar (beyond [`InnerOptions::planar_tolerance`] of
 //!    their size: subdivision control cages) are split into triangles, no vertex moved, with
 //!    diagonals that fold like their neighbouring edges. (The mesh must be a closed 2-manifold;
 //!    [`closed::require_closed`] says why one is not, for the scenes.)
@@ -55,6 +58,7 @@
 
 pub mod above;
 pub mod clearance;
+pub mod close;
 pub mod closed;
 pub mod coplanar;
 pub mod corner;
@@ -99,6 +103,10 @@ pub struct InnerOptions {
     /// ([`normals::flatten_ring_normals`]; default 0, the paper's n_V). Flattens large planar
     /// faces (the nut's sides); on curved models it can make the surface less fair.
     pub ring_normals: f64,
+    /// Vertices of one polygon closer than this share of the bounding-box diagonal are merged
+    /// into one corner of T before everything else ([`close`]; default 0: off). For cages with
+    /// near-duplicate crease rings (spot_control_cage).
+    pub merge_close: f64,
 }
 
 impl Default for InnerOptions {
@@ -109,23 +117,25 @@ impl Default for InnerOptions {
             fix_normals: true,
             planar_tolerance: planar::DEFAULT_TOLERANCE,
             ring_normals: 0.0,
+            merge_close: 0.0,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 5] = [
+    pub const KEYS: [&'static str; 6] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
         "planar_tolerance",
         "ring_normals",
+        "merge_close",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
-    /// (number in [0, 1]) from a scene's `[scheme]` table; absent keys keep their defaults, other keys
+    /// (number in [0, 1]) and `merge_close` (number in [0, 0.05]) from a scene's `[scheme]` table; absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -170,6 +180,15 @@ impl InnerOptions {
                 )));
             }
             o.ring_normals = b;
+        }
+        if let Some(t) = number("merge_close")? {
+            // Beyond 5 % of the diagonal whole features would merge: surely a typo.
+            if !(0.0..=0.05).contains(&t) {
+                return Err(bad(format!(
+                    "`scheme.merge_close` = {t}: must lie in [0, 0.05] (a share of the bounding-box diagonal)"
+                )));
+            }
+            o.merge_close = t;
         }
         match table.get("planar_tolerance") {
             None => {}
@@ -238,6 +257,9 @@ pub struct InnerReport {
     pub flipped_folds: usize,
     /// Apexes lifted over their base vertices' tangent planes ([`clearance`]).
     pub lifted_apexes: usize,
+    /// Clusters of near-duplicate vertices merged into one corner of T ([`close`],
+    /// `merge_close`), representative first.
+    pub merged_clusters: Vec<Vec<u32>>,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -278,11 +300,26 @@ pub fn build_with_report(
         )));
     }
     let mut report = InnerReport::default();
+    // Near-duplicate corners (opt-in): one corner of T per cluster.
+    let close = close::merge_close_vertices(mesh, normals, options.merge_close)?;
+    let (mesh, normals) = match &close {
+        Some(c) => {
+            report.merged_clusters.clone_from(&c.clusters);
+            (&c.mesh, &c.normals[..])
+        }
+        None => (mesh, normals),
+    };
     // Polygons that are not planar are split into triangles (no vertex moves).
     let split = planar::split_nonplanar(mesh, options.planar_tolerance);
     let mesh = match &split {
         Some(s) => {
             report.planar_split.clone_from(&s.faces);
+            // Faces named as the input's (the close-vertex merge may have dropped some).
+            if close.is_some() {
+                for sf in &mut report.planar_split {
+                    sf.face = mesh.face_parent[sf.face as usize];
+                }
+            }
             &s.mesh
         }
         None => mesh,

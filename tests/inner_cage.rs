@@ -1,0 +1,208 @@
+//! Near-duplicate vertex rings (subdivision cages' crease trick, spot_control_cage's horn
+//! bases) merged into one corner of T before the inner hull (`hull::inner::close`, scene key
+//! `scheme.merge_close`).
+
+use apatch::check::{check, CheckOptions};
+use apatch::hull::inner::{self, InnerOptions, ViolationKind};
+use apatch::mesh::{self, Mesh, NormalMethod};
+use glam::DVec3;
+use std::collections::HashMap;
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+
+/// An n-gonal "horn" standing on a block, joined through a crease ring: the block (radius 2,
+/// z from −1 to its top rim at z = −0.5) slopes up to the valley ring A (radius 1, z = 0); a
+/// strip of sliver quads leads from A to ring B, `gap` inwards and `gap` up (turned by `twist`
+/// radians: the slivers are then bent), from which the horn's walls rise to its top at z = 1.
+/// With `gap` = 0 the two rings coincide: the polyhedron the merge should give. Every vertex of
+/// A and B has four faces (two slivers), like the cage's horn-base rings.
+fn horn(n: usize, gap: f64, twist: f64) -> Mesh {
+    let mut positions = Vec::new();
+    let mut ring = |radius: f64, z: f64, turn: f64| -> Vec<u32> {
+        (0..n)
+            .map(|k| {
+                let a = TAU * k as f64 / n as f64 + turn;
+                positions.push(DVec3::new(radius * a.cos(), radius * a.sin(), z));
+                (positions.len() - 1) as u32
+            })
+            .collect()
+    };
+    let bottom = ring(2.0, -1.0, 0.0);
+    let rim = ring(2.0, -0.5, 0.0);
+    let a = ring(1.0, 0.0, 0.0);
+    let b = ring(1.0 - gap, gap, twist);
+    let top = ring(1.0, 1.0, 0.0);
+    let mut faces = vec![bottom.iter().rev().copied().collect::<Vec<u32>>()];
+    for k in 0..n {
+        let j = (k + 1) % n;
+        faces.push(vec![bottom[k], bottom[j], rim[j], rim[k]]);
+        faces.push(vec![rim[k], rim[j], a[j], a[k]]);
+        if gap > 0.0 {
+            faces.push(vec![a[k], a[j], b[j], b[k]]);
+            faces.push(vec![b[k], b[j], top[j], top[k]]);
+        } else {
+            faces.push(vec![a[k], a[j], top[j], top[k]]);
+        }
+    }
+    faces.push(top);
+    Mesh::new(positions, faces)
+}
+
+/// Writes `mesh` as an OBJ and a cubic-c1 scene with the extra `[scheme]` lines `scheme` into a
+/// fresh directory under the system's temporary directory; returns the scene's path.
+fn write_scene(name: &str, mesh: &Mesh, scheme: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("apatch_inner_cage_{}_{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut obj = String::new();
+    for p in &mesh.positions {
+        obj.push_str(&format!("v {:.17} {:.17} {:.17}\n", p.x, p.y, p.z));
+    }
+    for f in &mesh.faces {
+        let idx: Vec<String> = f.iter().map(|v| (v + 1).to_string()).collect();
+        obj.push_str(&format!("f {}\n", idx.join(" ")));
+    }
+    std::fs::write(dir.join("m.obj"), obj).unwrap();
+    let scene = format!(
+        "[model]\nfile = \"m.obj\"\nnormals = \"angle\"\n[scheme]\ntype = \"cubic-c1\"\n{scheme}\n\
+         [camera]\norigin = [4, 3, 5]\ntarget = [0, 0, 0]\nfov = 30\nwidth = 8\nheight = 8\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [-1, -1, -1]\nirradiance = 2.0\n"
+    );
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    path
+}
+
+/// The scene's hull violations and whether its cubic surface passes `check` (C1 jumps ≤ 1e-9
+/// relative, interpolation, no j-sheets, no holes): what `apatch check` decides.
+fn verdict(path: &Path) -> (usize, bool) {
+    let scene = apatch::scene::load(path).unwrap();
+    let complex = apatch::scene::build_complex(&scene).unwrap();
+    let hull = apatch::scene::inner_hull(&scene).unwrap().unwrap();
+    let violations = inner::verify(&hull).len();
+    (
+        violations,
+        check(&complex, &CheckOptions::default()).passed(),
+    )
+}
+
+/// A crease ring of near-duplicate vertices (1e-3 apart, flat or bent slivers) fails as it is:
+/// T folds back between each close pair, tetrahedra overlap, the surface leaves the hull. With
+/// `merge_close` (0.002 of the diagonal 5.8: 0.012, above the rings' 1.4e-3 and far below
+/// every other edge, ≥ 0.39) each pair is one corner of T: the hull verifies and the surface
+/// passes `check`, as the polyhedron with the rings made one (gap 0, independent truth that
+/// the merged geometry is sound) does. Measured when written: 504 (flat) and 2224 (bent)
+/// violations without the merge.
+#[test]
+fn close_crease_ring_fails_alone_and_passes_merged() {
+    let (v, passed) = verdict(&write_scene("one_ring", &horn(8, 0.0, 0.0), ""));
+    assert!(v == 0 && passed, "the single ring: {v} violations");
+    for (name, twist) in [("flat", 0.0), ("bent", 0.01)] {
+        let m = horn(8, 1e-3, twist);
+        let (v, passed) = verdict(&write_scene(name, &m, ""));
+        assert!(v > 0 && !passed, "{name}: the unmerged ring passed");
+        let merged = write_scene(&format!("{name}_merged"), &m, "merge_close = 0.002");
+        let (v, passed) = verdict(&merged);
+        assert!(v == 0 && passed, "{name} merged: {v} violations");
+    }
+}
+
+/// What the merge does to the mesh: every A/B pair becomes one vertex (the lower index, at
+/// its own place: no vertex moves), the slivers drop out, the rest is the single-ring
+/// polyhedron's faces, and the hull's report lists the clusters.
+#[test]
+fn merge_collapses_each_pair_and_drops_the_slivers() {
+    let n = 8;
+    let m = horn(n, 1e-3, 0.01);
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let c = inner::close::merge_close_vertices(&m, &normals, 0.002)
+        .unwrap()
+        .unwrap();
+    let (a0, b0) = (2 * n as u32, 3 * n as u32);
+    let want: Vec<Vec<u32>> = (0..n as u32).map(|k| vec![a0 + k, b0 + k]).collect();
+    assert_eq!(c.clusters, want);
+    assert_eq!(c.mesh.positions, m.positions);
+    let slivers: Vec<u32> = (0..n as u32).map(|k| 3 + 4 * k).collect();
+    assert_eq!(c.dropped_faces, slivers);
+    let single = horn(n, 0.0, 0.0);
+    // The merged faces are the single-ring polyhedron's (its unused ring B numbered alike).
+    assert_eq!(c.mesh.faces, single.faces);
+    let options = InnerOptions {
+        merge_close: 0.002,
+        ..InnerOptions::default()
+    };
+    let (_, report) = inner::build_with_report(&m, &normals, &options).unwrap();
+    assert_eq!(report.merged_clusters, want);
+    // Off (the default): nothing is merged.
+    assert!(inner::close::merge_close_vertices(&m, &normals, 0.0)
+        .unwrap()
+        .is_none());
+}
+
+/// The key is read as a share of the bounding-box diagonal in [0, 0.05]; out of range or of
+/// the wrong type is an error naming the key.
+#[test]
+fn merge_close_key_is_parsed_and_checked() {
+    let read = |s: &str| {
+        let t: toml::Table = toml::from_str(s).unwrap();
+        InnerOptions::from_toml(&t, Path::new("s.toml"))
+    };
+    assert_eq!(read("merge_close = 0.004").unwrap().merge_close, 0.004);
+    assert_eq!(read("").unwrap().merge_close, 0.0);
+    for bad in [
+        "merge_close = -1e-3",
+        "merge_close = 0.2",
+        "merge_close = true",
+    ] {
+        let e = read(bad).unwrap_err().to_string();
+        assert!(e.contains("merge_close"), "{bad}: {e}");
+    }
+}
+
+/// The elements (input vertices) a violation message names.
+fn elements(message: &str) -> Vec<u32> {
+    message
+        .split("element ")
+        .skip(1)
+        .filter_map(|s| {
+            s.split(|c: char| !c.is_ascii_digit())
+                .next()
+                .and_then(|d| d.parse().ok())
+        })
+        .collect()
+}
+
+/// Survey: a scene's hull violations by kind, by element and by element pair (default the
+/// cage; `CAGE_SCENE=path` for another).
+/// `cargo test --release --test inner_cage survey -- --ignored --nocapture`
+#[test]
+#[ignore = "survey: prints hull violations by kind and location"]
+fn survey_cage_violations() {
+    let path = std::env::var("CAGE_SCENE")
+        .unwrap_or_else(|_| "scenes/pending/paper1994/spot_control_cage.toml".into());
+    let scene = apatch::scene::load(Path::new(&path)).unwrap();
+    let hull = apatch::scene::inner_hull(&scene).unwrap().unwrap();
+    let v = inner::verify(&hull);
+    let mut by_kind: HashMap<ViolationKind, usize> = HashMap::new();
+    let mut by_element: HashMap<u32, usize> = HashMap::new();
+    let mut by_pair: HashMap<(u32, u32), usize> = HashMap::new();
+    for x in &v {
+        *by_kind.entry(x.kind).or_default() += 1;
+        let e = elements(&x.message);
+        for &k in &e {
+            *by_element.entry(k).or_default() += 1;
+        }
+        if let [a, b] = e[..] {
+            *by_pair.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    println!("{} violations: {by_kind:?}", v.len());
+    let mut els: Vec<_> = by_element.into_iter().collect();
+    els.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    println!("by element: {:?}", &els[..els.len().min(40)]);
+    let mut pairs: Vec<_> = by_pair.into_iter().collect();
+    pairs.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    println!("by pair: {:?}", &pairs[..pairs.len().min(30)]);
+    for x in v.iter().filter(|x| x.kind != ViolationKind::Intersecting) {
+        println!("  {:?}: {}", x.kind, x.message);
+    }
+}
