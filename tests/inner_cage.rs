@@ -206,3 +206,42 @@ fn survey_cage_violations() {
         println!("  {:?}: {}", x.kind, x.message);
     }
 }
+
+/// Dump: a scene's hull (after the cubic scheme's apex moves) as JSON for offline analysis:
+/// `CAGE_SCENE=… HULL_DUMP=out.json cargo test --release --test inner_cage dump -- --ignored`.
+#[test]
+#[ignore = "writes a hull dump for analysis"]
+fn dump_hull() {
+    let path = std::env::var("CAGE_SCENE")
+        .unwrap_or_else(|_| "scenes/pending/paper1994/spot_control_cage.toml".into());
+    let out = std::env::var("HULL_DUMP").unwrap_or_else(|_| "/tmp/hull_dump.json".into());
+    let scene = apatch::scene::load(Path::new(&path)).unwrap();
+    let hull = apatch::scene::inner_hull(&scene).unwrap().unwrap();
+    let v3 = |p: DVec3| format!("[{:e},{:e},{:e}]", p.x, p.y, p.z);
+    let origin = |o: &apatch::hull::simplicial::PointOrigin| {
+        use apatch::hull::simplicial::PointOrigin::*;
+        match o {
+            Centroid { face } => format!("[\"C\",{face}]"),
+            CornerGuard { face } => format!("[\"G\",{face}]"),
+            PseudoCentroid { vertex } => format!("[\"P\",{vertex}]"),
+            Other => "[\"O\",0]".into(),
+        }
+    };
+    let list = |v: Vec<String>| format!("[{}]", v.join(","));
+    let apex = |a: &Option<DVec3>| a.map_or("null".into(), v3);
+    let json = format!(
+        "{{\"points\":{},\"normals\":{},\"origins\":{},\"triangles\":{},\"apexes\":{},\"element\":{}}}",
+        list(hull.points.iter().map(|&p| v3(p)).collect()),
+        list(hull.normals.iter().map(|&p| v3(p)).collect()),
+        list(hull.origins.iter().map(origin).collect()),
+        list(hull.triangles.iter().map(|t| format!("{t:?}")).collect()),
+        list(
+            hull.apexes
+                .iter()
+                .map(|a| format!("[{},{}]", apex(&a[0]), apex(&a[1])))
+                .collect()
+        ),
+        list(hull.element.iter().map(|e| e.to_string()).collect()),
+    );
+    std::fs::write(out, json).unwrap();
+}
