@@ -30,7 +30,8 @@
 //!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
 //!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
 //!    Before that, [`unfold`] flips edges of T that fold back between two pseudo-centroids
-//!    (short polyhedron edges between non-trihedral vertices).
+//!    (short polyhedron edges between non-trihedral vertices), and [`umbrella`] turns the
+//!    normals of pseudo-centroids whose fan triangles stand almost edge-on to them.
 //! 6. [`wedge`]: where T folds, apexes of step (5) triangles that lean across the plane
 //!    bisecting the fold (into the neighbour's tetrahedra) are moved the least distance back
 //!    inside their wedge, keeping tangent containment and the least height (beyond the paper;
@@ -70,6 +71,7 @@ pub mod normals;
 pub mod planar;
 pub mod remesh;
 pub mod sides;
+pub mod umbrella;
 pub mod unfold;
 pub mod verify;
 pub mod wedge;
@@ -260,6 +262,9 @@ pub struct InnerReport {
     /// Clusters of near-duplicate vertices merged into one corner of T ([`close`],
     /// `merge_close`), representative first.
     pub merged_clusters: Vec<Vec<u32>>,
+    /// Points of T (pseudo-centroids) whose normals were turned to face their fan triangles
+    /// ([`umbrella`]).
+    pub umbrella_normals: Vec<u32>,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -450,6 +455,7 @@ pub fn build_with_report(
     net.add_edge_cells(&mut hull, &mesh.positions);
     report.ring_normals = normals::flatten_ring_normals(&mut hull, options.ring_normals);
     report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
+    report.umbrella_normals = umbrella::face_fans(&mut hull);
     report.sides = sides::settle(&mut hull);
     report.wedged = wedge::keep_in_wedges(&mut hull);
     report.lifted_apexes = clearance::lift_apexes(&mut hull);
