@@ -526,15 +526,25 @@ impl GuardNet {
 const SLIDE_ACROSS_WEIGHT: f64 = 10.0;
 
 /// The outward move of a one-triangle cell's apex off its edge: along the bisector of the two
-/// faces' normals, [`CELL_LIFT`] of the single guard `g`'s distance from the edge line.
+/// faces' normals, [`CELL_LIFT`] of the single guard `g`'s distance from the edge line, that
+/// distance capped at [`CELL_LIFT_REACH`] edge lengths.
 fn cell_lift(hull: &SimplicialHull, positions: &[DVec3], cell: &EdgeCell, g: u32) -> DVec3 {
     let (v1, v2) = (positions[cell.v[0] as usize], positions[cell.v[1] as usize]);
     let e = (v2 - v1).normalize_or_zero();
     let out =
         (hull.normals[cell.g[0] as usize] + hull.normals[cell.g[2] as usize]).normalize_or_zero();
     let d = hull.points[g as usize] - v1;
-    CELL_LIFT * (d - d.dot(e) * e).length() * out
+    let reach = (d - d.dot(e) * e).length();
+    CELL_LIFT * reach.min(CELL_LIFT_REACH * (v2 - v1).length()) * out
 }
+
+/// Cap on the guard distance [`cell_lift`] scales by, in units of the cell's edge V_1V_2: the
+/// lift comes from the local scale. mpi_poly's edge 74–77 (1.5 long) has its single guard (face
+/// 8's kernel guard) 10 away: uncapped, the apex rose 1.7 out of the polyhedron and its
+/// tetrahedron, over a nearly flat stretch of T (a 0.1° fold), covered its neighbours' (58
+/// overlaps); capped, 470 → 351 hull violations on the raw hull. letter_P's guards lie within
+/// their edges' lengths, so its cells do not change.
+pub const CELL_LIFT_REACH: f64 = 1.0;
 
 /// True for a star-shaped non-convex piece (kept whole with its kernel guard).
 fn is_star_only(pieces: &Pieces, p: usize) -> bool {

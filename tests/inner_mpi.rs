@@ -1,0 +1,135 @@
+//! mpi_poly's inner hull (1994, `hull::inner`): nearly flat folds and needle faces.
+//!
+//! The survey (`cargo test --test inner_mpi -- --ignored --nocapture`) prints the hull
+//! violations of `scenes/pending/paper1994/mpi_poly.toml` by kind and by the input element their
+//! triangles were built for, for the raw hull and the hull the cubic scheme fills.
+
+use apatch::hull::inner::{self, HullViolation, InnerOptions};
+use apatch::hull::simplicial::{PointOrigin, SimplicialHull};
+use apatch::mesh::{self, NormalMethod};
+use glam::DVec3;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The triangles of T a violation names (its own, and every "triangle N" in its message).
+fn named_triangles(v: &HullViolation) -> Vec<u32> {
+    let mut out: Vec<u32> = v.triangle.into_iter().collect();
+    let words: Vec<&str> = v.message.split_whitespace().collect();
+    for w in words.windows(2) {
+        if w[0] == "triangle" {
+            if let Ok(t) = w[1].trim_end_matches([',', ':', ')']).parse::<u32>() {
+                if !out.contains(&t) {
+                    out.push(t);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Prints the violations of `hull` by kind, by element and by the input vertex nearest to the
+/// centroid of each named triangle (elements of step (5') cells are edges, so the element
+/// tally mixes vertex and edge numbers; the nearest vertex does not).
+fn tally(label: &str, hull: &SimplicialHull, input: &[DVec3]) -> usize {
+    let v = inner::verify(hull);
+    let mut kinds: BTreeMap<String, usize> = BTreeMap::new();
+    let mut elements: BTreeMap<u32, usize> = BTreeMap::new();
+    let mut near: BTreeMap<usize, usize> = BTreeMap::new();
+    for x in &v {
+        let mut seen_near = Vec::new();
+        for t in named_triangles(x) {
+            let c = hull.triangles[t as usize]
+                .iter()
+                .map(|&i| hull.points[i as usize])
+                .sum::<DVec3>()
+                / 3.0;
+            let k = (0..input.len())
+                .min_by(|&a, &b| (input[a] - c).length().total_cmp(&(input[b] - c).length()))
+                .unwrap();
+            if !seen_near.contains(&k) {
+                seen_near.push(k);
+                *near.entry(k).or_default() += 1;
+            }
+        }
+        *kinds.entry(format!("{:?}", x.kind)).or_default() += 1;
+        let mut seen = Vec::new();
+        for t in named_triangles(x) {
+            let e = hull.element[t as usize];
+            if !seen.contains(&e) {
+                seen.push(e);
+                *elements.entry(e).or_default() += 1;
+            }
+        }
+    }
+    let mut by_count: Vec<(u32, usize)> = elements.into_iter().collect();
+    by_count.sort_by_key(|&(e, n)| (std::cmp::Reverse(n), e));
+    eprintln!("{label}: {} violations {kinds:?}", v.len());
+    eprintln!("  by element: {:?}", &by_count[..by_count.len().min(30)]);
+    let mut near: Vec<(usize, usize)> = near.into_iter().collect();
+    near.sort_by_key(|&(e, n)| (std::cmp::Reverse(n), e));
+    eprintln!(
+        "  by nearest input vertex: {:?}",
+        &near[..near.len().min(30)]
+    );
+    if std::env::var("MPI_VERBOSE").is_ok() {
+        for x in &v {
+            eprintln!("    {:?}: {}", x.kind, x.message);
+        }
+        for (i, (p, o)) in hull.points.iter().zip(&hull.origins).enumerate() {
+            let o = match o {
+                PointOrigin::Centroid { face } => format!("centroid of face {face}"),
+                PointOrigin::CornerGuard { face } => format!("guard of face {face}"),
+                PointOrigin::PseudoCentroid { vertex } => format!("C_0 of vertex {vertex}"),
+                PointOrigin::Other => "other".into(),
+            };
+            eprintln!("    point {i}: {p:.4} n {:.4} {o}", hull.normals[i]);
+        }
+        for (t, tri) in hull.triangles.iter().enumerate() {
+            eprintln!(
+                "    triangle {t} {tri:?} element {} apexes {:?}",
+                hull.element[t], hull.apexes[t]
+            );
+        }
+    }
+    v.len()
+}
+
+#[test]
+#[ignore = "survey for humans: prints mpi_poly's hull violations by kind and element"]
+fn mpi_poly_survey() {
+    let path = Path::new("scenes/models/mpi_poly.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+    eprintln!(
+        "raw hull: {} points, {} triangles, split {:?}, star {:?}, unseparable {:?}",
+        hull.points.len(),
+        hull.triangles.len(),
+        rep.split_faces,
+        rep.star_faces,
+        rep.unseparable
+    );
+    if std::env::var("MPI_VERBOSE").is_ok() {
+        let merged = inner::coplanar::merge_coplanar(&m);
+        let net = inner::guardnet::GuardNet::build(
+            &merged,
+            inner::decompose::convex_pieces(&merged).unwrap(),
+        );
+        for (i, f) in net.pieces.faces.iter().enumerate() {
+            eprintln!(
+                "    piece {i} of face {} region {}: {f:?} center {:.4}",
+                merged.face_parent[net.pieces.parent[i] as usize],
+                net.region[i],
+                net.pieces.center[i]
+            );
+        }
+        eprintln!("    nets {:?} fallback {:?}", net.nets, net.fallback);
+        for c in &net.cells {
+            eprintln!("    cell {:?} guards {:?}", c.v, c.g);
+        }
+    }
+    tally("raw hull", &hull, &m.positions);
+    let scene = apatch::scene::load(Path::new("scenes/pending/paper1994/mpi_poly.toml")).unwrap();
+    let prepared = apatch::scene::inner_hull(&scene).unwrap().unwrap();
+    tally("scheme's hull", &prepared, &m.positions);
+}
