@@ -133,3 +133,55 @@ fn mpi_poly_survey() {
     let prepared = apatch::scene::inner_hull(&scene).unwrap().unwrap();
     tally("scheme's hull", &prepared, &m.positions);
 }
+
+/// A prism of height `h` over a U (arms `arm` long, 1 wide, gap 1): its caps are no star
+/// (the arms hide each other's tips), so they get a corner guard net, and the side faces'
+/// single centroids lie h/2 from the caps' edges.
+fn u_prism(h: f64, arm: f64) -> apatch::mesh::Mesh {
+    let outline = [
+        (0.0, 0.0),
+        (3.0, 0.0),
+        (3.0, arm),
+        (2.0, arm),
+        (2.0, 1.0),
+        (1.0, 1.0),
+        (1.0, arm),
+        (0.0, arm),
+    ];
+    let n = outline.len() as u32;
+    let mut p = Vec::new();
+    for z in [0.0, h] {
+        p.extend(outline.iter().map(|&(x, y)| DVec3::new(x, y, z)));
+    }
+    let mut faces = vec![(0..n).rev().collect::<Vec<u32>>(), (n..2 * n).collect()];
+    for i in 0..n {
+        let j = (i + 1) % n;
+        faces.push(vec![i, j, j + n, i + n]);
+    }
+    apatch::mesh::Mesh::new(p, faces)
+}
+
+/// A tall U prism (20 high over unit edges): its caps get a corner guard net, and the step
+/// (5') cells along the caps' edges have a side face's centroid, 10 away, as their single
+/// guard. With the cells' apexes lifted by a fifth of that distance (2, over edges 1 long) their
+/// tetrahedra overlapped their neighbours' (44 violations); lifted by the local scale
+/// (`guardnet::CELL_LIFT_REACH`) the hull is smoothable and T is a sphere.
+#[test]
+fn tall_u_prism_cells_lift_by_the_local_scale() {
+    use apatch::hull::inner::verify::euler_characteristic;
+    for arm in [3.0, 5.0] {
+        let m = u_prism(20.0, arm);
+        let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+        let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+        // Both caps are split for a guard net (the feature under test).
+        assert_eq!(rep.split_faces, vec![(0, 3), (1, 3)]);
+        let v = inner::verify(&hull);
+        assert!(
+            v.is_empty(),
+            "arm {arm}: {} violations, first {:?}",
+            v.len(),
+            v.first()
+        );
+        assert_eq!(euler_characteristic(&hull), Some(2));
+    }
+}

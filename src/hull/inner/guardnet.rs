@@ -542,8 +542,10 @@ fn cell_lift(hull: &SimplicialHull, positions: &[DVec3], cell: &EdgeCell, g: u32
 /// lift comes from the local scale. mpi_poly's edge 74–77 (1.5 long) has its single guard (face
 /// 8's kernel guard) 10 away: uncapped, the apex rose 1.7 out of the polyhedron and its
 /// tetrahedron, over a nearly flat stretch of T (a 0.1° fold), covered its neighbours' (58
-/// overlaps); capped, 470 → 351 hull violations on the raw hull. letter_P's guards lie within
-/// their edges' lengths, so its cells do not change.
+/// overlaps); capped, 470 → 351 hull violations on the raw hull. A U prism 20 high over a U of
+/// unit edges (side-face centroids 10 from the caps' edges) had 44 overlaps and now verifies
+/// (`tests/inner_mpi.rs`). letter_P's guards lie within their edges' lengths, so its cells do
+/// not change.
 pub const CELL_LIFT_REACH: f64 = 1.0;
 
 /// True for a star-shaped non-convex piece (kept whole with its kernel guard).
