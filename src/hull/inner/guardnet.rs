@@ -441,8 +441,8 @@ impl GuardNet {
             let half = |qs: &[DVec3]| -> Vec<DVec3> { qs.iter().map(|&q| 0.5 * (q + m)).collect() };
             // One triangle: apex on V_1V_2 (M, or where `cell_slides` puts it), moved out of
             // the polyhedron along the bisector of the two faces' normals by CELL_LIFT of the
-            // single guard's distance from the edge. The edge lies in both face planes (the
-            // guards' tangent planes); moved outwards the apex stays tangent-containing (the triangle's points are on the planes' inner sides or on
+            // single guard's distance from the edge (at most CELL_LIFT_REACH edge lengths).
+            // The edge lies in both face planes (the guards' tangent planes); moved outwards the apex stays tangent-containing (the triangle's points are on the planes' inner sides or on
             // them). With M itself, the edge tetrahedra between two such cells over one net
             // edge are flat (all in the face plane); moved inwards, they fold over the cells.
             if g1 == g2 {
