@@ -185,3 +185,38 @@ fn tall_u_prism_cells_lift_by_the_local_scale() {
         assert_eq!(euler_characteristic(&hull), Some(2));
     }
 }
+
+/// mpi_poly's step (5') cell over edge 19–70 (one triangle: face 0's guards round vertex 19
+/// and 70, face 13's centroid) was slid along the edge to bring its edge tetrahedra's midpoint
+/// over the net edge, to 0.27 of the edge: behind vertex 19's own step (5) apex at 0.30, so
+/// the two tetrahedra overlapped (14 violations). Slid again clear of the corner apexes
+/// (`guardnet::SLIDE_GAP`, only where the first slide overlaps), it overlaps nothing.
+#[test]
+fn mpi_poly_cell_stays_clear_of_its_corner_apexes() {
+    let path = Path::new("scenes/models/mpi_poly.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+    let is = |p: u32, f: u32| match hull.origins[p as usize] {
+        PointOrigin::Centroid { face } | PointOrigin::CornerGuard { face } => face == f,
+        _ => false,
+    };
+    // The cell: element 19, one point of face 13 and two of face 0 (vertex 19's own fan
+    // triangles hold its pseudo-centroid instead).
+    let cells: Vec<usize> = (0..hull.triangles.len())
+        .filter(|&t| {
+            let tri = hull.triangles[t];
+            hull.element[t] == 19
+                && tri.iter().filter(|&&p| is(p, 13)).count() == 1
+                && tri.iter().filter(|&&p| is(p, 0)).count() == 2
+        })
+        .collect();
+    assert_eq!(cells.len(), 1, "{cells:?}");
+    let named = format!("triangle {} ", cells[0]);
+    let overlaps: Vec<String> = inner::verify(&hull)
+        .into_iter()
+        .filter(|v| format!("{} ", v.message).contains(&named))
+        .map(|v| v.message)
+        .collect();
+    assert!(overlaps.is_empty(), "{overlaps:#?}");
+}
