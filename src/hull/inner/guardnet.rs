@@ -441,8 +441,8 @@ impl GuardNet {
             let half = |qs: &[DVec3]| -> Vec<DVec3> { qs.iter().map(|&q| 0.5 * (q + m)).collect() };
             // One triangle: apex on V_1V_2 (M, or where `cell_slides` puts it), moved out of
             // the polyhedron along the bisector of the two faces' normals by CELL_LIFT of the
-            // single guard's distance from the edge. The edge lies in both face planes (the
-            // guards' tangent planes); moved outwards the apex stays tangent-containing (the triangle's points are on the planes' inner sides or on
+            // single guard's distance from the edge (at most CELL_LIFT_REACH edge lengths).
+            // The edge lies in both face planes (the guards' tangent planes); moved outwards the apex stays tangent-containing (the triangle's points are on the planes' inner sides or on
             // them). With M itself, the edge tetrahedra between two such cells over one net
             // edge are flat (all in the face plane); moved inwards, they fold over the cells.
             if g1 == g2 {
@@ -468,6 +468,12 @@ impl GuardNet {
     /// the edges allow (least squares, then clamped). Other cells keep ½.
     fn cell_slides(&self, hull: &SimplicialHull, positions: &[DVec3]) -> Vec<f64> {
         let mut slide = vec![0.5; self.cells.len()];
+        let mut owner: HashMap<(u32, u32), usize> = HashMap::new();
+        for (t, tri) in hull.triangles.iter().enumerate() {
+            for k in 0..3 {
+                owner.insert((tri[k], tri[(k + 1) % 3]), t);
+            }
+        }
         let mut by_pair: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
         for (ci, c) in self.cells.iter().enumerate() {
             let [g1, g2, g3, g4] = c.g;
@@ -511,9 +517,23 @@ impl GuardNet {
             } else {
                 0.5
             };
-            let clamp = |x: f64| x.clamp(0.25, 0.75);
-            let t = clamp((e1.dot(rr) - m12 * clamp(u0)) / m11.max(1e-300));
-            let u = clamp((e2.dot(rr) - m12 * t) / m22.max(1e-300));
+            let solve = |r1: (f64, f64), r2: (f64, f64)| {
+                let t =
+                    ((e1.dot(rr) - m12 * u0.clamp(r2.0, r2.1)) / m11.max(1e-300)).clamp(r1.0, r1.1);
+                let u = ((e2.dot(rr) - m12 * t) / m22.max(1e-300)).clamp(r2.0, r2.1);
+                (t, u)
+            };
+            let (mut t, mut u) = solve((0.25, 0.75), (0.25, 0.75));
+            // A slide past a corner's own apex overlaps that corner's tetrahedron: slide
+            // again, keeping clear of the corner apexes (mpi_poly's edge 19–70).
+            if self.cell_overlaps_corner(hull, positions, &owner, c1, t)
+                || self.cell_overlaps_corner(hull, positions, &owner, c2, u)
+            {
+                (t, u) = solve(
+                    self.slide_range(hull, positions, &owner, c1),
+                    self.slide_range(hull, positions, &owner, c2),
+                );
+            }
             slide[c1] = t;
             slide[c2] = u;
         }
@@ -521,20 +541,124 @@ impl GuardNet {
     }
 }
 
+/// Least distance, in units of the edge V_1V_2, between a paired cell's apex and the apexes of
+/// the corner triangles beside it (built for V_1 and V_2 in steps (3)–(5)) along the edge, when
+/// the least-squares slide made the cell's tetrahedron overlap a corner's
+/// ([`GuardNet::add_edge_cells`]). mpi_poly's cell over edge 19–70 was slid to 0.27 of the
+/// edge, behind vertex 19's step (5) apex at 0.30 (15 overlaps). Applied to every cell it
+/// broke letter_P_poly's sign conditions (its slides bring s over the net edges), so only
+/// overlapping cells are slid again. Where no slide keeps the gap at both ends the cell takes
+/// the middle of the two bounds.
+pub const SLIDE_GAP: f64 = 0.05;
+
+impl GuardNet {
+    /// The range of a paired cell's slide along its edge V_1V_2: within [¼, ¾], and beyond the
+    /// apexes of the corner triangles beside it along the edge by [`SLIDE_GAP`].
+    fn slide_range(
+        &self,
+        hull: &SimplicialHull,
+        positions: &[DVec3],
+        owner: &HashMap<(u32, u32), usize>,
+        ci: usize,
+    ) -> (f64, f64) {
+        let c = &self.cells[ci];
+        let [g1, g2, g3, g4] = c.g;
+        let v1 = positions[c.v[0] as usize];
+        let d = positions[c.v[1] as usize] - v1;
+        let u_of = |q: DVec3| (q - v1).dot(d) / d.length_squared();
+        let apexes = |key: (u32, u32)| -> Vec<f64> {
+            owner
+                .get(&key)
+                .map(|&t| hull.apexes[t].iter().flatten().map(|&q| u_of(q)).collect())
+                .unwrap_or_default()
+        };
+        let lo = apexes((g3, g1))
+            .into_iter()
+            .fold(0.25f64, |m, u| m.max(u + SLIDE_GAP));
+        let hi = apexes((g2, g4))
+            .into_iter()
+            .fold(0.75f64, |m, u| m.min(u - SLIDE_GAP));
+        if lo <= hi {
+            (lo, hi)
+        } else {
+            let mid = (0.5 * (lo + hi)).clamp(0.25, 0.75);
+            (mid, mid)
+        }
+    }
+
+    /// Whether one-triangle cell `ci`, its apex slid to `u`, overlaps the face tetrahedra of
+    /// the corner triangles beside it (the verifier's test and depth).
+    fn cell_overlaps_corner(
+        &self,
+        hull: &SimplicialHull,
+        positions: &[DVec3],
+        owner: &HashMap<(u32, u32), usize>,
+        ci: usize,
+        u: f64,
+    ) -> bool {
+        let c = &self.cells[ci];
+        let [g1, g2, g3, g4] = c.g;
+        let (single, tri) = if g1 == g2 {
+            (g1, [g1, g3, g4])
+        } else {
+            (g3, [g1, g3, g2])
+        };
+        let v1 = positions[c.v[0] as usize];
+        let apex =
+            v1 + u * (positions[c.v[1] as usize] - v1) + cell_lift(hull, positions, c, single);
+        let [a, b, cc] = tri.map(|i| hull.points[i as usize]);
+        let cell = [a, b, cc, apex];
+        [(g3, g1), (g2, g4)].iter().any(|key| {
+            owner.get(key).is_some_and(|&t| {
+                let [p, q, r] = hull.triangles[t].map(|i| hull.points[i as usize]);
+                hull.apexes[t].iter().flatten().any(|&x| {
+                    let corner = [p, q, r, x];
+                    let scale = longest(&cell).min(longest(&corner));
+                    let limit = super::verify::OVERLAP_DEPTH * scale;
+                    super::verify::sat_depth_above(&cell, &corner, limit).is_some()
+                })
+            })
+        })
+    }
+}
+
+/// Longest edge of a tetrahedron.
+fn longest(t: &[DVec3; 4]) -> f64 {
+    let mut l: f64 = 0.0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            l = l.max((t[i] - t[j]).length());
+        }
+    }
+    l
+}
+
 /// How much more the offset of s across a net edge counts than along it when the cells' apexes
 /// are slid ([`GuardNet::add_edge_cells`]).
 const SLIDE_ACROSS_WEIGHT: f64 = 10.0;
 
 /// The outward move of a one-triangle cell's apex off its edge: along the bisector of the two
-/// faces' normals, [`CELL_LIFT`] of the single guard `g`'s distance from the edge line.
+/// faces' normals, [`CELL_LIFT`] of the single guard `g`'s distance from the edge line, that
+/// distance capped at [`CELL_LIFT_REACH`] edge lengths.
 fn cell_lift(hull: &SimplicialHull, positions: &[DVec3], cell: &EdgeCell, g: u32) -> DVec3 {
     let (v1, v2) = (positions[cell.v[0] as usize], positions[cell.v[1] as usize]);
     let e = (v2 - v1).normalize_or_zero();
     let out =
         (hull.normals[cell.g[0] as usize] + hull.normals[cell.g[2] as usize]).normalize_or_zero();
     let d = hull.points[g as usize] - v1;
-    CELL_LIFT * (d - d.dot(e) * e).length() * out
+    let reach = (d - d.dot(e) * e).length();
+    CELL_LIFT * reach.min(CELL_LIFT_REACH * (v2 - v1).length()) * out
 }
+
+/// Cap on the guard distance [`cell_lift`] scales by, in units of the cell's edge V_1V_2: the
+/// lift comes from the local scale. mpi_poly's edge 74–77 (1.5 long) has its single guard (face
+/// 8's kernel guard) 10 away: uncapped, the apex rose 1.7 out of the polyhedron and its
+/// tetrahedron, over a nearly flat stretch of T (a 0.1° fold), covered its neighbours' (58
+/// overlaps); capped, 470 → 351 hull violations on the raw hull. A U prism 20 high over a U of
+/// unit edges (side-face centroids 10 from the caps' edges) had 44 overlaps and now verifies
+/// (`tests/inner_mpi.rs`). letter_P's guards lie within their edges' lengths, so its cells do
+/// not change.
+pub const CELL_LIFT_REACH: f64 = 1.0;
 
 /// True for a star-shaped non-convex piece (kept whole with its kernel guard).
 fn is_star_only(pieces: &Pieces, p: usize) -> bool {

@@ -1,0 +1,222 @@
+//! mpi_poly's inner hull (1994, `hull::inner`): nearly flat folds and needle faces.
+//!
+//! The survey (`cargo test --test inner_mpi -- --ignored --nocapture`) prints the hull
+//! violations of `scenes/pending/paper1994/mpi_poly.toml` by kind and by the input element their
+//! triangles were built for, for the raw hull and the hull the cubic scheme fills.
+
+use apatch::hull::inner::{self, HullViolation, InnerOptions};
+use apatch::hull::simplicial::{PointOrigin, SimplicialHull};
+use apatch::mesh::{self, NormalMethod};
+use glam::DVec3;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The triangles of T a violation names (its own, and every "triangle N" in its message).
+fn named_triangles(v: &HullViolation) -> Vec<u32> {
+    let mut out: Vec<u32> = v.triangle.into_iter().collect();
+    let words: Vec<&str> = v.message.split_whitespace().collect();
+    for w in words.windows(2) {
+        if w[0] == "triangle" {
+            if let Ok(t) = w[1].trim_end_matches([',', ':', ')']).parse::<u32>() {
+                if !out.contains(&t) {
+                    out.push(t);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Prints the violations of `hull` by kind, by element and by the input vertex nearest to the
+/// centroid of each named triangle (elements of step (5') cells are edges, so the element
+/// tally mixes vertex and edge numbers; the nearest vertex does not).
+fn tally(label: &str, hull: &SimplicialHull, input: &[DVec3]) -> usize {
+    let v = inner::verify(hull);
+    let mut kinds: BTreeMap<String, usize> = BTreeMap::new();
+    let mut elements: BTreeMap<u32, usize> = BTreeMap::new();
+    let mut near: BTreeMap<usize, usize> = BTreeMap::new();
+    for x in &v {
+        let mut seen_near = Vec::new();
+        for t in named_triangles(x) {
+            let c = hull.triangles[t as usize]
+                .iter()
+                .map(|&i| hull.points[i as usize])
+                .sum::<DVec3>()
+                / 3.0;
+            let k = (0..input.len())
+                .min_by(|&a, &b| (input[a] - c).length().total_cmp(&(input[b] - c).length()))
+                .unwrap();
+            if !seen_near.contains(&k) {
+                seen_near.push(k);
+                *near.entry(k).or_default() += 1;
+            }
+        }
+        *kinds.entry(format!("{:?}", x.kind)).or_default() += 1;
+        let mut seen = Vec::new();
+        for t in named_triangles(x) {
+            let e = hull.element[t as usize];
+            if !seen.contains(&e) {
+                seen.push(e);
+                *elements.entry(e).or_default() += 1;
+            }
+        }
+    }
+    let mut by_count: Vec<(u32, usize)> = elements.into_iter().collect();
+    by_count.sort_by_key(|&(e, n)| (std::cmp::Reverse(n), e));
+    eprintln!("{label}: {} violations {kinds:?}", v.len());
+    eprintln!("  by element: {:?}", &by_count[..by_count.len().min(30)]);
+    let mut near: Vec<(usize, usize)> = near.into_iter().collect();
+    near.sort_by_key(|&(e, n)| (std::cmp::Reverse(n), e));
+    eprintln!(
+        "  by nearest input vertex: {:?}",
+        &near[..near.len().min(30)]
+    );
+    if std::env::var("MPI_VERBOSE").is_ok() {
+        for x in &v {
+            eprintln!("    {:?}: {}", x.kind, x.message);
+        }
+        for (i, (p, o)) in hull.points.iter().zip(&hull.origins).enumerate() {
+            let o = match o {
+                PointOrigin::Centroid { face } => format!("centroid of face {face}"),
+                PointOrigin::CornerGuard { face } => format!("guard of face {face}"),
+                PointOrigin::PseudoCentroid { vertex } => format!("C_0 of vertex {vertex}"),
+                PointOrigin::Other => "other".into(),
+            };
+            eprintln!("    point {i}: {p:.4} n {:.4} {o}", hull.normals[i]);
+        }
+        for (t, tri) in hull.triangles.iter().enumerate() {
+            eprintln!(
+                "    triangle {t} {tri:?} element {} apexes {:?}",
+                hull.element[t], hull.apexes[t]
+            );
+        }
+    }
+    v.len()
+}
+
+#[test]
+#[ignore = "survey for humans: prints mpi_poly's hull violations by kind and element"]
+fn mpi_poly_survey() {
+    let path = Path::new("scenes/models/mpi_poly.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+    eprintln!(
+        "raw hull: {} points, {} triangles, split {:?}, star {:?}, unseparable {:?}",
+        hull.points.len(),
+        hull.triangles.len(),
+        rep.split_faces,
+        rep.star_faces,
+        rep.unseparable
+    );
+    if std::env::var("MPI_VERBOSE").is_ok() {
+        let merged = inner::coplanar::merge_coplanar(&m);
+        let net = inner::guardnet::GuardNet::build(
+            &merged,
+            inner::decompose::convex_pieces(&merged).unwrap(),
+        );
+        for (i, f) in net.pieces.faces.iter().enumerate() {
+            eprintln!(
+                "    piece {i} of face {} region {}: {f:?} center {:.4}",
+                merged.face_parent[net.pieces.parent[i] as usize],
+                net.region[i],
+                net.pieces.center[i]
+            );
+        }
+        eprintln!("    nets {:?} fallback {:?}", net.nets, net.fallback);
+        for c in &net.cells {
+            eprintln!("    cell {:?} guards {:?}", c.v, c.g);
+        }
+    }
+    tally("raw hull", &hull, &m.positions);
+    let scene = apatch::scene::load(Path::new("scenes/pending/paper1994/mpi_poly.toml")).unwrap();
+    let prepared = apatch::scene::inner_hull(&scene).unwrap().unwrap();
+    tally("scheme's hull", &prepared, &m.positions);
+}
+
+/// A prism of height `h` over a U (arms `arm` long, 1 wide, gap 1): its caps are no star
+/// (the arms hide each other's tips), so they get a corner guard net, and the side faces'
+/// single centroids lie h/2 from the caps' edges.
+fn u_prism(h: f64, arm: f64) -> apatch::mesh::Mesh {
+    let outline = [
+        (0.0, 0.0),
+        (3.0, 0.0),
+        (3.0, arm),
+        (2.0, arm),
+        (2.0, 1.0),
+        (1.0, 1.0),
+        (1.0, arm),
+        (0.0, arm),
+    ];
+    let n = outline.len() as u32;
+    let mut p = Vec::new();
+    for z in [0.0, h] {
+        p.extend(outline.iter().map(|&(x, y)| DVec3::new(x, y, z)));
+    }
+    let mut faces = vec![(0..n).rev().collect::<Vec<u32>>(), (n..2 * n).collect()];
+    for i in 0..n {
+        let j = (i + 1) % n;
+        faces.push(vec![i, j, j + n, i + n]);
+    }
+    apatch::mesh::Mesh::new(p, faces)
+}
+
+/// A tall U prism (20 high over unit edges): its caps get a corner guard net, and the step
+/// (5') cells along the caps' edges have a side face's centroid, 10 away, as their single
+/// guard. With the cells' apexes lifted by a fifth of that distance (2, over edges 1 long) their
+/// tetrahedra overlapped their neighbours' (44 violations); lifted by the local scale
+/// (`guardnet::CELL_LIFT_REACH`) the hull is smoothable and T is a sphere.
+#[test]
+fn tall_u_prism_cells_lift_by_the_local_scale() {
+    use apatch::hull::inner::verify::euler_characteristic;
+    for arm in [3.0, 5.0] {
+        let m = u_prism(20.0, arm);
+        let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+        let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+        // Both caps are split for a guard net (the feature under test).
+        assert_eq!(rep.split_faces, vec![(0, 3), (1, 3)]);
+        let v = inner::verify(&hull);
+        assert!(
+            v.is_empty(),
+            "arm {arm}: {} violations, first {:?}",
+            v.len(),
+            v.first()
+        );
+        assert_eq!(euler_characteristic(&hull), Some(2));
+    }
+}
+
+/// mpi_poly's step (5') cell over edge 19–70 (one triangle: face 0's guards round vertex 19
+/// and 70, face 13's centroid) was slid along the edge to bring its edge tetrahedra's midpoint
+/// over the net edge, to 0.27 of the edge: behind vertex 19's own step (5) apex at 0.30, so
+/// the two tetrahedra overlapped (14 violations). Slid again clear of the corner apexes
+/// (`guardnet::SLIDE_GAP`, only where the first slide overlaps), it overlaps nothing.
+#[test]
+fn mpi_poly_cell_stays_clear_of_its_corner_apexes() {
+    let path = Path::new("scenes/models/mpi_poly.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let hull = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
+    let is = |p: u32, f: u32| match hull.origins[p as usize] {
+        PointOrigin::Centroid { face } | PointOrigin::CornerGuard { face } => face == f,
+        _ => false,
+    };
+    // The cell: element 19, one point of face 13 and two of face 0 (vertex 19's own fan
+    // triangles hold its pseudo-centroid instead).
+    let cells: Vec<usize> = (0..hull.triangles.len())
+        .filter(|&t| {
+            let tri = hull.triangles[t];
+            hull.element[t] == 19
+                && tri.iter().filter(|&&p| is(p, 13)).count() == 1
+                && tri.iter().filter(|&&p| is(p, 0)).count() == 2
+        })
+        .collect();
+    assert_eq!(cells.len(), 1, "{cells:?}");
+    let named = format!("triangle {} ", cells[0]);
+    let overlaps: Vec<String> = inner::verify(&hull)
+        .into_iter()
+        .filter(|v| format!("{} ", v.message).contains(&named))
+        .map(|v| v.message)
+        .collect();
+    assert!(overlaps.is_empty(), "{overlaps:#?}");
+}
