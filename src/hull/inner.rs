@@ -61,6 +61,7 @@ pub mod corner;
 pub mod decompose;
 pub mod degenerate;
 pub mod fan;
+pub mod flatnet;
 pub mod guardnet;
 pub mod normals;
 pub mod planar;
@@ -238,6 +239,8 @@ pub struct InnerReport {
     pub flipped_folds: usize,
     /// Apexes lifted over their base vertices' tangent planes ([`clearance`]).
     pub lifted_apexes: usize,
+    /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
+    pub flat_nets: usize,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -305,7 +308,10 @@ pub fn build_with_report(
     let merged = coplanar::merge_coplanar(mesh);
     let mesh = &merged;
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.
-    let net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
+    let mut net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
+    // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
+    let flat = flatnet::spread_guards(&mut net, mesh);
+    report.flat_nets = flat.groups.len();
     let pieces = &net.pieces;
     let input_face = |f: u32| mesh.face_parent[f as usize];
     report.split_faces = pieces
@@ -411,6 +417,7 @@ pub fn build_with_report(
     }
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
+    flat.add_triangles(&mut hull);
     report.ring_normals = normals::flatten_ring_normals(&mut hull, options.ring_normals);
     report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
