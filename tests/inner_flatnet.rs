@@ -40,32 +40,81 @@ fn explore_fandisk() {
     );
     let net = GuardNet::build(&merged, pieces);
     eprintln!("nets {:?} fallback {:?}", net.nets, net.fallback);
-    let (hull, _) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+    let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+    eprintln!("flat nets {}", rep.flat_nets);
+    // Merged polygon size per representative input face.
+    let mut size = std::collections::HashMap::new();
+    for (f, face) in merged.faces.iter().enumerate() {
+        size.insert(merged.face_parent[f], face.len());
+    }
     let v = inner::verify(&hull);
     let mut kinds = std::collections::BTreeMap::new();
-    let mut by_face = std::collections::BTreeMap::new();
     for x in &v {
         *kinds.entry(format!("{:?}", x.kind)).or_insert(0) += 1;
-        if let Some(t) = x.triangle {
-            for &p in &hull.triangles[t as usize] {
-                if let apatch::hull::simplicial::PointOrigin::CornerGuard { face }
-                | apatch::hull::simplicial::PointOrigin::Centroid { face } =
-                    hull.origins[p as usize]
-                {
-                    *by_face.entry(face).or_insert(0) += 1;
+    }
+    eprintln!("{} violations {kinds:?}", v.len());
+    use apatch::hull::simplicial::PointOrigin;
+    let class = |t: usize| -> String {
+        let tri = hull.triangles[t];
+        let mut big = None;
+        let mut guards = 0;
+        let mut pc = 0;
+        for &p in &tri {
+            match hull.origins[p as usize] {
+                PointOrigin::CornerGuard { face } | PointOrigin::Centroid { face } => {
+                    let s = size.get(&face).copied().unwrap_or(3);
+                    if s >= 5 {
+                        big = Some(big.map_or(face, |b: u32| b.min(face)));
+                    }
+                    if matches!(hull.origins[p as usize], PointOrigin::CornerGuard { .. }) {
+                        guards += 1;
+                    }
                 }
+                PointOrigin::PseudoCentroid { .. } => pc += 1,
+                PointOrigin::Other => {}
             }
         }
+        match big {
+            Some(f) => format!("big{}:g{guards}p{pc}", size[&f]),
+            None => format!("small:g{guards}p{pc}"),
+        }
+    };
+    let mut per = std::collections::BTreeMap::new();
+    let mut per_tri = std::collections::HashMap::new();
+    for x in &v {
+        let mut ts = Vec::new();
+        let msg = &x.message;
+        let mut rest = msg.as_str();
+        while let Some(i) = rest.find("triangle ") {
+            rest = &rest[i + 9..];
+            let num: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
+            if let Ok(t) = num.parse::<usize>() {
+                ts.push(t);
+            }
+        }
+        ts.sort_unstable();
+        ts.dedup();
+        for t in ts {
+            *per.entry(class(t)).or_insert(0) += 1;
+            *per_tri.entry(t).or_insert(0) += 1;
+        }
     }
-    let mut bf: Vec<_> = by_face.into_iter().collect();
-    bf.sort_by_key(|x| std::cmp::Reverse(x.1));
-    eprintln!("{} violations {kinds:?}", v.len());
-    eprintln!(
-        "by input face of a centroid/guard of the triangle: {:?}",
-        &bf[..bf.len().min(30)]
-    );
-    for x in v.iter().take(5) {
-        eprintln!("  {}", x.message);
+    eprintln!("references by triangle class: {per:?}");
+    let mut worst: Vec<_> = per_tri.into_iter().collect();
+    worst.sort_by_key(|x| (std::cmp::Reverse(x.1), x.0));
+    for &(t, n) in worst.iter().take(12) {
+        let tri = hull.triangles[t];
+        let pts = tri.map(|i| hull.points[i as usize]);
+        let len = (pts[1] - pts[0])
+            .length()
+            .max((pts[2] - pts[1]).length())
+            .max((pts[0] - pts[2]).length());
+        eprintln!(
+            "  triangle {t} ({}) element {} refs {n} longest {len:.4} origins {:?}",
+            class(t),
+            hull.element[t],
+            tri.map(|i| hull.origins[i as usize])
+        );
     }
 }
 

@@ -24,11 +24,11 @@
 //! - the guard polygon is ear-clipped and made Delaunay by edge flips (no slivers where a
 //!   better triangle exists) — the zero coplanar group;
 //! - each of its triangles gets an L-U pair of face tetrahedra, apexes over its centroid on
-//!   both sides of the plane at [`FLAT_HEIGHT`] × its longest edge (every apex off the plane
+//!   both sides of the plane at [`FLAT_HEIGHT`] × its width (every apex off the plane
 //!   is tangent containing: the three tangent planes are the face plane), so it shares a side
 //!   with every neighbour (cells on convex edges are outer, on concave edges inner).
 
-use super::decompose::{guard_is_near, polygon_area};
+use super::decompose::polygon_area;
 use super::guardnet::{EdgeCell, GuardNet};
 use crate::hull::simplicial::{PointOrigin, SimplicialHull};
 use crate::mesh::{ear_clip, Fan, Mesh};
@@ -39,8 +39,10 @@ use std::collections::HashMap;
 /// share of the corner's shorter edge (halved until the guard sees both edges).
 pub const GUARD_RADIUS: f64 = 0.25;
 
-/// Height of the apexes over a zero coplanar triangle, as a share of its longest edge (as
-/// [`super::sides::MIN_HEIGHT`] for other triangles).
+/// Height of the apexes over a zero coplanar triangle, as a share of its width (twice its area
+/// over its longest edge): any height is tangent containing (the tangent planes are the face
+/// plane), and a long thin triangle's tetrahedra stay as thin as it (relative volume
+/// 6V / L³ = FLAT_HEIGHT · (width / L)², above `verify`'s 1e-8 down to width / L ≈ 4e-4).
 pub const FLAT_HEIGHT: f64 = super::sides::MIN_HEIGHT;
 
 /// Fewest corners for which a polygon whose point of T is far from a corner gets a flat net.
@@ -86,44 +88,65 @@ impl Frame {
     }
 }
 
-/// Gives every large flat polygon of `net` whose point of T lies far from a corner
-/// ([`guard_is_near`] false, at least [`MIN_CORNERS`] corners, a single piece) a zero coplanar
-/// guard net (module docs): new guard pieces, fans naming them, step (5') cells on its edges.
+/// Gives every large flat polygon of `mesh` whose points of T lie far from a corner (a corner
+/// V farther than [`super::decompose::GUARD_REACH`] × its longer edge from the point its fan
+/// names for the polygon; at least [`MIN_CORNERS`] corners; the polygon one region of `net`,
+/// with one entry in every corner's fan) a zero coplanar guard net (module docs): guard pieces
+/// (the polygon's own pieces reused first), fans naming them, step (5') cells on its edges.
 /// The interior triangles are added to the hull by [`FlatNets::add_triangles`].
 pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh) -> FlatNets {
     let pos = &mesh.positions;
     let mut out = FlatNets::default();
     let np = net.pieces.faces.len();
-    // Pieces per input polygon: only whole, single-piece polygons qualify.
-    let mut count: HashMap<u32, usize> = HashMap::new();
-    for &f in &net.pieces.parent {
-        *count.entry(f).or_default() += 1;
-    }
+    let mut of_face: HashMap<u32, Vec<u32>> = HashMap::new();
     for p in 0..np {
-        let face = net.pieces.faces[p].clone();
-        if face.len() < MIN_CORNERS || count[&net.pieces.parent[p]] != 1 {
+        of_face
+            .entry(net.pieces.parent[p])
+            .or_default()
+            .push(p as u32);
+    }
+    let mut faces: Vec<u32> = of_face.keys().copied().collect();
+    faces.sort_unstable();
+    for f in faces {
+        let own = of_face[&f].clone();
+        let face = mesh.faces[f as usize].clone();
+        if face.len() < MIN_CORNERS {
             continue;
         }
         let mut sorted = face.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        if sorted.len() != face.len()
-            || guard_is_near(pos, &face, net.pieces.center[p])
-            || face.iter().any(|&v| net.inside(v))
-        {
+        // One region holding exactly this polygon's pieces.
+        let r = net.region[own[0] as usize];
+        let region_ok = (0..np).all(|q| (net.region[q] == r) == (net.pieces.parent[q] == f));
+        if sorted.len() != face.len() || !region_ok || face.iter().any(|&v| net.inside(v)) {
             continue;
         }
-        // Every corner's fan must hold the piece exactly once.
-        let fans: Option<Vec<Fan>> = face
+        // Every corner's fan holds one of the pieces exactly once.
+        let fans: Option<Vec<(Fan, usize)>> = face
             .iter()
             .map(|&v| {
-                net.fan(v)
-                    .filter(|f| f.closed && f.faces.iter().filter(|&&x| x == p as u32).count() == 1)
+                let fan = net.fan(v).filter(|x| x.closed)?;
+                let at: Vec<usize> = (0..fan.faces.len())
+                    .filter(|&i| own.contains(&fan.faces[i]))
+                    .collect();
+                (at.len() == 1).then(|| (fan, at[0]))
             })
             .collect();
         let Some(fans) = fans else { continue };
-        let n = net.pieces.normal[p];
-        let mean = face.iter().map(|&v| pos[v as usize]).sum::<DVec3>() / face.len() as f64;
+        let k = face.len();
+        let far = (0..k).any(|i| {
+            let p = |j: usize| pos[face[j % k] as usize];
+            let v = p(i);
+            let e = (p(i + 1) - v).length().max((p(i + k - 1) - v).length());
+            let g = net.pieces.center[fans[i].0.faces[fans[i].1] as usize];
+            (g - v).length() > super::decompose::GUARD_REACH * e
+        });
+        if !far {
+            continue;
+        }
+        let n = net.pieces.normal[own[0] as usize];
+        let mean = face.iter().map(|&v| pos[v as usize]).sum::<DVec3>() / k as f64;
         let u = n.any_orthonormal_vector();
         let frame = Frame {
             o: mean,
@@ -134,36 +157,36 @@ pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh) -> FlatNets {
         let Some((gpos, tris)) = place_guards(&frame, pos, &face) else {
             continue;
         };
-        // Guard pieces: the polygon's own for corner 0, new ones for the others.
-        let mut guards = Vec::with_capacity(face.len());
-        for (k, &g) in gpos.iter().enumerate() {
+        // Guard pieces: the polygon's own first (every point of T stays used), new ones after.
+        let mut guards = Vec::with_capacity(k);
+        for (i, &g) in gpos.iter().enumerate() {
             let g = g - frame.n.dot(g - mean) * frame.n;
-            if k == 0 {
-                net.pieces.center[p] = g;
-                net.pieces.guard[p] = true;
-                guards.push(p as u32);
+            if let Some(&q) = own.get(i) {
+                net.pieces.center[q as usize] = g;
+                net.pieces.guard[q as usize] = true;
+                guards.push(q);
             } else {
                 let q = net.pieces.faces.len() as u32;
                 net.pieces.faces.push(face.clone());
-                net.pieces.parent.push(net.pieces.parent[p]);
+                net.pieces.parent.push(f);
                 net.pieces.normal.push(n);
                 net.pieces.guard.push(true);
                 net.pieces.center.push(g);
+                net.region.push(r);
                 guards.push(q);
             }
         }
-        for (k, (&v, fan)) in face.iter().zip(fans).enumerate() {
+        if own.len() > k {
+            continue; // cannot happen: pieces have corners of the polygon
+        }
+        for (i, (&v, (fan, at))) in face.iter().zip(fans).enumerate() {
             let mut fan = fan;
-            for x in &mut fan.faces {
-                if *x == p as u32 {
-                    *x = guards[k];
-                }
-            }
+            fan.faces[at] = guards[i];
             net.set_fan(v, fan);
         }
         out.groups.push(FlatGroup {
-            piece: p as u32,
-            face: net.pieces.parent[p],
+            piece: own[0],
+            face: f,
             corners: face.clone(),
             guards: guards.clone(),
             triangles: tris.iter().map(|t| t.map(|i| guards[i as usize])).collect(),
@@ -408,7 +431,7 @@ fn delaunay_flips(p: &[DVec2], tris: &mut [[u32; 3]]) {
 impl FlatNets {
     /// Appends the zero coplanar groups' triangles to `hull` (whose points include the guards)
     /// with an L-U pair of face tetrahedra each, apexes over the centroid at [`FLAT_HEIGHT`]
-    /// of the longest edge on both sides; `element` is the polygon's first corner.
+    /// of its width on both sides; `element` is the polygon's first corner.
     pub fn add_triangles(&self, hull: &mut SimplicialHull) {
         for g in &self.groups {
             for &tri in &g.triangles {
@@ -417,8 +440,9 @@ impl FlatNets {
                     continue;
                 };
                 let len = (b - a).length().max((c - b).length()).max((a - c).length());
+                let width = (b - a).cross(c - a).length() / len;
                 let m = (a + b + c) / 3.0;
-                let h = FLAT_HEIGHT * len;
+                let h = FLAT_HEIGHT * width;
                 hull.triangles.push(tri);
                 hull.apexes.push([Some(m + h * n), Some(m - h * n)]);
                 hull.element.push(g.corners[0]);
