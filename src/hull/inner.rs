@@ -305,12 +305,12 @@ pub fn build_with_report(
     };
     let nv = mesh.positions.len();
     let line = |v: usize| mesh.vertex_lines.get(v).copied().unwrap_or(0);
-    let merged = coplanar::merge_coplanar(mesh);
+    let (merged, merged_counts) = coplanar::merge_coplanar_counted(mesh);
     let mesh = &merged;
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.
     let mut net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
     // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
-    let flat = flatnet::spread_guards(&mut net, mesh);
+    let flat = flatnet::spread_guards(&mut net, mesh, &merged_counts);
     report.flat_nets = flat.groups.len();
     let pieces = &net.pieces;
     let input_face = |f: u32| mesh.face_parent[f as usize];

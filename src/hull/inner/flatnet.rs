@@ -23,8 +23,8 @@
 //!   step (5') cells between G_{V_1} and G_{V_2} ([`super::guardnet::EdgeCell`]);
 //! - the guard polygon is ear-clipped and made Delaunay by edge flips (no slivers where a
 //!   better triangle exists) — the zero coplanar group;
-//! - each of its triangles gets an L-U pair of face tetrahedra, apexes over its centroid on
-//!   both sides of the plane at [`FLAT_HEIGHT`] × its width (every apex off the plane
+//! - each of its triangles gets an L-U pair of face tetrahedra, apexes over its centroid
+//!   (drawn towards its edges on the guard polygon, [`BOUNDARY_PULL`]) on both sides of the plane at [`FLAT_HEIGHT`] × its width (every apex off the plane
 //!   is tangent containing: the three tangent planes are the face plane), so it shares a side
 //!   with every neighbour (cells on convex edges are outer, on concave edges inner).
 
@@ -44,6 +44,15 @@ pub const GUARD_RADIUS: f64 = 0.25;
 /// plane), and a long thin triangle's tetrahedra stay as thin as it (relative volume
 /// 6V / L³ = FLAT_HEIGHT · (width / L)², above `verify`'s 1e-8 down to width / L ≈ 4e-4).
 pub const FLAT_HEIGHT: f64 = super::sides::MIN_HEIGHT;
+
+/// Extra barycentric weight (against 1) of each end of a zero coplanar triangle's edge on the
+/// guard polygon for the point its apexes rise over. The step (5') cell across that edge has
+/// its apex H beyond the polyhedron edge; the edge tetrahedra between the two take the midpoint
+/// s of H and the flat apex q, and the cubic scheme can make them single sheeted only when s
+/// lies on the apex side of the cell's triangle (`guardnet`'s slid cells). With q over the
+/// centroid of a long flat triangle, s fell far inside the flat region, behind the cell
+/// (the quarter annulus prism's holes); drawn to the edge, s lies near it.
+pub const BOUNDARY_PULL: f64 = 4.0;
 
 /// Fewest corners for which a polygon whose point of T is far from a corner gets a flat net.
 pub const MIN_CORNERS: usize = 4;
@@ -88,13 +97,15 @@ impl Frame {
     }
 }
 
-/// Gives every large flat polygon of `mesh` whose points of T lie far from a corner (a corner
+/// Gives every large flat region of `mesh` (a polygon merged from several coplanar input
+/// faces, `merged[f]` ≥ 2, [`super::coplanar::merge_coplanar_counted`]; Appendix B's
+/// coplanarity) whose points of T lie far from a corner (a corner
 /// V farther than [`super::decompose::GUARD_REACH`] × its longer edge from the point its fan
 /// names for the polygon; at least [`MIN_CORNERS`] corners; the polygon one region of `net`,
 /// with one entry in every corner's fan) a zero coplanar guard net (module docs): guard pieces
 /// (the polygon's own pieces reused first), fans naming them, step (5') cells on its edges.
 /// The interior triangles are added to the hull by [`FlatNets::add_triangles`].
-pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh) -> FlatNets {
+pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh, merged: &[usize]) -> FlatNets {
     let pos = &mesh.positions;
     let mut out = FlatNets::default();
     let np = net.pieces.faces.len();
@@ -110,7 +121,7 @@ pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh) -> FlatNets {
     for f in faces {
         let own = of_face[&f].clone();
         let face = mesh.faces[f as usize].clone();
-        if face.len() < MIN_CORNERS {
+        if face.len() < MIN_CORNERS || merged.get(f as usize).copied().unwrap_or(1) < 2 {
             continue;
         }
         let mut sorted = face.clone();
@@ -175,9 +186,6 @@ pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh) -> FlatNets {
                 net.region.push(r);
                 guards.push(q);
             }
-        }
-        if own.len() > k {
-            continue; // cannot happen: pieces have corners of the polygon
         }
         for (i, (&v, (fan, at))) in face.iter().zip(fans).enumerate() {
             let mut fan = fan;
@@ -430,10 +438,15 @@ fn delaunay_flips(p: &[DVec2], tris: &mut [[u32; 3]]) {
 
 impl FlatNets {
     /// Appends the zero coplanar groups' triangles to `hull` (whose points include the guards)
-    /// with an L-U pair of face tetrahedra each, apexes over the centroid at [`FLAT_HEIGHT`]
+    /// with an L-U pair of face tetrahedra each, apexes over the centroid (drawn towards the
+    /// guard polygon, [`BOUNDARY_PULL`]) at [`FLAT_HEIGHT`]
     /// of its width on both sides; `element` is the polygon's first corner.
     pub fn add_triangles(&self, hull: &mut SimplicialHull) {
         for g in &self.groups {
+            let k = g.guards.len();
+            let boundary: Vec<(u32, u32)> = (0..k)
+                .map(|i| (g.guards[i], g.guards[(i + 1) % k]))
+                .collect();
             for &tri in &g.triangles {
                 let [a, b, c] = tri.map(|i| hull.points[i as usize]);
                 let Some(n) = (b - a).cross(c - a).try_normalize() else {
@@ -441,7 +454,15 @@ impl FlatNets {
                 };
                 let len = (b - a).length().max((c - b).length()).max((a - c).length());
                 let width = (b - a).cross(c - a).length() / len;
-                let m = (a + b + c) / 3.0;
+                // Over the base, drawn towards its edges on the guard polygon (module docs).
+                let mut w = [1.0; 3];
+                for e in 0..3 {
+                    if boundary.contains(&(tri[e], tri[(e + 1) % 3])) {
+                        w[e] += BOUNDARY_PULL;
+                        w[(e + 1) % 3] += BOUNDARY_PULL;
+                    }
+                }
+                let m = (w[0] * a + w[1] * b + w[2] * c) / (w[0] + w[1] + w[2]);
                 let h = FLAT_HEIGHT * width;
                 hull.triangles.push(tri);
                 hull.apexes.push([Some(m + h * n), Some(m - h * n)]);
