@@ -16,8 +16,13 @@
 //!   edges from V, halved until it sees both edges (the triangles G V U and G V W hold no
 //!   other corner and cross no edge of the polygon) and the guard polygon G_1 … G_n stays
 //!   simple and inside the face;
-//! - the polygon's point of T becomes the guard of its first corner, the other guards are
-//!   new points of T (same face, same normal);
+//! - only merged regions (several coplanar input faces, [`super::coplanar`]) whose point of T
+//!   (centroid, kernel guard or net guard named in a corner's fan) lies more than
+//!   [`super::decompose::GUARD_REACH`] × a corner's longer edge from that corner qualify:
+//!   single convex faces with short edges (random convex solids) keep their centroid, and
+//!   giving every merged region a flat net made fandisk worse (small regions' guards crowd);
+//! - the polygon's points of T (its pieces) become the guards of its first corners, the other
+//!   guards are new points of T (same face, same normal);
 //! - every corner V's fan names V's own guard for the face, so Algorithm 1 / 2 builds V's
 //!   triangles (3), (3'), (4), (5) with guards near V, and the edges V_1V_2 of the face get
 //!   step (5') cells between G_{V_1} and G_{V_2} ([`super::guardnet::EdgeCell`]);
