@@ -16,6 +16,9 @@
 //!    keeps one guard, the centroid of its kernel (it sees every corner); other non-convex
 //!    polygons are split into convex pieces whose centroids are the guards (Algorithm 2
 //!    reduced to Algorithm 1, as §4 allows).
+//!    Then [`flatnet`] (Appendix B, Algorithm 3): a merged flat region whose point of T lies
+//!    far from one of its corners gets a guard per corner, near it, and its interior becomes a
+//!    zero coplanar group of triangles among those guards (fandisk's large flat regions).
 //! 3. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
 //!    Appendix C) by rotating it where needed; corners where no direction is above all faces
 //!    are re-meshed first by Appendix C's corner smoothing ([`remesh`], before step 1).
@@ -66,6 +69,7 @@ pub mod corner;
 pub mod decompose;
 pub mod degenerate;
 pub mod fan;
+pub mod flatnet;
 pub mod guardnet;
 pub mod normals;
 pub mod planar;
@@ -265,6 +269,8 @@ pub struct InnerReport {
     /// Points of T (pseudo-centroids) whose normals were turned to face their fan triangles
     /// ([`umbrella`]).
     pub umbrella_normals: Vec<u32>,
+    /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
+    pub flat_nets: usize,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -344,10 +350,13 @@ pub fn build_with_report(
     };
     let nv = mesh.positions.len();
     let line = |v: usize| mesh.vertex_lines.get(v).copied().unwrap_or(0);
-    let merged = coplanar::merge_coplanar(mesh);
+    let (merged, merged_counts) = coplanar::merge_coplanar_counted(mesh);
     let mesh = &merged;
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.
-    let net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
+    let mut net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
+    // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
+    let flat = flatnet::spread_guards(&mut net, mesh, &merged_counts);
+    report.flat_nets = flat.groups.len();
     let pieces = &net.pieces;
     let input_face = |f: u32| mesh.face_parent[f as usize];
     report.split_faces = pieces
@@ -453,6 +462,7 @@ pub fn build_with_report(
     }
     corner::spread_hallway_apexes(&mut hull, &hallway);
     net.add_edge_cells(&mut hull, &mesh.positions);
+    flat.add_triangles(&mut hull);
     report.ring_normals = normals::flatten_ring_normals(&mut hull, options.ring_normals);
     report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
     report.umbrella_normals = umbrella::face_fans(&mut hull);

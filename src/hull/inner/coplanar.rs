@@ -29,6 +29,13 @@ pub const PLANE_DISTANCE: f64 = 1e-9;
 /// clone) when nothing is coplanar.
 #[must_use]
 pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
+    merge_coplanar_counted(mesh).0
+}
+
+/// [`merge_coplanar`], also returning how many input faces each polygon of the result holds
+/// (1 for a face kept as it was; [`super::flatnet`] treats only merged regions).
+#[must_use]
+pub fn merge_coplanar_counted(mesh: &Mesh) -> (Mesh, Vec<usize>) {
     let nf = mesh.faces.len();
     let normals: Vec<Option<DVec3>> = mesh
         .faces
@@ -68,7 +75,7 @@ pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
         }
     }
     if !any {
-        return mesh.clone();
+        return (mesh.clone(), vec![1; nf]);
     }
     let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
     for f in 0..nf {
@@ -79,24 +86,27 @@ pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
     roots.sort_unstable();
     let mut faces: Vec<Vec<u32>> = Vec::new();
     let mut reps: Vec<u32> = Vec::new();
+    let mut counts: Vec<usize> = Vec::new();
     for r in roots {
         let group = &groups[&r];
-        let keep_all = |faces: &mut Vec<Vec<u32>>, reps: &mut Vec<u32>| {
+        let keep_all = |faces: &mut Vec<Vec<u32>>, reps: &mut Vec<u32>, counts: &mut Vec<usize>| {
             for &f in group {
                 faces.push(mesh.faces[f].clone());
                 reps.push(f as u32);
+                counts.push(1);
             }
         };
         if group.len() == 1 {
-            keep_all(&mut faces, &mut reps);
+            keep_all(&mut faces, &mut reps, &mut counts);
             continue;
         }
         match boundary_loop(mesh, group) {
             Some(poly) => {
                 faces.push(poly);
                 reps.push(group[0] as u32);
+                counts.push(group.len());
             }
-            None => keep_all(&mut faces, &mut reps),
+            None => keep_all(&mut faces, &mut reps, &mut counts),
         }
     }
     // Vertices on a straight edge between only two polygons.
@@ -119,7 +129,7 @@ pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
             *face = kept;
         }
     }
-    Mesh {
+    let merged = Mesh {
         positions: mesh.positions.clone(),
         file_normals: mesh.file_normals.clone(),
         vertex_lines: mesh.vertex_lines.clone(),
@@ -129,7 +139,8 @@ pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
             .collect(),
         face_parent: reps,
         faces,
-    }
+    };
+    (merged, counts)
 }
 
 /// True when faces `f` and `g` (unit normals `nf`, `ng`) lie in one plane: normals within

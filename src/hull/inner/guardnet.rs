@@ -386,6 +386,12 @@ impl GuardNet {
             .or_else(|| self.topo.vertex_fan(v))
     }
 
+    /// Replaces the fan of `v` over regions ([`super::flatnet`]: a flat polygon's corner
+    /// names its own guard).
+    pub fn set_fan(&mut self, v: u32, fan: Fan) {
+        self.fans.insert(v, fan);
+    }
+
     /// True when `v` lies inside one region (no corner there).
     #[must_use]
     pub fn inside(&self, v: u32) -> bool {
