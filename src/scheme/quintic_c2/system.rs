@@ -392,6 +392,9 @@ pub struct SolveStats {
     /// Triangles of T given the partner apex of an L-U pair before building
     /// (`QuinticOptions::complete_lu_pairs`).
     pub lu_completed: usize,
+    /// Apexes moved to their side of their triangle's tangent planes before building
+    /// (`QuinticOptions::contain_tangents`).
+    pub tangent_moved: usize,
     /// Points of T whose stars were relaxed (solved with their edge middles and Hessian)
     /// because their determined weights missed Theorem 2.1's signs
     /// (`QuinticOptions::relax_stars`).
