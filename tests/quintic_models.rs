@@ -9,7 +9,8 @@ use std::path::Path;
 /// The scheme's defaults, with `LIFT=x`, `CURV=x`, `SIGNS=1`, `LU=0` and `JOINT=1` in the
 /// environment overriding the lift, the curvature, the sign pins, the L-U completion and the
 /// joint stars, `RELAX=0` turning off the relaxed stars, `CONSISTENT=1` the consistent
-/// stars and `HSIGNS=1` the Hessian sign fit (to explore).
+/// stars, `HSIGNS=1` the Hessian sign fit and `TANGENTS=1` the tangent containment (to
+/// explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -26,6 +27,7 @@ fn options() -> QuinticOptions {
         relax_stars: std::env::var("RELAX").map_or(true, |s| s != "0"),
         consistent_stars: std::env::var("CONSISTENT").is_ok_and(|s| s == "1"),
         hessian_signs: std::env::var("HSIGNS").is_ok_and(|s| s == "1"),
+        contain_tangents: std::env::var("TANGENTS").is_ok_and(|s| s == "1"),
     }
 }
 
@@ -740,4 +742,129 @@ fn letter_p_hessian_signs_close_the_holes() {
     }
     assert!(crossed[0] > 0, "{crossed:?}");
     assert_eq!(crossed[1], 0, "{crossed:?}");
+}
+
+/// A weight's class for [`sign_miss_classes`]: the tetrahedron's kind (face tetrahedron of a
+/// single-sided triangle or of an L-U pair, outer or inner; edge tetrahedron) and the domain
+/// point's pattern: the multiplicities of the points of T (largest first) | the share of the
+/// vertices off T (apex q; for an edge tetrahedron q and its midpoint s), with the scheme's
+/// stage and the paper's number where the pattern fixes it.
+fn weight_class(p: &apatch::complex::Patch, lu: bool, l: [u8; 4]) -> String {
+    let edge = p.role == apatch::complex::Role::Edge;
+    let n_t = if edge { 2 } else { 3 };
+    let mut t: Vec<u8> = l[..n_t].to_vec();
+    t.sort_unstable_by(|a, b| b.cmp(a));
+    let off: Vec<u8> = l[n_t..].to_vec();
+    let top = t[0];
+    let twos = t.iter().filter(|&&x| x == 2).count();
+    let what = match (top, twos) {
+        (5, _) => "jet no.0",
+        (4, _) => "jet no.1",
+        (3, _) => "jet no.2",
+        (2, 2) if off.iter().sum::<u8>() == 0 || (!edge && off[0] == 0) => {
+            "edge middle no.3 (free)"
+        }
+        (2, 2) => "edge middle no.4",
+        (2, _) => "star (no.5-7, 9: determined)",
+        _ if !edge && t == [1, 1, 0] && off[0] == 3 => "face middle (no.10/11)",
+        _ if !edge => "far face (no.8, 12, 13, 16: free; L-U inner: C2)",
+        _ if t == [1, 1] => "face middle (no.10/11)",
+        _ => "rest of edge tet (no.14, 15, 17, free)",
+    };
+    let kind = match (p.role, lu) {
+        (apatch::complex::Role::Edge, _) => "edge tet".to_string(),
+        (_, true) => "face tet L-U".to_string(),
+        _ => "face tet single".to_string(),
+    };
+    format!("{kind:15} {t:?}|{off:?} {what}")
+}
+
+/// Exploration: which weights miss Theorem 2.1's signs (k = 1, as [`jline_patches`]) on a
+/// scene's complex, by tetrahedron kind and domain-point class ([`weight_class`]): weights
+/// with a condition, misses, misses on boundary faces of the hull (faces of one patch), misses
+/// on crossed boundary faces (holes), and misses in patches crossed twice along a j-line.
+#[test]
+#[ignore = "exploration: SCENE=path"]
+fn sign_miss_classes() {
+    use apatch::complex::Role;
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    let sc = apatch::scene::load(&path).unwrap();
+    let c = apatch::scene::build_complex(&sc).unwrap();
+    let key = |v: [f64; 3]| v.map(f64::to_bits);
+    let face_key = |p: &apatch::complex::Patch, opp: usize| {
+        let mut f: Vec<[u64; 3]> = (0..4)
+            .filter(|&k| k != opp)
+            .map(|k| key(p.tet[k]))
+            .collect();
+        f.sort_unstable();
+        [f[0], f[1], f[2]]
+    };
+    let mut users: std::collections::HashMap<[[u64; 3]; 3], usize> = Default::default();
+    for p in &c.patches {
+        for opp in 0..4 {
+            *users.entry(face_key(p, opp)).or_insert(0) += 1;
+        }
+    }
+    let (crossed, wmax) = crossed_boundary_faces(&c);
+    let crossed: std::collections::HashSet<(usize, usize)> = crossed.into_iter().collect();
+    // Patches crossed twice along a j-line, each checked alone.
+    let mut jmulti = vec![false; c.patches.len()];
+    for (k, p) in c.patches.iter().enumerate() {
+        let mut one = apatch::complex::PatchComplex::new(&c.scheme);
+        one.continuity = c.continuity;
+        one.patches = vec![p.clone()];
+        jmulti[k] = check(&one, &CheckOptions::default()).sheets.j_multi_lines > 0;
+    }
+    let mi = apatch::bb::multi_indices(5);
+    // [with a condition, missed, missed on a boundary face, on a crossed one, in a j-patch]
+    let mut table: std::collections::BTreeMap<String, [usize; 5]> = Default::default();
+    for (k, p) in c.patches.iter().enumerate() {
+        let edge = p.role == Role::Edge;
+        let lu = !edge && users[&face_key(p, 3)] == 2;
+        let s = p.weights[apatch::bb::index_of([0, 0, 0, 5])].signum();
+        for (i, &l) in mi.iter().enumerate() {
+            let level = if edge { l[2] + l[3] } else { l[3] };
+            let req = match level {
+                0 if lu => 0.0,
+                0 => -s,
+                1 => 0.0,
+                _ => s,
+            };
+            if req == 0.0 {
+                continue;
+            }
+            let row = table.entry(weight_class(p, lu, l)).or_default();
+            row[0] += 1;
+            // Zero up to the solves' rounding (as `sign_stats`).
+            if req * p.weights[i] >= -1e-12 * wmax {
+                continue;
+            }
+            row[1] += 1;
+            let faces: Vec<usize> = (0..4).filter(|&o| l[o] == 0).collect();
+            if faces.iter().any(|&o| users[&face_key(p, o)] == 1) {
+                row[2] += 1;
+            }
+            if faces.iter().any(|&o| crossed.contains(&(k, o))) {
+                row[3] += 1;
+            }
+            if jmulti[k] {
+                row[4] += 1;
+            }
+        }
+    }
+    eprintln!(
+        "{}: {} crossed boundary faces, {} j-line patches",
+        path.display(),
+        crossed.len(),
+        jmulti.iter().filter(|&&b| b).count()
+    );
+    eprintln!("| class | with a sign | missed | on a boundary face | on a crossed face | in a j-line patch |");
+    for (k, r) in &table {
+        if r[1] > 0 {
+            eprintln!(
+                "| {k} | {} | {} | {} | {} | {} |",
+                r[0], r[1], r[2], r[3], r[4]
+            );
+        }
+    }
 }

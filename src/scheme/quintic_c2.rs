@@ -62,6 +62,13 @@ pub struct QuinticOptions {
     /// neighbours' normals and can bend the surface out through a flat base or back before
     /// an apex.
     pub hessian_signs: bool,
+    /// Move every apex that lies beyond a tangent plane of its triangle's points to its side of
+    /// them before building (the cubic scheme's
+    /// [`crate::scheme::cubic_c1::tangent::contain_tangents`]): the number 1 weights toward such
+    /// an apex, n_k·(q − p_k)/5, are fixed by the data with the wrong sign, so F starts with
+    /// the wrong sign on the boundary faces [p_k q s] of the edge tetrahedra next to p_k (a
+    /// hole) whatever the free weights are.
+    pub contain_tangents: bool,
 }
 
 impl Default for QuinticOptions {
@@ -75,6 +82,7 @@ impl Default for QuinticOptions {
             relax_stars: true,
             consistent_stars: false,
             hessian_signs: false,
+            contain_tangents: false,
         }
     }
 }
@@ -139,6 +147,13 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "contain_tangents" => match v.as_bool() {
+                    Some(b) => o.contain_tangents = b,
+                    None => bail!(
+                        "{}: `scheme.contain_tangents` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => match v.as_bool() {
                     Some(b) => o.signs = b,
                     None => bail!(
@@ -157,7 +172,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -193,6 +208,12 @@ pub fn build_with_stats(
     } else {
         (hull.clone(), Vec::new())
     };
+    let (completed, tangent_moved) = if options.contain_tangents {
+        let (h, moved, _stuck) = crate::scheme::cubic_c1::tangent::contain_tangents(&completed);
+        (h, moved.len())
+    } else {
+        (completed, 0)
+    };
     let hull = &completed;
     let np = hull.points.len() as u32;
     let nt = hull.triangles.len() as u32;
@@ -218,6 +239,7 @@ pub fn build_with_stats(
     )?;
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
     stats.lu_completed = lu_completed.len();
+    stats.tangent_moved = tangent_moved;
     stats.hessian_fit = hessian_fit;
     let mut complex = PatchComplex::new("quintic-c2");
     complex.continuity = Some(2);

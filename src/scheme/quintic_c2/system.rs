@@ -392,6 +392,9 @@ pub struct SolveStats {
     /// Triangles of T given the partner apex of an L-U pair before building
     /// (`QuinticOptions::complete_lu_pairs`).
     pub lu_completed: usize,
+    /// Apexes moved to their side of their triangle's tangent planes before building
+    /// (`QuinticOptions::contain_tangents`).
+    pub tangent_moved: usize,
     /// Points of T whose stars were relaxed (solved with their edge middles and Hessian)
     /// because their determined weights missed Theorem 2.1's signs
     /// (`QuinticOptions::relax_stars`).
@@ -742,7 +745,9 @@ impl System {
             equations: self.equations.len(),
             ..SolveStats::default()
         };
+        let trace = std::env::var_os("APATCH_SIGN_TRACE").is_some();
         for st in 1..=6u8 {
+            let mut dev = (0.0_f64, 0.0_f64, 0.0_f64, 0usize, 0usize, 0usize);
             // Union-find over this stage's unknowns, joined by this stage's equations.
             let mut parent: HashMap<u32, u32> = HashMap::new();
             fn find(p: &mut HashMap<u32, u32>, x: u32) -> u32 {
@@ -932,9 +937,35 @@ impl System {
                 for (j, &s) in unk.iter().enumerate() {
                     if sol.x[j].is_finite() {
                         value[s as usize] = sol.x[j];
+                        if trace {
+                            let d = (sol.x[j] - tgt[j]).abs();
+                            dev.0 = dev.0.max(d);
+                            dev.1 += d;
+                            dev.2 += tgt[j].abs();
+                            dev.3 += 1;
+                            let r = self.req[s as usize];
+                            if (r == 1 || r == -1) && f64::from(r) * tgt[j] < 0.0 {
+                                dev.4 += 1;
+                            }
+                            if (r == 1 || r == -1) && f64::from(r) * sol.x[j] < 0.0 {
+                                dev.5 += 1;
+                            }
+                        }
                     }
                     known[s as usize] = true;
                 }
+            }
+            if trace {
+                // Opt-in exploration on stderr (results unaffected).
+                eprintln!(
+                    "quintic-c2 stage {st}: {} weights, |x - target| max {:.2e} mean {:.2e}, mean |target| {:.2e}; sign misses: targets {}, solution {}",
+                    dev.3,
+                    dev.0,
+                    dev.1 / dev.3.max(1) as f64,
+                    dev.2 / dev.3.max(1) as f64,
+                    dev.4,
+                    dev.5
+                );
             }
         }
         let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
