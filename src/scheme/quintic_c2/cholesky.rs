@@ -29,6 +29,13 @@ pub const DEPENDENT_PIVOT: f64 = 1e-13;
 /// of the rows before them are dropped; whether they are met shows in the residual.
 pub const RETRY_PIVOT: f64 = 1e-9;
 
+/// Largest group (equations) ordered by the exact minimum degree with explicit cliques
+/// ([`min_degree`]); larger ones use the quotient graph
+/// ([`super::ordering::quotient_min_degree`]), whose cost does not grow with the cliques. The
+/// shipped scenes' sparse groups (≤ 9564 equations) stay below it and keep their bits; the
+/// exact order took 56 s (nut, 110k equations) to many minutes (spot) above it.
+pub const QUOTIENT_LIMIT: usize = 20_000;
+
 /// Rounds of iterative refinement after the first solve.
 const REFINE: usize = 4;
 
@@ -74,7 +81,7 @@ impl Factor {
 /// Minimum-degree elimination order of the graph `adj` (sorted neighbour lists without the
 /// node itself) and the pattern of L's columns it gives (each node's neighbours when it is
 /// eliminated), sorted by elimination position.
-fn min_degree(mut adj: Vec<Vec<u32>>) -> (Vec<u32>, Vec<Vec<u32>>, Vec<usize>) {
+pub(crate) fn min_degree(mut adj: Vec<Vec<u32>>) -> (Vec<u32>, Vec<Vec<u32>>, Vec<usize>) {
     let m = adj.len();
     let mut heap: BinaryHeap<Reverse<(usize, u32)>> =
         (0..m).map(|v| Reverse((adj[v].len(), v as u32))).collect();
@@ -153,7 +160,29 @@ fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64) -> (Factor, usize) {
         a.sort_unstable();
         a.dedup();
     }
-    let (order, pattern, pos) = min_degree(adj);
+    let t = std::time::Instant::now();
+    let (order, pattern, pos) = if m > QUOTIENT_LIMIT {
+        let (order, mut pattern) = super::ordering::quotient_min_degree(adj);
+        let mut pos = vec![0usize; m];
+        for (k, &v) in order.iter().enumerate() {
+            pos[v as usize] = k;
+        }
+        for p in &mut pattern {
+            p.sort_unstable_by_key(|&u| pos[u as usize]);
+        }
+        (order, pattern, pos)
+    } else {
+        min_degree(adj)
+    };
+    if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
+        // Opt-in timing of the ordering on stderr (exploration; results unaffected).
+        let nnz: usize = pattern.iter().map(Vec::len).sum();
+        eprintln!(
+            "quintic-c2 cholesky: {m} nodes, {} off-diagonal, ordering {:.2} s, nnz(L) {nnz}",
+            off.len(),
+            t.elapsed().as_secs_f64()
+        );
+    }
     // Values of the (partially updated) matrix on each column's pattern.
     let mut vals: Vec<Vec<f64>> = pattern.iter().map(|p| vec![0.0; p.len()]).collect();
     for &(i, k, a) in off {
