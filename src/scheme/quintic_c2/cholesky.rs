@@ -31,10 +31,12 @@ pub const RETRY_PIVOT: f64 = 1e-9;
 
 /// Largest group (equations) ordered by the exact minimum degree with explicit cliques
 /// ([`min_degree`]); larger ones use the quotient graph
-/// ([`super::ordering::quotient_min_degree`]), whose cost does not grow with the cliques. The
-/// shipped scenes' sparse groups (≤ 9564 equations) stay below it and keep their bits; the
-/// exact order took 56 s (nut, 110k equations) to many minutes (spot) above it.
-pub const QUOTIENT_LIMIT: usize = 20_000;
+/// ([`super::ordering::quotient_min_degree`]), whose cost does not grow with the cliques (the
+/// exact order did not finish spot's relaxed group of 972k equations). Below it the exact order
+/// is kept: the groups that build today (double_torus_poly 43k–70k, bunny 96k, knot 156k,
+/// spot 170k) keep their bits, and on double_torus_poly's third group the approximate order
+/// left a nearly dependent row undropped (residual 4.7e-6 instead of 9.8e-13, one more pass).
+pub const QUOTIENT_LIMIT: usize = 200_000;
 
 /// Rounds of iterative refinement after the first solve.
 const REFINE: usize = 4;
@@ -146,11 +148,16 @@ pub(crate) fn min_degree(mut adj: Vec<Vec<u32>>) -> (Vec<u32>, Vec<Vec<u32>>, Ve
     (order, pattern, pos)
 }
 
-/// Factors the symmetric matrix given by its diagonal `d` and strictly off-diagonal entries
-/// `off` (each pair once, (i, k, value)), dropping pivots below `drop` × the original
-/// diagonal. Returns the factor and the number of dropped nodes.
-fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64) -> (Factor, usize) {
-    let m = d.len();
+/// Elimination order, L's column patterns (sorted by elimination position) and each node's
+/// position, computed once per group and shared by both drop thresholds of [`solve_near`].
+struct Symbolic {
+    order: Vec<u32>,
+    pattern: Vec<Vec<u32>>,
+    pos: Vec<usize>,
+}
+
+/// The ordering of the symmetric matrix with `m` nodes and strictly off-diagonal entries `off`.
+fn symbolic(m: usize, off: &[(u32, u32, f64)]) -> Symbolic {
     let mut adj: Vec<Vec<u32>> = vec![Vec::new(); m];
     for &(i, k, _) in off {
         adj[i as usize].push(k);
@@ -183,6 +190,21 @@ fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64) -> (Factor, usize) {
             t.elapsed().as_secs_f64()
         );
     }
+    Symbolic {
+        order,
+        pattern,
+        pos,
+    }
+}
+
+/// Factors the symmetric matrix given by its diagonal `d` and strictly off-diagonal entries
+/// `off` (each pair once, (i, k, value)) in the order `sym`, dropping pivots below `drop` × the
+/// original diagonal. Returns the factor and the number of dropped nodes.
+fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Symbolic) -> (Factor, usize) {
+    let m = d.len();
+    let order = sym.order.clone();
+    let pattern = sym.pattern.clone();
+    let pos = &sym.pos;
     // Values of the (partially updated) matrix on each column's pattern.
     let mut vals: Vec<Vec<f64>> = pattern.iter().map(|p| vec![0.0; p.len()]).collect();
     for &(i, k, a) in off {
@@ -327,8 +349,9 @@ pub fn solve_near(rows: &[Row], n: usize, c: &[f64], target: &[f64], tol: f64) -
     let mut r = vec![0.0; m];
     let res0 = residual_of(target, &mut r);
     let mut best = (res0, target.to_vec(), 0);
+    let sym = symbolic(m, &off);
     for drop in [DEPENDENT_PIVOT, RETRY_PIVOT] {
-        let (f, dropped) = factor(&d, &off, drop);
+        let (f, dropped) = factor(&d, &off, drop, &sym);
         let mut x = target.to_vec();
         let mut res = residual_of(&x, &mut r);
         let mut first_step_helped = false;

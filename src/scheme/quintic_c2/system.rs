@@ -1097,6 +1097,16 @@ impl System {
         self.req[self.slot_of[t][crate::bb::index_of(l)] as usize]
     }
 
+    /// Largest |coefficient| of the C1/C2 equations (each has coefficient 1 on the weight it
+    /// defines): how far the rows are from the O(1) barycentrics of thick tetrahedra.
+    #[must_use]
+    pub fn max_coefficient(&self) -> f64 {
+        self.equations
+            .iter()
+            .flat_map(|e| e.terms.iter())
+            .fold(0.0_f64, |m, t| m.max(t.1.abs()))
+    }
+
     /// The 56 weights of tetrahedron `t` from the slot values.
     #[must_use]
     pub fn weights(&self, t: usize, value: &[f64]) -> Vec<f64> {
