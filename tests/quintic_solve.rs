@@ -58,3 +58,43 @@ fn knot_consistent_stars_are_c2() {
         .collect();
     assert!(f.is_empty(), "{f:?}");
 }
+
+/// The nut's hull (its scene's `ring_normals = 1`) holds a flat L-U pair: face tetrahedra whose
+/// apexes lie 5e-8 of their size from the base's plane (above the hull's degeneracy bound 1e-8
+/// in 6V/L³, so `hull::inner::degenerate` keeps them). Written from such a sliver, the C2 rows
+/// across its side faces carry barycentrics² ~ 1e10 (measured 7.1e10), which no factorisation
+/// of the group's normal matrix survives; `system::assemble` writes those faces from the thick
+/// edge tetrahedron instead, so every coefficient stays O(1)–O(100).
+#[test]
+fn nut_sliver_faces_are_written_from_the_thick_side() {
+    use apatch::scheme::quintic_c2::system;
+    let path = Path::new("scenes/models/nut_pyvista.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let opts = InnerOptions {
+        ring_normals: 1.0,
+        ..InnerOptions::default()
+    };
+    let hull = inner::build(&m, &normals, &opts).unwrap();
+    let (hull, _) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+    let (tets, _) = system::tetrahedra(&hull).unwrap();
+    // The sliver is there: some face tetrahedron's apex is within 1e-6 of its longest edge
+    // from its base's plane (measured 4.7e-8 and 1.9e-7).
+    let flattest = tets
+        .iter()
+        .filter(|t| t.role == apatch::complex::Role::Face)
+        .map(|t| {
+            let [a, b, c, q] = t.pts;
+            let n = (b - a).cross(c - a).normalize();
+            let l = [b - a, c - b, a - c, q - a, q - b, q - c]
+                .iter()
+                .fold(0.0_f64, |m, e| m.max(e.length()));
+            n.dot(q - a).abs() / l
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(flattest < 1e-6, "{flattest}");
+    let sys = system::assemble(&tets, hull.points.len() as u32).unwrap();
+    // Written from the thick side the rows carry barycentrics of thick neighbours (measured
+    // largest 59.4); the sliver's own side would give 7.1e10.
+    assert!(sys.max_coefficient() < 1e3, "{}", sys.max_coefficient());
+}

@@ -11,6 +11,7 @@
 pub mod cholesky;
 pub mod dense;
 pub mod jets;
+pub mod ordering;
 pub mod signs;
 pub mod sparse;
 pub mod system;

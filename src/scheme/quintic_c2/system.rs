@@ -224,6 +224,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
     let mut face_list: Vec<FaceUsers> = faces.into_iter().collect();
     face_list.sort_unstable_by_key(|(f, _)| *f);
     let mut equations = Vec::new();
+    let mut stable_swaps = 0usize;
     let mut boundary = vec![false; keys.len()];
     for (f, users) in face_list {
         match users.len() {
@@ -253,7 +254,22 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         if swap {
             std::mem::swap(&mut a, &mut b);
         }
+        // Stable direction: a sliver A (apex nearly in its base's plane; the nut's hull has
+        // L-U pairs 5e-8 of their size high) puts B's opposite vertex at barycentrics ~1e5 in
+        // A, so the C2 rows carry β² ~ 1e10 and the group's normal matrix is singular to
+        // rounding. The conditions of a face are symmetric (C1 and C2 either way span the same
+        // equations), so such a face is written from B, whose barycentrics of A's vertex are
+        // O(1) when B is thick.
+        let g = spread(tets, a, b);
+        if g > STABLE_SPREAD && spread(tets, b, a) < g {
+            std::mem::swap(&mut a, &mut b);
+            stable_swaps += 1;
+        }
         face_equations(tets, &slot_of, a, b, &mi, &mut equations)?;
+    }
+    if stable_swaps > 0 && std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
+        // Opt-in report on stderr (exploration; results unaffected).
+        eprintln!("quintic-c2: {stable_swaps} faces written from the thicker tetrahedron");
     }
     Ok(System {
         slot_of,
@@ -263,6 +279,22 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         np,
         req,
         boundary,
+    })
+}
+
+/// Largest |barycentric| of B's opposite vertex in A above which a face's C1/C2 equations are
+/// written from the other side when that side's is smaller ([`assemble`]). Adjacent thick
+/// tetrahedra give O(1)–O(10) (2 for the collinear edge-tetrahedron pairs); the shipped
+/// quintic scenes stay below it, so their equations are unchanged.
+pub const STABLE_SPREAD: f64 = 1e3;
+
+/// Largest |barycentric| of `b`'s opposite vertex in `a`'s tetrahedron (∞ when `a` is
+/// degenerate).
+fn spread(tets: &[HullTet], a: (u32, usize), b: (u32, usize)) -> f64 {
+    Tet::new(tets[a.0 as usize].pts).map_or(f64::INFINITY, |t| {
+        t.bary(tets[b.0 as usize].pts[b.1])
+            .iter()
+            .fold(0.0_f64, |m, x| m.max(x.abs()))
     })
 }
 
@@ -1096,6 +1128,16 @@ impl System {
         self.req[self.slot_of[t][crate::bb::index_of(l)] as usize]
     }
 
+    /// Largest |coefficient| of the C1/C2 equations (each has coefficient 1 on the weight it
+    /// defines): how far the rows are from the O(1) barycentrics of thick tetrahedra.
+    #[must_use]
+    pub fn max_coefficient(&self) -> f64 {
+        self.equations
+            .iter()
+            .flat_map(|e| e.terms.iter())
+            .fold(0.0_f64, |m, t| m.max(t.1.abs()))
+    }
+
     /// The 56 weights of tetrahedron `t` from the slot values.
     #[must_use]
     pub fn weights(&self, t: usize, value: &[f64]) -> Vec<f64> {
@@ -1131,6 +1173,10 @@ fn solve_rows(
         // Sparse direct: minimum-degree Cholesky of Â Âᵀ with refinement (Craig's method,
         // `sparse`, needed thousands of iterations on the knot's coupled groups).
         let t = std::time::Instant::now();
+        if let Some(dir) = std::env::var_os("APATCH_SOLVE_DUMP") {
+            // Opt-in dump of the large groups for offline solver experiments.
+            dump_group(std::path::Path::new(&dir), rows, n, c, tgt, scale);
+        }
         let sol = cholesky::solve_near(rows, n, c, tgt, 1e-13 * scale);
         if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
             // Opt-in timing of the large groups on stderr (exploration; results unaffected).
@@ -1142,6 +1188,41 @@ fn solve_rows(
             );
         }
         sol
+    }
+}
+
+/// Writes one group (`rows`, `c`, `tgt`, `scale`) as little-endian binary to a new numbered
+/// file in `dir` (exploration only, `APATCH_SOLVE_DUMP`): m, n as u64, `scale`, then per row
+/// its length (u64) and (column u64, coefficient f64) pairs, then c and tgt.
+fn dump_group(
+    dir: &std::path::Path,
+    rows: &[sparse::Row],
+    n: usize,
+    c: &[f64],
+    tgt: &[f64],
+    scale: f64,
+) {
+    let mut b: Vec<u8> = Vec::new();
+    b.extend((rows.len() as u64).to_le_bytes());
+    b.extend((n as u64).to_le_bytes());
+    b.extend(scale.to_le_bytes());
+    for r in rows {
+        b.extend((r.len() as u64).to_le_bytes());
+        for &(j, a) in r {
+            b.extend((j as u64).to_le_bytes());
+            b.extend(a.to_le_bytes());
+        }
+    }
+    for v in c.iter().chain(tgt) {
+        b.extend(v.to_le_bytes());
+    }
+    let _ = std::fs::create_dir_all(dir);
+    for k in 0.. {
+        let f = dir.join(format!("group{k:03}.bin"));
+        if !f.exists() {
+            let _ = std::fs::write(f, b);
+            break;
+        }
     }
 }
 

@@ -1,0 +1,248 @@
+//! Fill-reducing elimination order for the sparse direct solver ([`super::cholesky`]) on large
+//! groups: minimum degree on the quotient graph (elements), with approximate external degrees
+//! and element absorption, in the spirit of Amestoy, Davis and Duff's AMD.
+//!
+//! Why: the explicit-clique minimum degree of [`super::cholesky`] merges every eliminated
+//! node's neighbours into each other's adjacency lists, which costs the square of the growing
+//! cliques per elimination. On the groups of the real models (spot's coupled edge middles,
+//! 170k equations; relaxed stars, up to 970k) that took minutes and gigabytes before any
+//! factoring started. Here an eliminated node becomes an *element* (the list of its
+//! uneliminated neighbours), variables keep lists of adjacent elements and of the original
+//! neighbours not yet covered by an element, and degrees are the bound
+//! |A_i| + |L_p| − 1 + Σ_{e ≠ p} |L_e \ L_p| (never below the true external degree), so each
+//! elimination costs about the size of the lists it touches.
+//!
+//! Deterministic: the next pivot is the smallest approximate degree, ties broken by the
+//! smallest index, so the order does not depend on the thread count or on hashing.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Elimination order of the graph `adj` (sorted neighbour lists without the node itself) and
+/// the pattern of L's columns it gives (each node's uneliminated neighbours in the elimination
+/// graph when it is eliminated, exactly), unsorted.
+#[must_use]
+pub fn quotient_min_degree(adj: Vec<Vec<u32>>) -> (Vec<u32>, Vec<Vec<u32>>) {
+    let m = adj.len();
+    // Variable → original neighbours not yet covered by an element.
+    let mut vars = adj;
+    // Variable → adjacent live elements (an element is named by its pivot).
+    let mut elems: Vec<Vec<u32>> = vec![Vec::new(); m];
+    // Element → its variables (only uneliminated ones: eliminating a variable absorbs every
+    // element that holds it).
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); m];
+    let mut eliminated = vec![false; m];
+    let mut dead = vec![false; m];
+    let mut deg: Vec<usize> = vars.iter().map(Vec::len).collect();
+    let mut heap: BinaryHeap<Reverse<(usize, u32)>> =
+        (0..m).map(|v| Reverse((deg[v], v as u32))).collect();
+    // mark[i] == p: i is in L_p (the current pivot's new element).
+    let mut mark = vec![u32::MAX; m];
+    // |L_e \ L_p| of the elements next to L_p during one elimination (−1: not computed).
+    let mut w: Vec<i64> = vec![-1; m];
+    let mut touched: Vec<u32> = Vec::new();
+    let mut order = Vec::with_capacity(m);
+    let mut pattern: Vec<Vec<u32>> = vec![Vec::new(); m];
+    let mut remaining = m;
+    while let Some(Reverse((d, p))) = heap.pop() {
+        let pi = p as usize;
+        if eliminated[pi] || d != deg[pi] {
+            continue; // stale entry
+        }
+        eliminated[pi] = true;
+        order.push(p);
+        remaining -= 1;
+        // L_p: p's variables and the variables of its elements, which p absorbs.
+        let mut lp: Vec<u32> = Vec::new();
+        mark[pi] = p;
+        for &j in &vars[pi] {
+            let ji = j as usize;
+            if !eliminated[ji] && mark[ji] != p {
+                mark[ji] = p;
+                lp.push(j);
+            }
+        }
+        for &e in &elems[pi] {
+            let ei = e as usize;
+            if dead[ei] {
+                continue;
+            }
+            for &j in &members[ei] {
+                let ji = j as usize;
+                if !eliminated[ji] && mark[ji] != p {
+                    mark[ji] = p;
+                    lp.push(j);
+                }
+            }
+            dead[ei] = true;
+            members[ei] = Vec::new();
+        }
+        vars[pi] = Vec::new();
+        elems[pi] = Vec::new();
+        lp.sort_unstable();
+        // |L_e \ L_p| for every live element next to L_p.
+        for &i in &lp {
+            let ii = i as usize;
+            elems[ii].retain(|&e| !dead[e as usize]);
+            for &e in &elems[ii] {
+                let ei = e as usize;
+                if w[ei] < 0 {
+                    w[ei] = members[ei].len() as i64;
+                    touched.push(e);
+                }
+                w[ei] -= 1;
+            }
+        }
+        for &i in &lp {
+            let ii = i as usize;
+            // Elements inside L_p are covered by p's (absorbed below); variables in L_p too.
+            elems[ii].retain(|&e| w[e as usize] != 0);
+            vars[ii].retain(|&j| !eliminated[j as usize] && mark[j as usize] != p);
+            let external: usize = elems[ii].iter().map(|&e| w[e as usize] as usize).sum();
+            let dnew = (vars[ii].len() + lp.len() - 1 + external).min(remaining - 1);
+            elems[ii].push(p);
+            deg[ii] = dnew;
+            heap.push(Reverse((dnew, i)));
+        }
+        for &e in &touched {
+            let ei = e as usize;
+            if w[ei] == 0 {
+                dead[ei] = true;
+                members[ei] = Vec::new();
+            }
+            w[ei] = -1;
+        }
+        touched.clear();
+        members[pi].clone_from(&lp);
+        pattern[pi] = lp;
+    }
+    (order, pattern)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Pattern of L by brute-force symbolic elimination in the given order (explicit cliques):
+    /// the independent truth the quotient graph's patterns must equal.
+    fn brute_patterns(adj: &[Vec<u32>], order: &[u32]) -> Vec<Vec<u32>> {
+        let m = adj.len();
+        let mut g: Vec<std::collections::BTreeSet<u32>> =
+            adj.iter().map(|a| a.iter().copied().collect()).collect();
+        let mut done = vec![false; m];
+        let mut out = vec![Vec::new(); m];
+        for &p in order {
+            let nb: Vec<u32> = g[p as usize]
+                .iter()
+                .copied()
+                .filter(|&u| !done[u as usize])
+                .collect();
+            for &a in &nb {
+                for &b in &nb {
+                    if a != b {
+                        g[a as usize].insert(b);
+                    }
+                }
+            }
+            done[p as usize] = true;
+            out[p as usize] = nb;
+        }
+        out
+    }
+
+    /// On seeded random sparse graphs and a 2D grid, every node is eliminated once and each
+    /// column pattern is exactly the symbolic elimination's in that order.
+    #[test]
+    fn patterns_match_symbolic_elimination() {
+        let mut s = 42_u64;
+        let mut next = |k: u64| {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) % k
+        };
+        let mut graphs: Vec<Vec<Vec<u32>>> = Vec::new();
+        for m in [1usize, 2, 30, 200, 600] {
+            let mut adj = vec![Vec::new(); m];
+            for _ in 0..2 * m {
+                let (a, b) = (next(m as u64) as u32, next(m as u64) as u32);
+                if a != b {
+                    adj[a as usize].push(b);
+                    adj[b as usize].push(a);
+                }
+            }
+            graphs.push(adj);
+        }
+        let k = 20;
+        let mut grid = vec![Vec::new(); k * k];
+        for i in 0..k {
+            for j in 0..k {
+                let v = (i * k + j) as u32;
+                if i + 1 < k {
+                    grid[v as usize].push(v + k as u32);
+                    grid[v as usize + k].push(v);
+                }
+                if j + 1 < k {
+                    grid[v as usize].push(v + 1);
+                    grid[v as usize + 1].push(v);
+                }
+            }
+        }
+        graphs.push(grid);
+        for mut adj in graphs {
+            for a in &mut adj {
+                a.sort_unstable();
+                a.dedup();
+            }
+            let (order, pattern) = quotient_min_degree(adj.clone());
+            let mut seen = order.clone();
+            seen.sort_unstable();
+            assert_eq!(seen, (0..adj.len() as u32).collect::<Vec<_>>());
+            let truth = brute_patterns(&adj, &order);
+            for (v, (p, t)) in pattern.iter().zip(&truth).enumerate() {
+                let mut p = p.clone();
+                let mut t = t.clone();
+                p.sort_unstable();
+                t.sort_unstable();
+                assert_eq!(p, t, "node {v}");
+            }
+        }
+    }
+
+    /// On a grid (where fill matters) the approximate degrees order about as well as exact
+    /// minimum degree ([`super::super::cholesky::min_degree`], explicit cliques), and far
+    /// better than the natural order (band fill ~k³).
+    #[test]
+    fn grid_fill_close_to_exact_minimum_degree() {
+        let k = 30;
+        let mut adj = vec![Vec::new(); k * k];
+        for i in 0..k {
+            for j in 0..k {
+                let v = i * k + j;
+                if i + 1 < k {
+                    adj[v].push((v + k) as u32);
+                    adj[v + k].push(v as u32);
+                }
+                if j + 1 < k {
+                    adj[v].push((v + 1) as u32);
+                    adj[v + 1].push(v as u32);
+                }
+            }
+        }
+        for a in &mut adj {
+            a.sort_unstable();
+        }
+        let (_, pattern) = quotient_min_degree(adj.clone());
+        let nnz: usize = pattern.iter().map(Vec::len).sum();
+        let (_, exact, _) = super::super::cholesky::min_degree(adj);
+        let nnz_exact: usize = exact.iter().map(Vec::len).sum();
+        // Approximate degrees overestimate where elements overlap, so ties break differently;
+        // AMD's published fill is within a few per cent of exact minimum degree, 1.5× is loose.
+        assert!(
+            (nnz as f64) < 1.5 * nnz_exact as f64,
+            "{nnz} vs {nnz_exact}"
+        );
+        // Natural order: every node keeps the next k in its column, k³ = 27000 entries.
+        assert!(nnz < k * k * k / 2, "{nnz}");
+    }
+}
