@@ -220,3 +220,36 @@ fn mpi_poly_cell_stays_clear_of_its_corner_apexes() {
         .collect();
     assert!(overlaps.is_empty(), "{overlaps:#?}");
 }
+
+/// Needle face 35's guard net leaves one piece's guard without a corner (the assignment gives
+/// each region corner ONE guard); that point, (0, 1.43, 4.01), had no triangle, so no patch
+/// interpolated it and `apatch check` failed vertex value 1.9e-3 / normal 0.37 there. Every
+/// point of T must be a corner of a triangle of T; the unassigned guard is dropped.
+#[test]
+fn mpi_poly_every_point_of_t_has_a_triangle() {
+    let path = Path::new("scenes/models/mpi_poly.obj");
+    let (m, _) = mesh::load(path).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+    let mut used = vec![false; hull.points.len()];
+    for t in &hull.triangles {
+        for &i in t {
+            used[i as usize] = true;
+        }
+    }
+    let orphans: Vec<(usize, DVec3, PointOrigin)> = (0..used.len())
+        .filter(|&i| !used[i])
+        .map(|i| (i, hull.points[i], hull.origins[i]))
+        .collect();
+    assert!(
+        orphans.is_empty(),
+        "points of T without a triangle: {orphans:?}"
+    );
+    assert_eq!(hull.normals.len(), hull.points.len());
+    assert_eq!(hull.origins.len(), hull.points.len());
+    // The dropped guard: exactly the one of face 35 (before the fix it was point 50).
+    assert_eq!(rep.unused_points, vec![50]);
+    // And no point of T lies there any more (0.01: the next points of T are ≥ 0.3 away).
+    let target = DVec3::new(0.0, 1.430335, 4.006873);
+    assert!(hull.points.iter().all(|p| (*p - target).length() > 0.01));
+}

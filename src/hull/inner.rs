@@ -77,6 +77,7 @@ pub mod remesh;
 pub mod sides;
 pub mod umbrella;
 pub mod unfold;
+pub mod unused;
 pub mod verify;
 pub mod wedge;
 
@@ -271,6 +272,9 @@ pub struct InnerReport {
     pub umbrella_normals: Vec<u32>,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
+    /// Points of T no triangle used (guards the guard net gave no corner), dropped
+    /// ([`unused`]); indices before the drop.
+    pub unused_points: Vec<u32>,
 }
 
 /// Builds the inner simplicial hull of `mesh` (polygons, counter-clockwise from outside) with
@@ -285,7 +289,8 @@ pub fn build(mesh: &Mesh, normals: &[DVec3], options: &InnerOptions) -> Result<S
 /// [`build`], also returning what was changed on the way.
 ///
 /// T's points are, in order: one per convex piece of every polygon (its centroid; normal = the
-/// polygon's normal), then one pseudo-centroid per non-trihedral vertex. Triangles are emitted
+/// polygon's normal), then one pseudo-centroid per non-trihedral vertex; points no triangle
+/// uses (a guard net's unassigned guards) are dropped at the end ([`unused`]). Triangles are emitted
 /// vertex by vertex; `element` is the input vertex.
 ///
 /// # Errors
@@ -470,5 +475,12 @@ pub fn build_with_report(
     report.wedged = wedge::keep_in_wedges(&mut hull);
     report.lifted_apexes = clearance::lift_apexes(&mut hull);
     report.degenerate_repaired = degenerate::repair(&mut hull, &mesh.vertex_lines)?;
+    let (unused_points, renumber) = unused::drop_unused_points(&mut hull);
+    if !unused_points.is_empty() {
+        for i in &mut report.umbrella_normals {
+            *i = renumber[*i as usize].expect("an umbrella point has fan triangles");
+        }
+    }
+    report.unused_points = unused_points;
     Ok((hull, report))
 }
