@@ -360,7 +360,7 @@ pub fn build_with_report(
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.
     let mut net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
     // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
-    let flat = flatnet::spread_guards(&mut net, mesh, &merged_counts);
+    let flat = flatnet::spread_guards_folded(&mut net, mesh, &merged_counts, Some(normals));
     report.flat_nets = flat.groups.len();
     let pieces = &net.pieces;
     let input_face = |f: u32| mesh.face_parent[f as usize];

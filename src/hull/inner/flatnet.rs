@@ -21,6 +21,10 @@
 //!   [`super::decompose::GUARD_REACH`] × a corner's longer edge from that corner qualify:
 //!   single convex faces with short edges (random convex solids) keep their centroid, and
 //!   giving every merged region a flat net made fandisk worse (small regions' guards crowd);
+//!   with the vertex normals ([`spread_guards_folded`]) so do merged regions whose point of T
+//!   folds a corner's fan (a gap wider than [`FOLD_GAP`] between consecutive fan points round
+//!   n_V: fandisk's strips of coplanar triangles with straight corners, whose vertex mean lies
+//!   a few degrees from a straight corner's edge), in passes while new ones appear;
 //! - the polygon's points of T (its pieces) become the guards of its first corners, the other
 //!   guards are new points of T (same face, same normal);
 //! - every corner V's fan names V's own guard for the face, so Algorithm 1 / 2 builds V's
@@ -111,6 +115,49 @@ impl Frame {
 /// (the polygon's own pieces reused first), fans naming them, step (5') cells on its edges.
 /// The interior triangles are added to the hull by [`FlatNets::add_triangles`].
 pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh, merged: &[usize]) -> FlatNets {
+    spread_guards_folded(net, mesh, merged, None)
+}
+
+/// Widest fan gap (radians, counter-clockwise round n_V between consecutive points of a
+/// corner's fan, projected along n_V) next to a merged polygon's point beyond which the
+/// polygon gets a flat net too ([`spread_guards_folded`]): π, where the fan triangle
+/// [C_0, C_i, C_{i+1}] turns over (fandisk's 6-corner strip [550, 640, 847, 1384, 1385, 641],
+/// whose corner 641 is straight and whose vertex mean lies 4° from the edge to 1385: gap 211°,
+/// the inverted triangle 3735).
+pub const FOLD_GAP: f64 = std::f64::consts::PI;
+
+/// Sine of the turn below which a polygon's corner of about π counts as straight (0.1°).
+pub const STRAIGHT_SIN: f64 = 1.75e-3;
+
+/// Width (twice the area over the diameter) below which a convex polygon counts as a strip, as
+/// a share of its diameter: fandisk's strips are 0.13 long and 0.017 wide.
+pub const STRIP_WIDTH: f64 = 0.25;
+
+/// Least cosine between a vertex normal and every face normal round it for the fold test
+/// (cos 10°).
+pub const FLAT_VERTEX_COS: f64 = 0.985;
+
+/// Most passes over the polygons when fold qualifies them ([`spread_guards_folded`]).
+pub const FOLD_PASSES: usize = 4;
+
+/// Counter-clockwise angle round `n` from `a` to `b`, in [0, 2π).
+fn ccw(n: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let t = n.dot(a.cross(b)).atan2(a.dot(b));
+    if t < 0.0 {
+        t + 2.0 * std::f64::consts::PI
+    } else {
+        t
+    }
+}
+
+/// [`spread_guards`], with the vertex normals `normals` (when given) also qualifying merged
+/// polygons whose point of T folds a corner's fan: a gap next to it wider than [`FOLD_GAP`].
+pub fn spread_guards_folded(
+    net: &mut GuardNet,
+    mesh: &Mesh,
+    merged: &[usize],
+    normals: Option<&[DVec3]>,
+) -> FlatNets {
     let pos = &mesh.positions;
     let mut out = FlatNets::default();
     let np = net.pieces.faces.len();
@@ -123,87 +170,165 @@ pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh, merged: &[usize]) -> FlatN
     }
     let mut faces: Vec<u32> = of_face.keys().copied().collect();
     faces.sort_unstable();
-    for f in faces {
-        let own = of_face[&f].clone();
-        let face = mesh.faces[f as usize].clone();
-        if face.len() < MIN_CORNERS || merged.get(f as usize).copied().unwrap_or(1) < 2 {
-            continue;
-        }
-        let mut sorted = face.clone();
-        sorted.sort_unstable();
-        sorted.dedup();
-        // One region holding exactly this polygon's pieces.
-        let r = net.region[own[0] as usize];
-        let region_ok = (0..np).all(|q| (net.region[q] == r) == (net.pieces.parent[q] == f));
-        if sorted.len() != face.len() || !region_ok || face.iter().any(|&v| net.inside(v)) {
-            continue;
-        }
-        // Every corner's fan holds one of the pieces exactly once.
-        let fans: Option<Vec<(Fan, usize)>> = face
-            .iter()
-            .map(|&v| {
-                let fan = net.fan(v).filter(|x| x.closed)?;
-                let at: Vec<usize> = (0..fan.faces.len())
-                    .filter(|&i| own.contains(&fan.faces[i]))
-                    .collect();
-                (at.len() == 1).then(|| (fan, at[0]))
-            })
-            .collect();
-        let Some(fans) = fans else { continue };
-        let k = face.len();
-        let far = (0..k).any(|i| {
-            let p = |j: usize| pos[face[j % k] as usize];
-            let v = p(i);
-            let e = (p(i + 1) - v).length().max((p(i + k - 1) - v).length());
-            let g = net.pieces.center[fans[i].0.faces[fans[i].1] as usize];
-            (g - v).length() > super::decompose::GUARD_REACH * e
-        });
-        if !far {
-            continue;
-        }
-        let n = net.pieces.normal[own[0] as usize];
-        let mean = face.iter().map(|&v| pos[v as usize]).sum::<DVec3>() / k as f64;
-        let u = n.any_orthonormal_vector();
-        let frame = Frame {
-            o: mean,
-            u,
-            v: n.cross(u),
-            n,
-        };
-        let Some((gpos, tris)) = place_guards(&frame, pos, &face) else {
-            continue;
-        };
-        // Guard pieces: the polygon's own first (every point of T stays used), new ones after.
-        let mut guards = Vec::with_capacity(k);
-        for (i, &g) in gpos.iter().enumerate() {
-            let g = g - frame.n.dot(g - mean) * frame.n;
-            if let Some(&q) = own.get(i) {
-                net.pieces.center[q as usize] = g;
-                net.pieces.guard[q as usize] = true;
-                guards.push(q);
-            } else {
-                let q = net.pieces.faces.len() as u32;
-                net.pieces.faces.push(face.clone());
-                net.pieces.parent.push(f);
-                net.pieces.normal.push(n);
-                net.pieces.guard.push(true);
-                net.pieces.center.push(g);
-                net.region.push(r);
-                guards.push(q);
+    // Passes: a polygon's fans change when a neighbour gets its net, which can fold them.
+    let mut done = std::collections::HashSet::new();
+    for _ in 0..FOLD_PASSES {
+        let found = out.groups.len();
+        for &f in &faces {
+            if done.contains(&f) {
+                continue;
             }
+            let own = of_face[&f].clone();
+            let face = mesh.faces[f as usize].clone();
+            if face.len() < MIN_CORNERS || merged.get(f as usize).copied().unwrap_or(1) < 2 {
+                continue;
+            }
+            let mut sorted = face.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            // One region holding exactly this polygon's pieces.
+            let r = net.region[own[0] as usize];
+            let region_ok = (0..np).all(|q| (net.region[q] == r) == (net.pieces.parent[q] == f));
+            if sorted.len() != face.len() || !region_ok || face.iter().any(|&v| net.inside(v)) {
+                continue;
+            }
+            // Every corner's fan holds one of the pieces exactly once.
+            let fans: Option<Vec<(Fan, usize)>> = face
+                .iter()
+                .map(|&v| {
+                    let fan = net.fan(v).filter(|x| x.closed)?;
+                    let at: Vec<usize> = (0..fan.faces.len())
+                        .filter(|&i| own.contains(&fan.faces[i]))
+                        .collect();
+                    (at.len() == 1).then(|| (fan, at[0]))
+                })
+                .collect();
+            let Some(fans) = fans else { continue };
+            let k = face.len();
+            let far = (0..k).any(|i| {
+                let p = |j: usize| pos[face[j % k] as usize];
+                let v = p(i);
+                let e = (p(i + 1) - v).length().max((p(i + k - 1) - v).length());
+                let g = net.pieces.center[fans[i].0.faces[fans[i].1] as usize];
+                (g - v).length() > super::decompose::GUARD_REACH * e
+            });
+            // Only strips: convex polygons with a straight corner (a vertex of the old
+            // triangulation on an edge; fandisk's folds), so no other model's hull changes.
+            let corner_turn = |i: usize| {
+                let v = pos[face[i] as usize];
+                let a = pos[face[(i + 1) % k] as usize] - v;
+                let b = pos[face[(i + k - 1) % k] as usize] - v;
+                (
+                    a.cross(b).length() / (a.length() * b.length()),
+                    a.dot(b) < 0.0,
+                )
+            };
+            let diameter = face
+                .iter()
+                .flat_map(|&a| {
+                    face.iter()
+                        .map(move |&b| (pos[a as usize] - pos[b as usize]).length())
+                })
+                .fold(0.0, f64::max);
+            let area = 0.5 * crate::mesh::geometry::area_vector(pos, &face).length();
+            let strip = 2.0 * area < STRIP_WIDTH * diameter * diameter
+                && crate::mesh::convexity::polygon_is_convex(pos, &face)
+                && (0..k).any(|i| {
+                    let (sin, opposite) = corner_turn(i);
+                    opposite && sin < STRAIGHT_SIN
+                });
+            let folds = strip
+                && normals.is_some_and(|normals| {
+                    (0..k).any(|i| {
+                        let v = pos[face[i] as usize];
+                        let (fan, _) = &fans[i];
+                        let m = fan.ring.len();
+                        // A vertex with a reflex face corner (beyond rounding: straight ones count)
+                        // has a fan gap beyond π by itself (Algorithm 2's hallway corners): no fold.
+                        let reflex = (0..fan.faces.len()).any(|j| {
+                            let a = pos[fan.ring[j] as usize] - v;
+                            let b = pos[fan.ring[(j + 1) % m] as usize] - v;
+                            let nf = net.pieces.normal[fan.faces[j] as usize];
+                            a.cross(b).dot(nf) < -1e-9 * a.length() * b.length()
+                        });
+                        if reflex {
+                            return false;
+                        }
+                        // Only nearly flat vertices (fandisk's strips lie within 4° of their
+                        // neighbours); sharp vertices keep their fans (the nut's).
+                        let flat = normals.get(face[i] as usize).is_some_and(|n| {
+                            let n = n.normalize_or_zero();
+                            fan.faces
+                                .iter()
+                                .all(|&g| net.pieces.normal[g as usize].dot(n) > FLAT_VERTEX_COS)
+                        });
+                        if !flat {
+                            return false;
+                        }
+                        let Some(n) = normals
+                            .get(face[i] as usize)
+                            .and_then(|n| n.try_normalize())
+                        else {
+                            return false;
+                        };
+                        let (fan, at) = &fans[i];
+                        let m = fan.faces.len();
+                        let c = |j: usize| net.pieces.center[fan.faces[j % m] as usize] - v;
+                        let g = c(*at);
+                        ccw(n, c(at + m - 1), g).max(ccw(n, g, c(at + 1))) > FOLD_GAP
+                    })
+                });
+            if !far && !folds {
+                continue;
+            }
+            let n = net.pieces.normal[own[0] as usize];
+            let mean = face.iter().map(|&v| pos[v as usize]).sum::<DVec3>() / k as f64;
+            let u = n.any_orthonormal_vector();
+            let frame = Frame {
+                o: mean,
+                u,
+                v: n.cross(u),
+                n,
+            };
+            let Some((gpos, tris)) = place_guards(&frame, pos, &face) else {
+                continue;
+            };
+            // Guard pieces: the polygon's own first (every point of T stays used), new ones after.
+            let mut guards = Vec::with_capacity(k);
+            for (i, &g) in gpos.iter().enumerate() {
+                let g = g - frame.n.dot(g - mean) * frame.n;
+                if let Some(&q) = own.get(i) {
+                    net.pieces.center[q as usize] = g;
+                    net.pieces.guard[q as usize] = true;
+                    guards.push(q);
+                } else {
+                    let q = net.pieces.faces.len() as u32;
+                    net.pieces.faces.push(face.clone());
+                    net.pieces.parent.push(f);
+                    net.pieces.normal.push(n);
+                    net.pieces.guard.push(true);
+                    net.pieces.center.push(g);
+                    net.region.push(r);
+                    guards.push(q);
+                }
+            }
+            for (i, (&v, (fan, at))) in face.iter().zip(fans).enumerate() {
+                let mut fan = fan;
+                fan.faces[at] = guards[i];
+                net.set_fan(v, fan);
+            }
+            out.groups.push(FlatGroup {
+                piece: own[0],
+                face: f,
+                corners: face.clone(),
+                guards: guards.clone(),
+                triangles: tris.iter().map(|t| t.map(|i| guards[i as usize])).collect(),
+            });
+            done.insert(f);
         }
-        for (i, (&v, (fan, at))) in face.iter().zip(fans).enumerate() {
-            let mut fan = fan;
-            fan.faces[at] = guards[i];
-            net.set_fan(v, fan);
+        if out.groups.len() == found || normals.is_none() {
+            break;
         }
-        out.groups.push(FlatGroup {
-            piece: own[0],
-            face: f,
-            corners: face.clone(),
-            guards: guards.clone(),
-            triangles: tris.iter().map(|t| t.map(|i| guards[i as usize])).collect(),
-        });
     }
     if out.groups.is_empty() {
         return out;
