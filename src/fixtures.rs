@@ -526,3 +526,36 @@ pub fn quad_torus(nu: usize, nv: usize) -> crate::mesh::Mesh {
         .expect("a valid torus")
         .0
 }
+
+/// Writes `mesh` as an OBJ and a small `cubic-c1` scene (8×8 camera looking at `target`) with the
+/// extra `[scheme]` lines `scheme` into a fresh directory `prefix_<pid>_<name>` under the system's
+/// temporary directory; returns the scene's path. For tests that run the CLI or the scene loader
+/// on a generated polyhedron.
+pub fn write_cubic_scene(
+    prefix: &str,
+    name: &str,
+    mesh: &crate::mesh::Mesh,
+    scheme: &str,
+    target: [f64; 3],
+) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("{prefix}_{}_{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut obj = String::new();
+    for p in &mesh.positions {
+        obj.push_str(&format!("v {:.17} {:.17} {:.17}\n", p.x, p.y, p.z));
+    }
+    for f in &mesh.faces {
+        let idx: Vec<String> = f.iter().map(|v| (v + 1).to_string()).collect();
+        obj.push_str(&format!("f {}\n", idx.join(" ")));
+    }
+    std::fs::write(dir.join("m.obj"), obj).unwrap();
+    let [tx, ty, tz] = target;
+    let scene = format!(
+        "[model]\nfile = \"m.obj\"\nnormals = \"angle\"\n[scheme]\ntype = \"cubic-c1\"\n{scheme}\n\
+         [camera]\norigin = [4, 3, 5]\ntarget = [{tx}, {ty}, {tz}]\nfov = 30\nwidth = 8\nheight = 8\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [-1, -1, -1]\nirradiance = 2.0\n"
+    );
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    path
+}

@@ -51,25 +51,7 @@ fn horn(n: usize, gap: f64, twist: f64) -> Mesh {
 /// Writes `mesh` as an OBJ and a cubic-c1 scene with the extra `[scheme]` lines `scheme` into a
 /// fresh directory under the system's temporary directory; returns the scene's path.
 fn write_scene(name: &str, mesh: &Mesh, scheme: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("apatch_inner_cage_{}_{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let mut obj = String::new();
-    for p in &mesh.positions {
-        obj.push_str(&format!("v {:.17} {:.17} {:.17}\n", p.x, p.y, p.z));
-    }
-    for f in &mesh.faces {
-        let idx: Vec<String> = f.iter().map(|v| (v + 1).to_string()).collect();
-        obj.push_str(&format!("f {}\n", idx.join(" ")));
-    }
-    std::fs::write(dir.join("m.obj"), obj).unwrap();
-    let scene = format!(
-        "[model]\nfile = \"m.obj\"\nnormals = \"angle\"\n[scheme]\ntype = \"cubic-c1\"\n{scheme}\n\
-         [camera]\norigin = [4, 3, 5]\ntarget = [0, 0, 0]\nfov = 30\nwidth = 8\nheight = 8\n\
-         [[lights]]\ntype = \"directional\"\ndirection = [-1, -1, -1]\nirradiance = 2.0\n"
-    );
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, scene).unwrap();
-    path
+    apatch::fixtures::write_cubic_scene("apatch_inner_cage", name, mesh, scheme, [0.0, 0.0, 0.0])
 }
 
 /// The scene's hull violations and whether its cubic surface passes `check` (C1 jumps ≤ 1e-9

@@ -138,14 +138,20 @@ pub(crate) fn min_degree(mut adj: Vec<Vec<u32>>) -> (Vec<u32>, Vec<Vec<u32>>, Ve
         }
         pattern[vi] = nb;
     }
-    let mut pos = vec![0usize; m];
+    let pos = sort_by_position(&order, &mut pattern);
+    (order, pattern, pos)
+}
+
+/// Each node's position in the elimination `order`; sorts every column pattern by it.
+fn sort_by_position(order: &[u32], pattern: &mut [Vec<u32>]) -> Vec<usize> {
+    let mut pos = vec![0usize; order.len()];
     for (k, &v) in order.iter().enumerate() {
         pos[v as usize] = k;
     }
-    for p in &mut pattern {
+    for p in pattern {
         p.sort_unstable_by_key(|&u| pos[u as usize]);
     }
-    (order, pattern, pos)
+    pos
 }
 
 /// Elimination order, L's column patterns (sorted by elimination position) and each node's
@@ -170,13 +176,7 @@ fn symbolic(m: usize, off: &[(u32, u32, f64)]) -> Symbolic {
     let t = std::time::Instant::now();
     let (order, pattern, pos) = if m > QUOTIENT_LIMIT {
         let (order, mut pattern) = super::ordering::quotient_min_degree(adj);
-        let mut pos = vec![0usize; m];
-        for (k, &v) in order.iter().enumerate() {
-            pos[v as usize] = k;
-        }
-        for p in &mut pattern {
-            p.sort_unstable_by_key(|&u| pos[u as usize]);
-        }
+        let pos = sort_by_position(&order, &mut pattern);
         (order, pattern, pos)
     } else {
         min_degree(adj)
