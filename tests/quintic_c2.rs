@@ -122,3 +122,131 @@ fn perturbed_hull_is_c2() {
     assert!(r.interpolation.normal_angle.worst <= 1e-9);
     assert!(r.passed(), "{:?}", r.failures());
 }
+
+/// A fan of `k` triangles of T around the point 0 (ring points at angles `angles`, heights
+/// `z`), one outer face tetrahedron per triangle with apex over its centroid moved by
+/// `offsets`: the star of point 0 is closed (edge tetrahedra on every edge at 0).
+fn fan_hull(
+    angles: &[f64],
+    z: &[f64],
+    offsets: &[glam::DVec3],
+) -> apatch::hull::simplicial::SimplicialHull {
+    use apatch::hull::simplicial::{PointOrigin, SimplicialHull};
+    use glam::DVec3;
+    let k = angles.len();
+    let mut points = vec![DVec3::ZERO];
+    for m in 0..k {
+        points.push(DVec3::new(angles[m].cos(), angles[m].sin(), z[m]));
+    }
+    let triangles: Vec<[u32; 3]> = (0..k)
+        .map(|m| [0, 1 + m as u32, 1 + ((m + 1) % k) as u32])
+        .collect();
+    let apexes = triangles
+        .iter()
+        .zip(offsets)
+        .map(|(t, o)| {
+            let c = t.iter().map(|&v| points[v as usize]).sum::<DVec3>() / 3.0;
+            [Some(c + *o), None]
+        })
+        .collect();
+    SimplicialHull {
+        normals: vec![DVec3::Z; k + 1],
+        origins: vec![PointOrigin::Other; k + 1],
+        element: (0..k as u32).collect(),
+        points,
+        triangles,
+        apexes,
+    }
+}
+
+/// (rows, cols, rank drop, smallest σ/σmax above the drop) of the star system of point 0.
+fn star_of_centre(
+    hull: &apatch::hull::simplicial::SimplicialHull,
+    rule: apatch::hull::simplicial::EdgePoint,
+) -> (usize, usize, usize, f64) {
+    use apatch::scheme::quintic_c2::{dense, system};
+    let (tets, _) = system::tetrahedra_with(hull, rule).unwrap();
+    let sys = system::assemble(&tets, hull.points.len() as u32).unwrap();
+    let st = sys
+        .star_systems()
+        .into_iter()
+        .find(|s| s.point == 0)
+        .unwrap();
+    let s = dense::singular_values(&st.matrix, st.rows, st.cols);
+    // Structural zeros come out at 1e-16 of σmax and below (rounding of the equations'
+    // coefficients); the other singular values of these O(1) stars are above 1e-4.
+    let rank = s.iter().filter(|&&x| x > 1e-10 * s[0]).count();
+    (
+        st.rows,
+        st.cols,
+        st.rows.min(st.cols) - rank,
+        s[rank - 1] / s[0],
+    )
+}
+
+/// Issue 8: the vertex-star system of appendices D and E (numbers 5, 6 and 9 around a point
+/// with k triangles: 12k equations in 12k weights) is singular for *every* hull, not only for
+/// points in special position. Appendix D's chain has determinant Πφ − (−1)^k Πψ, and the
+/// ratios φ_i/ψ_i telescope to ±1 around the point whatever the apexes and the edge
+/// tetrahedra's shared point s are (docs/quintic.md: each ratio is a quotient of
+/// det(d_{i−1}, d_i, d_{i+1})-terms of the edges d_i at the point), so the rank drops by
+/// exactly one on a generic star, for s at the apexes' midpoint, elsewhere on their line, or
+/// off it. Appendix E's chain is nonsingular on a generic star but singular too where every
+/// edge's two triangles are mirror images (a regular fan): there the drop is two at the
+/// midpoint and one with s off the middle.
+#[test]
+fn star_systems_are_singular_for_every_edge_point() {
+    use apatch::hull::simplicial::EdgePoint;
+    use glam::DVec3;
+    // Seeded jitter (LCG) for a generic fan of 5 triangles.
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut rnd = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let k = 5;
+    let rules = [
+        EdgePoint::Midpoint,
+        EdgePoint::Ratio(0.3),
+        EdgePoint::Lift(0.5),
+        EdgePoint::Lift(-0.4),
+    ];
+    for _fan in 0..3 {
+        let angles: Vec<f64> = (0..k)
+            .map(|m| std::f64::consts::TAU * (m as f64 + 0.3 * rnd()) / k as f64)
+            .collect();
+        let z: Vec<f64> = (0..k).map(|_| -0.2 + 0.3 * rnd()).collect();
+        let offsets: Vec<DVec3> = (0..k)
+            .map(|_| DVec3::new(0.2 * rnd(), 0.2 * rnd(), 0.5 + 0.3 * rnd()))
+            .collect();
+        let hull = fan_hull(&angles, &z, &offsets);
+        for rule in rules {
+            let (m, n, drop, next) = star_of_centre(&hull, rule);
+            assert_eq!((m, n), (12 * k, 12 * k), "{rule:?}");
+            assert_eq!(
+                drop, 1,
+                "{rule:?}: appendix D's chain, singular for any geometry"
+            );
+            // The rest is well conditioned on a generic fan (1e-4 and above here).
+            assert!(next > 1e-7, "{rule:?}: {next:e}");
+        }
+    }
+    // A regular fan: every edge's two triangles (and apexes) are mirror images.
+    let angles: Vec<f64> = (0..k)
+        .map(|m| std::f64::consts::TAU * m as f64 / k as f64)
+        .collect();
+    let hull = fan_hull(&angles, &[-0.2; 5], &[DVec3::new(0.0, 0.0, 0.5); 5]);
+    assert_eq!(star_of_centre(&hull, EdgePoint::Midpoint).2, 2);
+    assert_eq!(
+        star_of_centre(&hull, EdgePoint::Lift(0.5)).2,
+        2,
+        "s on the mirror"
+    );
+    assert_eq!(
+        star_of_centre(&hull, EdgePoint::Ratio(0.3)).2,
+        1,
+        "mirror broken"
+    );
+}

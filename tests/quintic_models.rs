@@ -868,3 +868,111 @@ fn sign_miss_classes() {
         }
     }
 }
+
+/// Exploration (issue 8): rank and σ_min/σ_max of the vertex-star systems (appendices D and E)
+/// of a scene's hull for each placement of the edge tetrahedra's shared point s.
+/// `SCENE=path [EVERY=k] [RULES=mid,lift:0.3,ratio:0.3] cargo test --release --test
+/// quintic_models star_conditioning -- --ignored --nocapture`.
+#[test]
+#[ignore = "exploration: SCENE=path"]
+fn star_conditioning() {
+    use apatch::hull::simplicial::EdgePoint;
+    use apatch::scheme::quintic_c2::{dense, system};
+    let path = std::path::PathBuf::from(std::env::var("SCENE").unwrap());
+    let sc = apatch::scene::load(&path).unwrap();
+    let hull = apatch::scene::inner_hull(&sc).unwrap().unwrap();
+    let (hull, _) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+    let every: usize = std::env::var("EVERY")
+        .ok()
+        .and_then(|x| x.parse().ok())
+        .unwrap_or(1);
+    let rules = std::env::var("RULES").unwrap_or_else(|_| "mid,lift:0.3,lift:-0.3".into());
+    for r in rules.split(',') {
+        let rule = match r.split_once(':') {
+            None => EdgePoint::Midpoint,
+            Some(("lift", t)) => EdgePoint::Lift(t.parse().unwrap()),
+            Some(("ratio", t)) => EdgePoint::Ratio(t.parse().unwrap()),
+            Some(other) => panic!("unknown rule {other:?}"),
+        };
+        let (tets, _) = system::tetrahedra_with(&hull, rule).unwrap();
+        let sys = system::assemble(&tets, hull.points.len() as u32).unwrap();
+        let stars = sys.star_systems();
+        let mut ratios: Vec<f64> = Vec::new();
+        let mut shapes: std::collections::BTreeMap<(usize, usize, usize), usize> =
+            Default::default();
+        let mut deficient = 0;
+        let mut next: Vec<f64> = Vec::new();
+        if let Ok(dir) = std::env::var("STAR_DUMP") {
+            // One star per shape as JSON for offline analysis.
+            let mut seen = std::collections::HashSet::new();
+            for st in &stars {
+                if seen.insert((st.rows, st.cols)) {
+                    let cols: Vec<String> = st
+                        .unknowns
+                        .iter()
+                        .map(|(t, l)| {
+                            let tt = &tets[*t as usize];
+                            format!(
+                                "[{t}, \"{:?}\", \"{:?}\", {:?}, {:?}, {:?}]",
+                                tt.role,
+                                tt.side,
+                                tt.gid,
+                                l,
+                                tt.pts.map(|p| p.to_array())
+                            )
+                        })
+                        .collect();
+                    let js = format!(
+                        "{{\"point\": {}, \"rows\": {}, \"cols\": {}, \"matrix\": {:?}, \"unknowns\": [{}]}}",
+                        st.point,
+                        st.rows,
+                        st.cols,
+                        st.matrix,
+                        cols.join(", ")
+                    );
+                    let f = format!("{dir}/star_{r}_{}x{}.json", st.rows, st.cols);
+                    std::fs::write(f, js).unwrap();
+                }
+            }
+        }
+        for st in stars.iter().step_by(every) {
+            let s = dense::singular_values(&st.matrix, st.rows, st.cols);
+            // Numerical rank: singular values above 1e-10 of the largest (the structural
+            // zeros sit at 1e-16 and below, the smallest others at 1e-6 and above).
+            let rank = s.iter().filter(|&&x| x > 1e-10 * s[0]).count();
+            *shapes
+                .entry((st.rows, st.cols, st.rows.min(st.cols) - rank))
+                .or_insert(0) += 1;
+            let k = st.rows.min(st.cols);
+            let ratio = s[k - 1] / s[0];
+            if ratio < 1e-12 {
+                deficient += 1;
+            }
+            ratios.push(ratio);
+            // Beside the structural null vector of appendix D's chain (docs/quintic.md): the
+            // conditioning of the rest.
+            next.push(s[rank.max(1) - 1] / s[0]);
+        }
+        next.sort_unstable_by(f64::total_cmp);
+        let qn = |f: f64| next[((next.len() - 1) as f64 * f) as usize];
+        println!(
+            "{r}: smallest σ/σmax above the rank drop: min {:.2e} 10% {:.2e} median {:.2e} 90% {:.2e}",
+            qn(0.0),
+            qn(0.1),
+            qn(0.5),
+            qn(0.9)
+        );
+        ratios.sort_unstable_by(f64::total_cmp);
+        let q = |f: f64| ratios[((ratios.len() - 1) as f64 * f) as usize];
+        println!(
+            "{r}: {} stars sampled of {}, (rows, cols, rank drop): count {shapes:?}, σmin/σmax < 1e-12: {deficient}; min {:.2e} 10% {:.2e} median {:.2e} 90% {:.2e} max {:.2e}",
+            ratios.len(),
+            stars.len(),
+            q(0.0),
+            q(0.1),
+            q(0.5),
+            q(0.9),
+            q(1.0)
+        );
+    }
+}

@@ -67,6 +67,38 @@ pub struct SimplicialHull {
     pub element: Vec<u32>,
 }
 
+/// Where the point s shared by a pair of edge tetrahedra `[p_i p_j q0 s]`, `[p_i p_j q1 s]`
+/// lies. Definition 3.6 (5)(ii) and the scheme's (6.12) put s on the line of the two apexes,
+/// s = μ1 q0 + μ2 q1; on such a line the vertex-star systems of appendices D and E can be
+/// singular for every point (see `docs/quintic.md`, issue 8), so the quintic scheme may move
+/// s off it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum EdgePoint {
+    /// s = (q0 + q1)/2, on the apexes' line (the default, Def. 3.6 (5)(ii)).
+    #[default]
+    Midpoint,
+    /// s = m + t·(m − e) with m = (q0 + q1)/2 and e = (p_i + p_j)/2 the edge's midpoint: off
+    /// the apexes' line in the plane through e and the line (away from T for t > 0, toward
+    /// the edge for −1 < t < 0).
+    Lift(f64),
+    /// s = (1 − μ) q0 + μ q1 with this μ (q0 the apex of the edge's first triangle): on the
+    /// apexes' line but not at its middle.
+    Ratio(f64),
+}
+
+impl EdgePoint {
+    /// The point s for apexes `q0`, `q1` over the edge [`pi` `pj`].
+    #[must_use]
+    pub fn place(self, q0: DVec3, q1: DVec3, pi: DVec3, pj: DVec3) -> DVec3 {
+        let m = 0.5 * (q0 + q1);
+        match self {
+            EdgePoint::Midpoint => m,
+            EdgePoint::Lift(t) => m + t * (m - 0.5 * (pi + pj)),
+            EdgePoint::Ratio(mu) => (1.0 - mu) * q0 + mu * q1,
+        }
+    }
+}
+
 /// An edge of T with the triangles on both sides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HullEdge {
@@ -156,6 +188,12 @@ impl SimplicialHull {
     /// The edge tetrahedra S_e: for every interior edge of T and every side on which both
     /// adjacent triangles have a face tetrahedron, the pair glued to them.
     pub fn edge_tets(&self) -> Result<Vec<EdgeTet>, String> {
+        self.edge_tets_with(EdgePoint::Midpoint)
+    }
+
+    /// [`SimplicialHull::edge_tets`] with the shared point s of each pair placed by `rule`
+    /// ([`EdgePoint::Midpoint`] gives exactly `edge_tets`).
+    pub fn edge_tets_with(&self, rule: EdgePoint) -> Result<Vec<EdgeTet>, String> {
         let edges = self.edges()?;
         let mut out = Vec::new();
         for (e, edge) in edges.iter().enumerate() {
@@ -170,9 +208,9 @@ impl SimplicialHull {
                 ) else {
                     continue;
                 };
-                let s = 0.5 * (q0 + q1);
                 let pi = self.points[edge.v[0] as usize];
                 let pj = self.points[edge.v[1] as usize];
+                let s = rule.place(q0, q1, pi, pj);
                 for (face, q) in [(f0, q0), (f1, q1)] {
                     out.push(EdgeTet {
                         edge: e as u32,
@@ -217,5 +255,14 @@ mod tests {
         assert_eq!(et[0].tet[3], DVec3::new(0.5, 0.5, 1.5));
         assert_eq!(et[0].tet[2], DVec3::new(0.3, 0.3, 1.0));
         assert_eq!(et[1].tet[2], DVec3::new(0.7, 0.7, 2.0));
+        // The placements of s: the midpoint is `edge_tets`; a ratio on the apexes' line from
+        // the first triangle's apex; a lift away from the edge's midpoint (0.5, 0.5, 0).
+        let mid = hull.edge_tets_with(EdgePoint::Midpoint).unwrap();
+        assert_eq!(mid, et);
+        let r = hull.edge_tets_with(EdgePoint::Ratio(0.25)).unwrap();
+        // Rounding of 0.75·0.3 + 0.25·0.7.
+        assert!(r[0].tet[3].distance(DVec3::new(0.4, 0.4, 1.25)) < 1e-15);
+        let l = hull.edge_tets_with(EdgePoint::Lift(1.0)).unwrap();
+        assert_eq!(l[1].tet[3], DVec3::new(0.5, 0.5, 3.0));
     }
 }

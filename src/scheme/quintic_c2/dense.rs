@@ -158,6 +158,67 @@ pub fn dependencies(a: &[f64], m: usize, n: usize, rank_tol: f64) -> Vec<Vec<f64
     out
 }
 
+/// The singular values of A (`m`×`n`, row-major), largest first: one-sided Jacobi rotations
+/// of A's columns until they are orthogonal to rounding (small singular values keep their
+/// relative accuracy, so σ_min/σ_max near 1e-16 is told apart from 1e-10). A diagnostic for the
+/// vertex-star systems; O(m n² · sweeps).
+#[must_use]
+pub fn singular_values(a: &[f64], m: usize, n: usize) -> Vec<f64> {
+    debug_assert_eq!(a.len(), m * n);
+    // Columns of A (or of Aᵀ when it has fewer), which the rotations orthogonalise.
+    let (rows, cols) = if m >= n { (m, n) } else { (n, m) };
+    let mut c: Vec<Vec<f64>> = (0..cols)
+        .map(|j| {
+            (0..rows)
+                .map(|i| if m >= n { a[i * n + j] } else { a[j * n + i] })
+                .collect()
+        })
+        .collect();
+    for _sweep in 0..60 {
+        let mut rotated = false;
+        for p in 0..cols {
+            for q in p + 1..cols {
+                let (alpha, beta, gamma) = c[p]
+                    .iter()
+                    .zip(&c[q])
+                    .fold((0.0, 0.0, 0.0), |(al, be, ga), (x, y)| {
+                        (al + x * x, be + y * y, ga + x * y)
+                    });
+                // Columns orthogonal to rounding already.
+                if gamma == 0.0 || gamma.abs() <= 1e-15 * (alpha * beta).sqrt() {
+                    continue;
+                }
+                rotated = true;
+                let zeta = (beta - alpha) / (2.0 * gamma);
+                let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
+                let t = if zeta == 0.0 { 1.0 } else { t };
+                let cs = 1.0 / (1.0 + t * t).sqrt();
+                let sn = cs * t;
+                let (cp, cq) = if p < q {
+                    let (lo, hi) = c.split_at_mut(q);
+                    (&mut lo[p], &mut hi[0])
+                } else {
+                    unreachable!()
+                };
+                for (x, y) in cp.iter_mut().zip(cq.iter_mut()) {
+                    let (u, v) = (*x, *y);
+                    *x = cs * u - sn * v;
+                    *y = sn * u + cs * v;
+                }
+            }
+        }
+        if !rotated {
+            break;
+        }
+    }
+    let mut s: Vec<f64> = c
+        .iter()
+        .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .collect();
+    s.sort_unstable_by(|a, b| b.total_cmp(a));
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -191,6 +252,33 @@ mod tests {
         // Inconsistent dependent row shows in the residual.
         let s = solve_near(&a, 2, 2, &[2.0, 5.0], &[0.0, 0.0], 1e-12);
         assert!(s.residual > 0.1);
+    }
+
+    /// Singular values of a product U·diag(3, 1e-9, 0)·Vᵀ of rotations: found to their own
+    /// relative accuracy, the rank drop as an exact zero up to rounding.
+    #[test]
+    fn singular_values_of_a_known_matrix() {
+        let (c1, s1) = (0.6_f64, 0.8_f64);
+        let (c2, s2) = (0.28_f64, 0.96_f64);
+        // U rotates axes 0, 1; V rotates axes 1, 2.
+        let u = [[c1, -s1, 0.0], [s1, c1, 0.0], [0.0, 0.0, 1.0]];
+        let v = [[1.0, 0.0, 0.0], [0.0, c2, -s2], [0.0, s2, c2]];
+        let d = [3.0, 1e-9, 0.0];
+        let mut a = [0.0; 9];
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i * 3 + j] = (0..3).map(|k| u[i][k] * d[k] * v[j][k]).sum();
+            }
+        }
+        let s = singular_values(&a, 3, 3);
+        // Relative accuracy of one-sided Jacobi: a few ulps of the largest for each.
+        assert!((s[0] - 3.0).abs() < 1e-14, "{s:?}");
+        assert!((s[1] - 1e-9).abs() < 1e-14, "{s:?}");
+        assert!(s[2] < 1e-15, "{s:?}");
+        // Wide matrix: the same values as its transpose's.
+        let at: Vec<f64> = (0..9).map(|k| a[(k % 3) * 3 + k / 3]).collect();
+        let st = singular_values(&at[..6], 2, 3);
+        assert_eq!(st.len(), 2);
     }
 
     /// Row 3 = row 1 + 2·row 2: one dependency, yᵀA = 0, against the construction.

@@ -35,7 +35,7 @@ use super::{cholesky, dense, sparse};
 use crate::bb::{multi_indices, Tet};
 use crate::complex::Role;
 use crate::error::{Error, Result};
-use crate::hull::simplicial::{Side, SimplicialHull};
+use crate::hull::simplicial::{EdgePoint, Side, SimplicialHull};
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -70,6 +70,18 @@ pub struct HullTet {
 /// # Errors
 /// A non-manifold T.
 pub fn tetrahedra(hull: &SimplicialHull) -> Result<(Vec<HullTet>, Vec<DVec3>)> {
+    tetrahedra_with(hull, EdgePoint::Midpoint)
+}
+
+/// [`tetrahedra`] with the edge tetrahedra's shared points placed by `rule`
+/// ([`SimplicialHull::edge_tets_with`]).
+///
+/// # Errors
+/// A non-manifold T.
+pub fn tetrahedra_with(
+    hull: &SimplicialHull,
+    rule: EdgePoint,
+) -> Result<(Vec<HullTet>, Vec<DVec3>)> {
     let np = hull.points.len() as u32;
     let nt = hull.triangles.len() as u32;
     let apex = |t: u32, side: Side| np + 2 * t + side as u32;
@@ -99,7 +111,7 @@ pub fn tetrahedra(hull: &SimplicialHull) -> Result<(Vec<HullTet>, Vec<DVec3>)> {
             }
         }
     }
-    for et in hull.edge_tets().map_err(Error::Invalid)? {
+    for et in hull.edge_tets_with(rule).map_err(Error::Invalid)? {
         let e = &edges[et.edge as usize];
         let s = mid(et.edge, et.side);
         pos[s as usize] = et.tet[3];
@@ -438,6 +450,21 @@ pub struct SolveStats {
     pub hessian_fit: signs::HessianFit,
 }
 
+/// One point's vertex-star system ([`System::star_systems`]).
+#[derive(Clone, Debug)]
+pub struct StarSystem {
+    /// The point of T at the star's centre.
+    pub point: u32,
+    /// Equations.
+    pub rows: usize,
+    /// Unknown weights.
+    pub cols: usize,
+    /// The coefficients of the unknowns, row-major `rows` × `cols`.
+    pub matrix: Vec<f64>,
+    /// Per unknown, one tetrahedron holding it and its multi-index there.
+    pub unknowns: Vec<(u32, [u8; 4])>,
+}
+
 /// A group whose equations could not be met in one pass.
 struct Failure {
     stage: u8,
@@ -541,6 +568,69 @@ impl System {
         }
         stats.relaxed_for_signs = at2(&level) - before;
         Ok((value, stats))
+    }
+
+    /// The homogeneous matrix of every point's vertex-star system (appendices D and E: the
+    /// slots with the point at multiplicity 2 and the other points of T at most 1, and the
+    /// C1/C2 equations whose last unknowns they are, as the staged solve groups them when no
+    /// star is relaxed), one per point of T with a star, in point order. A diagnostic: the
+    /// paper's systems are square and nonsingular for points in general position.
+    #[must_use]
+    pub fn star_systems(&self) -> Vec<StarSystem> {
+        let np = self.np;
+        let stage_of: Vec<u8> = self.keys.iter().map(|&k| stage(k, np).0).collect();
+        let centre = |s: usize| {
+            unkey(self.keys[s])
+                .into_iter()
+                .find(|p| p.0 < np && p.1 == 2)
+                .map(|p| p.0)
+        };
+        let mut cols: HashMap<u32, Vec<u32>> = HashMap::new();
+        for (s, &st) in stage_of.iter().enumerate() {
+            if st == 2 {
+                if let Some(p) = centre(s) {
+                    cols.entry(p).or_default().push(s as u32);
+                }
+            }
+        }
+        let mut rows: HashMap<u32, Vec<usize>> = HashMap::new();
+        for (e, eq) in self.equations.iter().enumerate() {
+            if eq.terms.iter().any(|t| stage_of[t.0 as usize] > 2) {
+                continue;
+            }
+            if let Some(t) = eq.terms.iter().find(|t| stage_of[t.0 as usize] == 2) {
+                if let Some(p) = centre(t.0 as usize) {
+                    rows.entry(p).or_default().push(e);
+                }
+            }
+        }
+        let mut points: Vec<u32> = cols.keys().copied().collect();
+        points.sort_unstable();
+        points
+            .into_iter()
+            .map(|p| {
+                let unk = &cols[&p];
+                let col: HashMap<u32, usize> =
+                    unk.iter().enumerate().map(|(i, s)| (*s, i)).collect();
+                let eqs = rows.get(&p).cloned().unwrap_or_default();
+                let (m, n) = (eqs.len(), unk.len());
+                let mut a = vec![0.0; m * n];
+                for (i, &e) in eqs.iter().enumerate() {
+                    for &(s, k) in &self.equations[e].terms {
+                        if let Some(&j) = col.get(&s) {
+                            a[i * n + j] += k;
+                        }
+                    }
+                }
+                StarSystem {
+                    point: p,
+                    rows: m,
+                    cols: n,
+                    matrix: a,
+                    unknowns: unk.iter().map(|&s| self.home[s as usize]).collect(),
+                }
+            })
+            .collect()
     }
 
     /// Whether slot `s` misses Theorem 2.1's sign in `value` (`tiny`: zero up to rounding).
