@@ -71,6 +71,7 @@ pub mod degenerate;
 pub mod fan;
 pub mod flatnet;
 pub mod guardnet;
+pub mod nearguard;
 pub mod normals;
 pub mod planar;
 pub mod remesh;
@@ -272,6 +273,8 @@ pub struct InnerReport {
     pub umbrella_normals: Vec<u32>,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
+    /// Corners of star faces given a guard of their own ([`nearguard`]): (input face, vertex).
+    pub near_guards: Vec<(u32, u32)>,
     /// Points of T no triangle used (guards the guard net gave no corner), dropped
     /// ([`unused`]); indices before the drop.
     pub unused_points: Vec<u32>,
@@ -362,6 +365,11 @@ pub fn build_with_report(
     // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
     let flat = flatnet::spread_guards_folded(&mut net, mesh, &merged_counts, Some(normals));
     report.flat_nets = flat.groups.len();
+    // Star faces' corners served from far where the face folds nearly flat into a neighbour.
+    report.near_guards = nearguard::add_near_guards(&mut net, mesh)
+        .into_iter()
+        .map(|(f, v, _)| (mesh.face_parent[f as usize], v))
+        .collect();
     let pieces = &net.pieces;
     let input_face = |f: u32| mesh.face_parent[f as usize];
     report.split_faces = pieces
