@@ -19,6 +19,9 @@
 //!    Then [`flatnet`] (Appendix B, Algorithm 3): a merged flat region whose point of T lies
 //!    far from one of its corners gets a guard per corner, near it, and its interior becomes a
 //!    zero coplanar group of triangles among those guards (fandisk's large flat regions).
+//!    Then [`nearguard`]: a star face's corner served from far by its kernel guard, where the
+//!    face meets a nearly flat neighbour whose guard changes along that edge, gets a guard of
+//!    its own near it (mpi_poly's corner 74).
 //! 3. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
 //!    Appendix C) by rotating it where needed; corners where no direction is above all faces
 //!    are re-meshed first by Appendix C's corner smoothing ([`remesh`], before step 1).
@@ -40,7 +43,8 @@
 //!    inside their wedge, keeping tangent containment and the least height (beyond the paper;
 //!    the nut's valleys of T). After it, [`clearance`] lifts apexes that lie below a base
 //!    vertex's tangent plane (else the surface leaves the hull through the edge tetrahedra's
-//!    outer faces), and [`degenerate`] rebuilds over the base any face tetrahedron that
+//!    outer faces; those below by less than the input's non-planarity are nudged over by a
+//!    hair), and [`degenerate`] rebuilds over the base any face tetrahedron that
 //!    is still degenerate (far apexes from nearly parallel intersections), or names the
 //!    element in an error.
 //!    Between steps 4 and 5, [`normals`] may turn pseudo-centroid normals towards their large
@@ -71,6 +75,7 @@ pub mod degenerate;
 pub mod fan;
 pub mod flatnet;
 pub mod guardnet;
+pub mod nearguard;
 pub mod normals;
 pub mod planar;
 pub mod remesh;
@@ -272,6 +277,8 @@ pub struct InnerReport {
     pub umbrella_normals: Vec<u32>,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
+    /// Corners of star faces given a guard of their own ([`nearguard`]): (input face, vertex).
+    pub near_guards: Vec<(u32, u32)>,
     /// Points of T no triangle used (guards the guard net gave no corner), dropped
     /// ([`unused`]); indices before the drop.
     pub unused_points: Vec<u32>,
@@ -362,6 +369,11 @@ pub fn build_with_report(
     // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
     let flat = flatnet::spread_guards_folded(&mut net, mesh, &merged_counts, Some(normals));
     report.flat_nets = flat.groups.len();
+    // Star faces' corners served from far where the face folds nearly flat into a neighbour.
+    report.near_guards = nearguard::add_near_guards(&mut net, mesh)
+        .into_iter()
+        .map(|(f, v, _)| (mesh.face_parent[f as usize], v))
+        .collect();
     let pieces = &net.pieces;
     let input_face = |f: u32| mesh.face_parent[f as usize];
     report.split_faces = pieces

@@ -20,7 +20,10 @@
 //! which keeps the pair tangent-containing (Definition 3.5): at a vertex whose plane does not
 //! cut the base, the other two base vertices are on one side and the apex of the other side is
 //! across it. Apexes already on or above all three planes (the trihedral corners' V lies in
-//! all three) are left alone; `verify` judges the moved ones like any other.
+//! all three) are left alone; `verify` judges the moved ones like any other. Apexes below a
+//! plane by less than the input's non-planarity but beyond rounding are nudged over all three
+//! by a hair ([`NUDGE_HEIGHT`]), so the cubic scheme does not move them by its margin
+//! (`scheme::cubic_c1::tangent`).
 
 use crate::hull::simplicial::SimplicialHull;
 use glam::DVec3;
@@ -56,6 +59,9 @@ pub fn lift_apexes(hull: &mut SimplicialHull) -> usize {
             if let Some(lifted) = lift(q, p, n, sign * nn, len, g) {
                 hull.apexes[t][side] = Some(lifted);
                 moved += 1;
+            } else if let Some(nudged) = nudge(q, p, n, sign * nn, len, g) {
+                hull.apexes[t][side] = Some(nudged);
+                moved += 1;
             }
         }
     }
@@ -74,7 +80,50 @@ fn lift(q: DVec3, p: [DVec3; 3], n: [DVec3; 3], up: DVec3, len: f64, g: DVec3) -
     if (0..3).all(|k| h(k, q) >= -crate::mesh::PLANARITY_TOL * len) {
         return None;
     }
-    let target = CLEARANCE * len;
+    move_over(q, p, n, up, len, g, CLEARANCE * len)
+}
+
+/// Relative slope σ(q − p_k)·n_k / |q − p_k| below which [`nudge`] moves an apex: the cubic
+/// scheme's `tangent::TANGENT_TOL` (apexes beyond it are moved there, by a margin of 0.02).
+pub const NUDGE_TOL: f64 = 1e-9;
+
+/// Height over the tangent planes a nudged apex gets, relative to the triangle's longest edge:
+/// far above the scheme's tolerance, far below anything `verify` or the patches see.
+pub const NUDGE_HEIGHT: f64 = 1e-6;
+
+/// An apex below a base vertex's tangent plane by no more than the input's non-planarity (which
+/// [`lift`] leaves alone) but beyond rounding (relative slope below [`NUDGE_TOL`]), moved the
+/// least step over all three planes by [`NUDGE_HEIGHT`]. Why: mpi_poly's faces are planar to
+/// 8e-5 only, so a trihedral corner's apex V lay 1e-4 beyond the plane of a guard 10 away; the
+/// cubic scheme then moved it by its margin 0.02 × the distance (0.56 at vertex 77) and the
+/// moved tetrahedra overlapped their neighbours (raw hull 295 violations, the scheme's 396;
+/// nudged, both 282). `None` when no move is needed or none works.
+fn nudge(q: DVec3, p: [DVec3; 3], n: [DVec3; 3], up: DVec3, len: f64, g: DVec3) -> Option<DVec3> {
+    let side = up.dot(n[0] + n[1] + n[2]).signum();
+    let below = (0..3).any(|k| {
+        let d = q - p[k];
+        side * n[k].dot(d) < -NUDGE_TOL * d.length()
+    });
+    if !below {
+        return None;
+    }
+    move_over(q, p, n, up, len, g, NUDGE_HEIGHT * len)
+}
+
+/// The apex `q` moved by the least step along `up`, across the plane it is furthest below, or
+/// between the two, until it clears every tangent plane by `target` and stays on its side of
+/// the triangle; `None` when no direction works.
+fn move_over(
+    q: DVec3,
+    p: [DVec3; 3],
+    n: [DVec3; 3],
+    up: DVec3,
+    len: f64,
+    g: DVec3,
+    target: f64,
+) -> Option<DVec3> {
+    let side = up.dot(n[0] + n[1] + n[2]).signum();
+    let h = |k: usize, x: DVec3| side * n[k].dot(x - p[k]);
     let worst = (0..3)
         .min_by(|&a, &b| h(a, q).total_cmp(&h(b, q)))
         .expect("three vertices");
@@ -139,5 +188,29 @@ mod tests {
         assert_eq!(lifted.x, q.x);
         assert_eq!(lifted.y, q.y);
         assert!(lift(lifted, p, n, DVec3::Z, len, g).is_none());
+    }
+
+    /// A trihedral-like apex 1e-5 below one vertex's tangent plane (within the planarity
+    /// tolerance, so `lift` leaves it) is nudged over all three planes by a hair, and moves
+    /// far less than the clearance would move it.
+    #[test]
+    fn apex_a_hair_below_a_plane_is_nudged() {
+        let p = [DVec3::ZERO, DVec3::X * 10.0, DVec3::Y * 10.0];
+        let g = (p[0] + p[1] + p[2]) / 3.0;
+        // Vertex 2's plane tilts: −0.1x + z = 0 through p_2, so q = (3, 3, 0.3) lies on it and
+        // 0.3 over the other two.
+        let n = [DVec3::Z, DVec3::Z, (DVec3::Z - 0.1 * DVec3::X).normalize()];
+        let len = 200f64.sqrt();
+        let q = DVec3::new(3.0, 3.0, 0.3) - n[2] * 1e-5;
+        assert!(n[2].dot(q - p[2]) < -1e-6);
+        assert!(lift(q, p, n, DVec3::Z, len, g).is_none());
+        let nudged = nudge(q, p, n, DVec3::Z, len, g).expect("nudged");
+        for k in 0..3 {
+            // Rounding of the step (coordinates ~10): far below the nudge height 1.4e-5.
+            assert!(n[k].dot(nudged - p[k]) >= NUDGE_HEIGHT * len - 1e-12);
+        }
+        // A hair: well under a thousandth of the edge (the clearance would be 0.28).
+        assert!((nudged - q).length() < 1e-3);
+        assert!(nudge(nudged, p, n, DVec3::Z, len, g).is_none());
     }
 }

@@ -359,7 +359,7 @@ pub fn spread_guards_folded(
 /// The step (5') cell on polygon edge {a, b} from the fans of a and b: V_1 → V_2 runs
 /// counter-clockwise in f_1. `None` when the guards agree on both sides (no cell needed) or a
 /// fan does not hold the edge.
-fn edge_cell(net: &GuardNet, a: u32, b: u32) -> Option<EdgeCell> {
+pub(crate) fn edge_cell(net: &GuardNet, a: u32, b: u32) -> Option<EdgeCell> {
     let fa = net.fan(a)?;
     let fb = net.fan(b)?;
     let k = fa.faces.len();
