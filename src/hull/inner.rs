@@ -18,7 +18,9 @@
 //!    reduced to Algorithm 1, as §4 allows).
 //!    Then [`flatnet`] (Appendix B, Algorithm 3): a merged flat region whose point of T lies
 //!    far from one of its corners gets a guard per corner, near it, and its interior becomes a
-//!    zero coplanar group of triangles among those guards (fandisk's large flat regions).
+//!    zero coplanar group of triangles among those guards (fandisk's large flat regions; also
+//!    merged strips whose point folds a corner's fan and regions whose diagonals of T pass
+//!    beside an edge at a nearly flat corner, [`flatnet::diagonal_misses`]).
 //! 3. [`above`]: the normal of every non-trihedral vertex is made "above face" (§4 (ii),
 //!    Appendix C) by rotating it where needed; corners where no direction is above all faces
 //!    are re-meshed first by Appendix C's corner smoothing ([`remesh`], before step 1).
