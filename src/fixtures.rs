@@ -559,3 +559,103 @@ pub fn write_cubic_scene(
     std::fs::write(&path, scene).unwrap();
     path
 }
+
+/// What the sign threshold of [`crossed_boundary_faces`] is a share of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SignScale {
+    /// The largest |weight| of the patch itself.
+    Patch,
+    /// The largest |weight| of the whole complex.
+    Complex,
+}
+
+/// Boundary faces of `c` (faces of one patch only, matched by the bits of their corners) on
+/// which F takes both signs at the points of a lattice of `steps` steps per edge (barycentric
+/// i/steps): values above `share` × the largest |weight| (of the patch or of the complex,
+/// `scale`) count as positive, below its negative as negative. A sampling test (the checker's
+/// hole certificate is `check`'s); returns the crossed faces as (patch, opposite corner) and
+/// the complex's largest |weight|.
+pub fn crossed_boundary_faces(
+    c: &PatchComplex,
+    steps: usize,
+    share: f64,
+    scale: SignScale,
+) -> (Vec<(usize, usize)>, f64) {
+    let face_key = |p: &Patch, opp: usize| {
+        let mut f: Vec<[u64; 3]> = (0..4)
+            .filter(|&k| k != opp)
+            .map(|k| p.tet[k].map(f64::to_bits))
+            .collect();
+        f.sort_unstable();
+        [f[0], f[1], f[2]]
+    };
+    let mut users: std::collections::HashMap<[[u64; 3]; 3], usize> =
+        std::collections::HashMap::new();
+    for p in &c.patches {
+        for opp in 0..4 {
+            *users.entry(face_key(p, opp)).or_insert(0) += 1;
+        }
+    }
+    let largest = |p: &Patch| p.weights.iter().fold(0.0_f64, |a, w| a.max(w.abs()));
+    let wmax = c.patches.iter().map(largest).fold(0.0_f64, f64::max);
+    let mut crossed = Vec::new();
+    for (k, p) in c.patches.iter().enumerate() {
+        let tol = share
+            * match scale {
+                SignScale::Patch => largest(p),
+                SignScale::Complex => wmax,
+            };
+        for opp in 0..4 {
+            if users[&face_key(p, opp)] != 1 {
+                continue;
+            }
+            let others: Vec<usize> = (0..4).filter(|&x| x != opp).collect();
+            let (mut pos, mut neg) = (false, false);
+            for i in 0..=steps {
+                for j in 0..=steps - i {
+                    let mut b = [0.0; 4];
+                    b[others[0]] = i as f64 / steps as f64;
+                    b[others[1]] = j as f64 / steps as f64;
+                    b[others[2]] = (steps - i - j) as f64 / steps as f64;
+                    let f = p.value_bary(b);
+                    pos |= f > tol;
+                    neg |= f < -tol;
+                }
+            }
+            if pos && neg {
+                crossed.push((k, opp));
+            }
+        }
+    }
+    (crossed, wmax)
+}
+
+#[cfg(test)]
+mod crossed_tests {
+    use super::*;
+
+    /// Two linear patches sharing the face opposite corner 3 of the first: the shared face
+    /// is no boundary face; the other faces are crossed exactly where they hold corners of
+    /// both signs. The weight 1e-3 on the second patch is a sign at the patch's own scale but
+    /// below 1e-2 of the complex's largest weight.
+    #[test]
+    fn crossed_boundary_faces_by_hand() {
+        let t = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+        let mut c = PatchComplex::new("test-crossed");
+        c.patches.push(plain_patch(t, 1, vec![1.0, -1.0, 1.0, 1.0]));
+        // Mirror of the first through the plane z = 0: shares corners 0, 1, 2.
+        let u = [DVec3::ZERO, DVec3::X, DVec3::Y, -DVec3::Z];
+        c.patches
+            .push(plain_patch(u, 1, vec![1e-3, 1e-3, 1e-3, -1e-3]));
+        let (mut got, wmax) = crossed_boundary_faces(&c, 4, 1e-2, SignScale::Patch);
+        got.sort_unstable();
+        assert_eq!(wmax, 1.0);
+        // Patch 0: faces opposite 0 and 2 hold corner 1 (negative) and a positive corner; the
+        // face opposite 3 is shared; the face opposite 1 is all positive. Patch 1: every
+        // boundary face holds corner 3 (negative) and a positive corner.
+        assert_eq!(got, vec![(0, 0), (0, 2), (1, 0), (1, 1), (1, 2)]);
+        let (mut got, _) = crossed_boundary_faces(&c, 4, 1e-2, SignScale::Complex);
+        got.sort_unstable();
+        assert_eq!(got, vec![(0, 0), (0, 2)]);
+    }
+}

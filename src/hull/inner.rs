@@ -18,7 +18,9 @@
 //!    reduced to Algorithm 1, as §4 allows).
 //!    Then [`flatnet`] (Appendix B, Algorithm 3): a merged flat region whose point of T lies
 //!    far from one of its corners gets a guard per corner, near it, and its interior becomes a
-//!    zero coplanar group of triangles among those guards (fandisk's large flat regions).
+//!    zero coplanar group of triangles among those guards (fandisk's large flat regions; also
+//!    merged strips whose point folds a corner's fan and regions whose diagonals of T pass
+//!    beside an edge at a nearly flat corner, [`flatnet::diagonal_misses`]).
 //!    Then [`nearguard`]: a star face's corner served from far by its kernel guard, where the
 //!    face meets a nearly flat neighbour whose guard changes along that edge, gets a guard of
 //!    its own near it (mpi_poly's corner 74).

@@ -13,7 +13,8 @@
 //! Reconstruction (the paper's figures are missing):
 //! - the guard of corner V (edges V→W and U→V of the polygon, counter-clockwise) lies on the
 //!   bisector of the corner's interior angle at [`GUARD_RADIUS`] × the shorter of the two
-//!   edges from V, halved until it sees both edges (the triangles G V U and G V W hold no
+//!   edges from V (or of V's distance to the nearest other edge of the polygon, when that is
+//!   less: across a narrow strip), halved until it sees both edges (the triangles G V U and G V W hold no
 //!   other corner and cross no edge of the polygon) and the guard polygon G_1 … G_n stays
 //!   simple and inside the face;
 //! - only merged regions (several coplanar input faces, [`super::coplanar`]) whose point of T
@@ -24,7 +25,12 @@
 //!   with the vertex normals ([`spread_guards_folded`]) so do merged regions whose point of T
 //!   folds a corner's fan (a gap wider than [`FOLD_GAP`] between consecutive fan points round
 //!   n_V: fandisk's strips of coplanar triangles with straight corners, whose vertex mean lies
-//!   a few degrees from a straight corner's edge), in passes while new ones appear;
+//!   a few degrees from a straight corner's edge), and merged regions where, at a nearly flat
+//!   corner V, the diagonal of T from the region's point to the point of the face across one
+//!   of V's edges passes beside that edge ([`diagonal_misses`]: Algorithm 1's two triangles
+//!   over the edge fold over each other; fandisk's polygons along its 3° folds, whose straight
+//!   corners on the fold see a far point of T at a grazing angle), in passes while new ones
+//!   appear;
 //! - the polygon's points of T (its pieces) become the guards of its first corners, the other
 //!   guards are new points of T (same face, same normal);
 //! - every corner V's fan names V's own guard for the face, so Algorithm 1 / 2 builds V's
@@ -151,7 +157,8 @@ fn ccw(n: DVec3, a: DVec3, b: DVec3) -> f64 {
 }
 
 /// [`spread_guards`], with the vertex normals `normals` (when given) also qualifying merged
-/// polygons whose point of T folds a corner's fan: a gap next to it wider than [`FOLD_GAP`].
+/// polygons whose point of T folds a corner's fan (a gap next to it wider than [`FOLD_GAP`])
+/// or whose diagonals of T pass beside an edge at a nearly flat corner ([`diagonal_misses`]).
 pub fn spread_guards_folded(
     net: &mut GuardNet,
     mesh: &Mesh,
@@ -278,7 +285,8 @@ pub fn spread_guards_folded(
                         ccw(n, c(at + m - 1), g).max(ccw(n, g, c(at + 1))) > FOLD_GAP
                     })
                 });
-            if !far && !folds {
+            let misses = normals.is_some_and(|n| diagonal_misses(net, pos, n, &face, &fans));
+            if !far && !folds && !misses {
                 continue;
             }
             let n = net.pieces.normal[own[0] as usize];
@@ -356,6 +364,54 @@ pub fn spread_guards_folded(
     out
 }
 
+/// True when, at some corner V of `face`, the diagonal from the polygon's point of T named in
+/// V's fan to the point of the face across one of V's polygon edges V W passes the edge's line
+/// outside the edge (closest points of the two lines: at a share t of V → W outside (0, 1),
+/// or beyond either end of the diagonal): Algorithm 1's two triangles
+/// over that edge, [C_0(V), G, C'] and [C_0(W), C', G], then fold over each other.
+pub fn diagonal_misses(
+    net: &GuardNet,
+    pos: &[DVec3],
+    normals: &[DVec3],
+    face: &[u32],
+    fans: &[(Fan, usize)],
+) -> bool {
+    face.iter().zip(fans).any(|(&v, (fan, at))| {
+        // Only nearly flat corners, where T's fan lies close to one plane (sharp corners' fans
+        // turn round their edges, and the lines' closest points say nothing about a fold).
+        let flat = normals.get(v as usize).is_some_and(|n| {
+            let n = n.normalize_or_zero();
+            fan.faces
+                .iter()
+                .all(|&g| net.pieces.normal[g as usize].dot(n) > FLAT_VERTEX_COS)
+        });
+        if !flat {
+            return false;
+        }
+        let m = fan.faces.len();
+        let g = net.pieces.center[fan.faces[*at] as usize];
+        let a = pos[v as usize];
+        [
+            (fan.ring[*at], fan.faces[(at + m - 1) % m]),
+            (fan.ring[(at + 1) % m], fan.faces[(at + 1) % m]),
+        ]
+        .into_iter()
+        .any(|(w, other)| {
+            let c = net.pieces.center[other as usize];
+            let (d1, d2, r) = (pos[w as usize] - a, c - g, a - g);
+            let (a11, a12, a22) = (d1.dot(d1), d1.dot(d2), d2.dot(d2));
+            let (b1, b2) = (d1.dot(r), d2.dot(r));
+            let det = a11 * a22 - a12 * a12;
+            if det <= 1e-12 * a11 * a22 {
+                return false; // parallel lines: no crossing to judge
+            }
+            let t = (a12 * b2 - a22 * b1) / det;
+            let s = (a11 * b2 - a12 * b1) / det;
+            t <= 0.0 || t >= 1.0 || s <= 0.0 || s >= 1.0
+        })
+    })
+}
+
 /// The step (5') cell on polygon edge {a, b} from the fans of a and b: V_1 → V_2 runs
 /// counter-clockwise in f_1. `None` when the guards agree on both sides (no cell needed) or a
 /// fan does not hold the edge.
@@ -408,7 +464,17 @@ fn place_guards(frame: &Frame, pos: &[DVec3], face: &[u32]) -> Option<(Vec<DVec3
             dw.x * half.cos() - dw.y * half.sin(),
             dw.x * half.sin() + dw.y * half.cos(),
         );
-        let mut r = GUARD_RADIUS * (u - v).length().min((w - v).length());
+        // The corner's reach: its shorter edge, and across a narrow strip the distance to the
+        // nearest edge not at v (fandisk's face 1313, 0.019 wide with edges of 0.08 at its
+        // straight corners: guards a quarter edge in from both sides met in the middle).
+        let across = boundary
+            .iter()
+            .enumerate()
+            .filter(|&(j, _)| j != i && (j + 1) % k != i)
+            .map(|(_, &(a, b))| point_segment_distance(v, a, b))
+            .fold(f64::INFINITY, f64::min);
+        let reach = (u - v).length().min((w - v).length()).min(across);
+        let mut r = GUARD_RADIUS * reach;
         let mut found = None;
         for _ in 0..12 {
             let g = v + r * dir;
@@ -488,6 +554,17 @@ fn sees_corner(
         }
     }
     true
+}
+
+/// Distance from `p` to the segment a–b.
+fn point_segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let d = b - a;
+    let t = if d.length_squared() > 0.0 {
+        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + t * d - p).length()
 }
 
 /// True when segment p–q properly crosses a boundary edge (shared endpoints do not count).
@@ -603,5 +680,54 @@ impl FlatNets {
             .guards
             .iter()
             .all(|&q| matches!(hull.origins[q as usize], PointOrigin::CornerGuard { .. }))));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A strip 0.02 wide with straight corners whose edges are four times its width (fandisk's
+    /// face 1313): a quarter of the shorter edge reaches across the strip, so the guards of two
+    /// opposite straight corners met in the middle and the guard polygon was not simple. With
+    /// the reach capped by the distance to the opposite edge, every guard lies within a quarter
+    /// of the strip's width from its corner and the guard polygon is triangulated.
+    #[test]
+    fn thin_strip_guards_stay_on_their_side() {
+        // Bottom edge 0 → 0.16 with straight corners at 0.08; top edge with straight corners at
+        // 0.04 and 0.12, counter-clockwise seen from +z.
+        let pts = [
+            (0.0, 0.0),
+            (0.08, 0.0),
+            (0.16, 0.0),
+            (0.16, 0.02),
+            (0.12, 0.02),
+            (0.04, 0.02),
+            (0.0, 0.02),
+        ];
+        let pos: Vec<DVec3> = pts.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
+        let face: Vec<u32> = (0..pos.len() as u32).collect();
+        let frame = Frame {
+            o: DVec3::ZERO,
+            u: DVec3::X,
+            v: DVec3::Y,
+            n: DVec3::Z,
+        };
+        let (guards, tris) = place_guards(&frame, &pos, &face).expect("guards placed");
+        assert_eq!(tris.len(), face.len() - 2);
+        for (g, p) in guards.iter().zip(&pos) {
+            // A quarter of the width 0.02 (bisector of a corner of 90° or 180°), plus rounding.
+            assert!((*g - *p).length() <= 0.25 * 0.02 + 1e-12, "{g} from {p}");
+            assert!(g.y > 0.0 && g.y < 0.02, "{g} inside the strip");
+        }
+    }
+
+    /// `point_segment_distance` against hand values: perpendicular foot inside, ends outside.
+    #[test]
+    fn point_segment_distance_cases() {
+        let (a, b) = (DVec2::new(0.0, 0.0), DVec2::new(2.0, 0.0));
+        assert_eq!(point_segment_distance(DVec2::new(1.0, 3.0), a, b), 3.0);
+        assert_eq!(point_segment_distance(DVec2::new(5.0, 4.0), a, b), 5.0);
+        assert_eq!(point_segment_distance(DVec2::new(-3.0, 0.0), a, b), 3.0);
     }
 }
