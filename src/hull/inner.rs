@@ -9,7 +9,8 @@
 //!    [`planar`]: polygons that are not planar (beyond [`InnerOptions::planar_tolerance`] of
 //!    their size: subdivision control cages) are split into triangles, no vertex moved, with
 //!    diagonals that fold like their neighbouring edges and do not end at steep corners
-//!    (vertex normal almost in the polygon's plane, [`planar::STEEP_CORNER`]). (The mesh must be a closed 2-manifold;
+//!    (vertex normal almost in the polygon's plane, [`planar::STEEP_CORNER`]); nearly
+//!    coplanar triangles meeting at a folded corner are joined back ([`planar::JOIN_ANGLE`]). (The mesh must be a closed 2-manifold;
 //!    [`closed::require_closed`] says why one is not, for the scenes.)
 //! 1. [`coplanar`]: edge-adjacent coplanar faces are merged into one polygon (one face per
 //!    plane, as the paper's polyhedra have; Appendix B's coplanarity treated at its source).

@@ -14,7 +14,11 @@
 //! the corner would give it several points of T a few degrees apart seen along its normal, and
 //! the fan triangle between them stands edge-on (spot_control_cage's vertex 104: 68 overlapping
 //! tetrahedra named it, none once its quads 85/175 are cut the other way). Triangulations with
-//! fewer diagonal ends at steep corners win before the fold sense below.
+//! fewer diagonal ends at steep corners win before the fold sense below. And at a folded
+//! corner (its input normal below one of its polygons: Appendix C turns it, often nearly into a
+//! polygon's plane) two triangles of the split meeting there that are nearly coplanar
+//! ([`JOIN_ANGLE`]) are joined back into one quad, so the corner gets one point of T from them
+//! (spot_control_cage's vertex 52 and its pentagon 36).
 //!
 //! Which diagonals: a non-planar polygon folds along whichever diagonals it is cut by, and the
 //! fold's sense matters. A new edge that is reflex where the polyhedron round it is convex makes
@@ -57,6 +61,18 @@ pub const MAX_ENUMERATED: usize = 9;
 /// of it meeting at the corner crowd their points of T together as seen along the normal.
 pub const STEEP_CORNER: f64 = 0.2;
 
+/// Two triangles of one split polygon whose diagonal ends at a folded corner (its input normal
+/// not above all its polygons: Appendix C will turn it, [`super::above`]) are joined back into
+/// one quad, one point of T, when their normals differ by less than this many degrees. Such
+/// a corner's turned normal can stand almost in the polygon's plane, where two nearly coplanar
+/// pieces give it two points of T a few degrees apart seen along the normal and a fan triangle
+/// edge-on between them (spot_control_cage's vertex 52: face 36's pieces, 1.3° apart, 8° apart
+/// seen along n_V). The quad deviates from its plane by at most this fold, which the hull
+/// takes as planar (its centroid and area normal). Measured on spot_control_cage (hull
+/// violations, holes): 2° 400 / 34, 3° and 5° 358 / 40, 10° 410 / 42 (10 `EdgeNonconvex`), none
+/// 442 / 34; joining at any corner instead of folded ones: 1° 378 (14 `EdgeNonconvex`).
+pub const JOIN_ANGLE: f64 = 3.0;
+
 /// Passes of the above-face repair over the corners that still fail.
 pub const REPAIR_PASSES: usize = 3;
 
@@ -75,6 +91,9 @@ pub struct SplitFace {
     /// in a convex region, or convex in a concave one); 0 for polygons of more than
     /// [`MAX_ENUMERATED`] corners, which are ear-clipped unscored.
     pub against: usize,
+    /// Pairs of its triangles joined back into one quad at a folded corner ([`JOIN_ANGLE`]);
+    /// the polygon then has `triangles − joined` pieces.
+    pub joined: usize,
 }
 
 /// A mesh with its non-planar polygons split, and what was split.
@@ -381,6 +400,53 @@ fn repair_above_face(
     Choice { choice, repaired }
 }
 
+/// The pieces of one split polygon: its triangles `tris`, with edge-adjacent pairs whose
+/// diagonal ends at a folded corner (`folded`) and whose normals differ by less than
+/// [`JOIN_ANGLE`] made one quad again (greedy in triangle order, each triangle once).
+fn join_flat_pairs(positions: &[DVec3], tris: &[[u32; 3]], folded: &[bool]) -> Vec<Vec<u32>> {
+    let cos = JOIN_ANGLE.to_radians().cos();
+    let normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    let mut used = vec![false; tris.len()];
+    let mut out = Vec::new();
+    for i in 0..tris.len() {
+        if used[i] {
+            continue;
+        }
+        let mut joined = None;
+        {
+            'search: for j in i + 1..tris.len() {
+                if used[j] || normal(&tris[i]).dot(normal(&tris[j])) < cos {
+                    continue;
+                }
+                for k in 0..3 {
+                    let (a, b) = (tris[i][k], tris[i][(k + 1) % 3]);
+                    for l in 0..3 {
+                        if tris[j][l] == b
+                            && tris[j][(l + 1) % 3] == a
+                            && (folded[a as usize] || folded[b as usize])
+                        {
+                            let opp = tris[j][(l + 2) % 3];
+                            joined = Some((j, vec![a, opp, b, tris[i][(k + 2) % 3]]));
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
+        match joined {
+            Some((j, q)) => {
+                used[j] = true;
+                out.push(q);
+            }
+            None => out.push(tris[i].to_vec()),
+        }
+    }
+    out
+}
+
 /// Splits every polygon of `mesh` that deviates from its plane by more than `tolerance`
 /// (relative to its size) into triangles, as the module documentation describes. `None` when
 /// no polygon deviates (the mesh is used as it is). Zero-area polygons are left alone (the
@@ -463,6 +529,23 @@ pub fn split_nonplanar_steep(
         .collect();
     let repaired = chosen.repaired;
     let chosen = chosen.choice;
+    // Corners whose input normal is not above all their polygons (Appendix C will turn it).
+    let folded: Vec<bool> = match normals {
+        None => vec![false; mesh.positions.len()],
+        Some(ns) => {
+            let mut faces: Vec<Vec<DVec3>> = vec![Vec::new(); mesh.positions.len()];
+            for face in &mesh.faces {
+                let nf = area_vector(&mesh.positions, face).normalize_or_zero();
+                for &v in face {
+                    faces[v as usize].push(nf);
+                }
+            }
+            ns.iter()
+                .zip(&faces)
+                .map(|(&n, fs)| fs.len() > 3 && clearance(n, fs) < ABOVE_MARGIN)
+                .collect()
+        }
+    };
     // Rebuild the mesh with lines and parents.
     let count = mesh.faces.len() + bent.len();
     let mut out = Mesh {
@@ -478,15 +561,17 @@ pub fn split_nonplanar_steep(
     for (f, face) in mesh.faces.iter().enumerate() {
         let pieces: Vec<Vec<u32>> = if slot < bent.len() && bent[slot].0 == f {
             let c = &options[slot][chosen[slot]];
+            let pieces = join_flat_pairs(&mesh.positions, &c.triangles, &folded);
             report.push(SplitFace {
                 face: f as u32,
                 line: mesh.face_lines.get(f).copied().unwrap_or(0),
                 deviation: bent[slot].1,
                 triangles: c.triangles.len(),
                 against: c.against,
+                joined: c.triangles.len() - pieces.len(),
             });
             slot += 1;
-            c.triangles.iter().map(|t| t.to_vec()).collect()
+            pieces
         } else {
             vec![face.clone()]
         };
