@@ -159,26 +159,45 @@ type HullRepairs = (
 /// (`hull::inner::planar`) do to the scene's mesh: each with its threshold, `None` when it
 /// changes nothing (or the scene is no mesh scene). The split's faces are the input's.
 fn hull_repairs(scene: &apatch::scene::Scene) -> anyhow::Result<HullRepairs> {
-    let apatch::scene::Model::Mesh { file, scheme, .. } = &scene.model else {
+    let apatch::scene::Model::Mesh {
+        file,
+        scheme,
+        normals,
+        ..
+    } = &scene.model
+    else {
         return Ok((None, None));
     };
     let options = apatch::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
     let (m, _) = apatch::mesh::load(file)?;
-    let merged = apatch::hull::inner::close::merge_close_vertices(&m, &[], options.merge_close)?;
+    // The hull's normals, for the split's steep and folded corners (as `hull::inner` has them).
+    let vn = normals
+        .parse()
+        .ok()
+        .and_then(|method| apatch::mesh::vertex_normals(&m, method).ok());
+    let merged = apatch::hull::inner::close::merge_close_vertices(
+        &m,
+        vn.as_deref().unwrap_or(&[]),
+        options.merge_close,
+    )?;
     let mesh = merged.as_ref().map_or(&m, |c| &c.mesh);
-    let split = apatch::hull::inner::planar::split_nonplanar(mesh, options.planar_tolerance).map(
-        |mut s| {
-            if merged.is_some() {
-                for f in &mut s.faces {
-                    f.face = mesh.face_parent[f.face as usize];
+    let vn = merged.as_ref().map_or(vn.as_deref(), |c| {
+        (c.normals.len() == mesh.positions.len()).then_some(&c.normals[..])
+    });
+    let split =
+        apatch::hull::inner::planar::split_nonplanar_steep(mesh, options.planar_tolerance, vn).map(
+            |mut s| {
+                if merged.is_some() {
+                    for f in &mut s.faces {
+                        f.face = mesh.face_parent[f.face as usize];
+                    }
+                    for f in &mut s.kept {
+                        *f = mesh.face_parent[*f as usize];
+                    }
                 }
-                for f in &mut s.kept {
-                    *f = mesh.face_parent[*f as usize];
-                }
-            }
-            (options.planar_tolerance, s)
-        },
-    );
+                (options.planar_tolerance, s)
+            },
+        );
     Ok((merged.map(|c| (options.merge_close, c)), split))
 }
 
@@ -316,9 +335,15 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let Some((tolerance, sp)) = &split {
             println!(
                 "planar split     {} non-planar polygons (beyond {tolerance:e} of their size) split \
-                 into {} triangles before the hull (`scheme.planar_tolerance`){}  info",
+                 into {} triangles before the hull (`scheme.planar_tolerance`){}{}  info",
                 sp.faces.len(),
                 sp.faces.iter().map(|f| f.triangles).sum::<usize>(),
+                match sp.faces.iter().map(|f| f.joined).sum::<usize>() {
+                    0 => String::new(),
+                    j => format!(
+                        ", {j} nearly coplanar pairs at folded corners joined back into quads (`hull::inner::planar::JOIN_ANGLE`)"
+                    ),
+                },
                 if sp.kept.is_empty() {
                     String::new()
                 } else {

@@ -8,7 +8,9 @@
 //!    control cages; no vertex moves, the sliver faces between them drop out).
 //!    [`planar`]: polygons that are not planar (beyond [`InnerOptions::planar_tolerance`] of
 //!    their size: subdivision control cages) are split into triangles, no vertex moved, with
-//!    diagonals that fold like their neighbouring edges. (The mesh must be a closed 2-manifold;
+//!    diagonals that fold like their neighbouring edges and do not end at steep corners
+//!    (vertex normal almost in the polygon's plane, [`planar::STEEP_CORNER`]); nearly
+//!    coplanar triangles meeting at a folded corner are joined back ([`planar::JOIN_ANGLE`]). (The mesh must be a closed 2-manifold;
 //!    [`closed::require_closed`] says why one is not, for the scenes.)
 //! 1. [`coplanar`]: edge-adjacent coplanar faces are merged into one polygon (one face per
 //!    plane, as the paper's polyhedra have; Appendix B's coplanarity treated at its source).
@@ -335,7 +337,7 @@ pub fn build_with_report(
         None => (mesh, normals),
     };
     // Polygons that are not planar are split into triangles (no vertex moves).
-    let split = planar::split_nonplanar(mesh, options.planar_tolerance);
+    let split = planar::split_nonplanar_steep(mesh, options.planar_tolerance, Some(normals));
     let mesh = match &split {
         Some(s) => {
             report.planar_split.clone_from(&s.faces);

@@ -8,6 +8,18 @@
 //! tolerance (relative to the face size, [`crate::mesh::geometry::planarity_deviation`]) into
 //! triangles makes it one; the vertices, and so the points the surface interpolates, stay.
 //!
+//! Steep corners first: where the hull's vertex normals are known
+//! ([`split_nonplanar_steep`]), a diagonal should not end at a corner whose normal stands almost
+//! in the polygon's plane (cosine below [`STEEP_CORNER`]). There the polygon's pieces meeting at
+//! the corner would give it several points of T a few degrees apart seen along its normal, and
+//! the fan triangle between them stands edge-on (spot_control_cage's vertex 104: 68 overlapping
+//! tetrahedra named it, none once its quads 85/175 are cut the other way). Triangulations with
+//! fewer diagonal ends at steep corners win before the fold sense below. And at a folded
+//! corner (its input normal below one of its polygons: Appendix C turns it, often nearly into a
+//! polygon's plane) two triangles of the split meeting there that are nearly coplanar
+//! ([`JOIN_ANGLE`]) are joined back into one quad, so the corner gets one point of T from them
+//! (spot_control_cage's vertex 52 and its pentagon 36).
+//!
 //! Which diagonals: a non-planar polygon folds along whichever diagonals it is cut by, and the
 //! fold's sense matters. A new edge that is reflex where the polyhedron round it is convex makes
 //! a saddle that needs L-U pairs in T, and its two triangles tilt so that a corner's faces can
@@ -44,6 +56,23 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-5;
 /// (Catalan(7) = 429 for 9 corners); larger ones are ear-clipped in their mean plane.
 pub const MAX_ENUMERATED: usize = 9;
 
+/// A corner of a bent polygon is steep when its vertex normal's cosine with the polygon's
+/// normal is below this: the polygon stands almost edge-on to the corner's fan, and pieces
+/// of it meeting at the corner crowd their points of T together as seen along the normal.
+pub const STEEP_CORNER: f64 = 0.2;
+
+/// Two triangles of one split polygon whose diagonal ends at a folded corner (its input normal
+/// not above all its polygons: Appendix C will turn it, [`super::above`]) are joined back into
+/// one quad, one point of T, when their normals differ by less than this many degrees. Such
+/// a corner's turned normal can stand almost in the polygon's plane, where two nearly coplanar
+/// pieces give it two points of T a few degrees apart seen along the normal and a fan triangle
+/// edge-on between them (spot_control_cage's vertex 52: face 36's pieces, 1.3° apart, 8° apart
+/// seen along n_V). The quad deviates from its plane by at most this fold, which the hull
+/// takes as planar (its centroid and area normal). Measured on spot_control_cage (hull
+/// violations, holes): 2° 400 / 34, 3° and 5° 358 / 40, 10° 410 / 42 (10 `EdgeNonconvex`), none
+/// 442 / 34; joining at any corner instead of folded ones: 1° 378 (14 `EdgeNonconvex`).
+pub const JOIN_ANGLE: f64 = 3.0;
+
 /// Passes of the above-face repair over the corners that still fail.
 pub const REPAIR_PASSES: usize = 3;
 
@@ -62,6 +91,9 @@ pub struct SplitFace {
     /// in a convex region, or convex in a concave one); 0 for polygons of more than
     /// [`MAX_ENUMERATED`] corners, which are ear-clipped unscored.
     pub against: usize,
+    /// Pairs of its triangles joined back into one quad at a folded corner ([`JOIN_ANGLE`]);
+    /// the polygon then has `triangles − joined` pieces.
+    pub joined: usize,
 }
 
 /// A mesh with its non-planar polygons split, and what was split.
@@ -159,15 +191,27 @@ struct Candidate {
     /// Smallest positive projected area share (n_t · N / |n_t|) of its triangles: larger is
     /// better shaped.
     min_upright: f64,
+    /// Diagonal ends at steep corners ([`STEEP_CORNER`]).
+    steep: usize,
 }
 
 /// The valid triangulations of polygon `face` (global vertex indices), best first by the
 /// score of the module documentation. Triangles must be oriented like the polygon about its
 /// area normal (n_t · N > 1e-9 |n_t|, and area above 1e-12 of the size squared: no folded or
 /// needle triangles). Empty when none is (then the caller ear-clips).
-fn candidates(positions: &[DVec3], face: &[u32], sense: f64) -> Vec<Candidate> {
+fn candidates(
+    positions: &[DVec3],
+    face: &[u32],
+    sense: f64,
+    normals: Option<&[DVec3]>,
+) -> Vec<Candidate> {
     let n = face.len();
     let normal = area_vector(positions, face).normalize_or_zero();
+    // Corners whose vertex normal stands almost in the polygon's plane.
+    let steep: Vec<bool> = face
+        .iter()
+        .map(|&v| normals.is_some_and(|ns| ns[v as usize].dot(normal) < STEEP_CORNER))
+        .collect();
     let size = face_size(positions, face);
     let p = |i: usize| positions[face[i] as usize];
     let mut out = Vec::new();
@@ -188,13 +232,14 @@ fn candidates(positions: &[DVec3], face: &[u32], sense: f64) -> Vec<Candidate> {
             normals.push(a / len);
         }
         // Diagonals: pairs of triangles sharing two corners.
-        let (mut against, mut against_sum) = (0, 0.0);
+        let (mut against, mut against_sum, mut steep_ends) = (0, 0.0, 0);
         for i in 0..tri.len() {
             for j in i + 1..tri.len() {
                 for k in 0..3 {
                     let (a, b) = (tri[i][k], tri[i][(k + 1) % 3]);
                     let shared = (0..3).any(|l| tri[j][l] == b && tri[j][(l + 1) % 3] == a);
                     if shared {
+                        steep_ends += usize::from(steep[a]) + usize::from(steep[b]);
                         let e = (p(b) - p(a)).normalize_or_zero();
                         let s = sense * fold(normals[i], normals[j], e);
                         if s < 0.0 {
@@ -210,11 +255,13 @@ fn candidates(positions: &[DVec3], face: &[u32], sense: f64) -> Vec<Candidate> {
             against,
             against_sum,
             min_upright,
+            steep: steep_ends,
         });
     }
     out.sort_by(|x, y| {
-        x.against
-            .cmp(&y.against)
+        x.steep
+            .cmp(&y.steep)
+            .then(x.against.cmp(&y.against))
             .then(x.against_sum.total_cmp(&y.against_sum))
             .then(y.min_upright.total_cmp(&x.min_upright))
     });
@@ -353,12 +400,71 @@ fn repair_above_face(
     Choice { choice, repaired }
 }
 
+/// The pieces of one split polygon: its triangles `tris`, with edge-adjacent pairs whose
+/// diagonal ends at a folded corner (`folded`) and whose normals differ by less than
+/// [`JOIN_ANGLE`] made one quad again (greedy in triangle order, each triangle once).
+fn join_flat_pairs(positions: &[DVec3], tris: &[[u32; 3]], folded: &[bool]) -> Vec<Vec<u32>> {
+    let cos = JOIN_ANGLE.to_radians().cos();
+    let normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    let mut used = vec![false; tris.len()];
+    let mut out = Vec::new();
+    for i in 0..tris.len() {
+        if used[i] {
+            continue;
+        }
+        let mut joined = None;
+        {
+            'search: for j in i + 1..tris.len() {
+                if used[j] || normal(&tris[i]).dot(normal(&tris[j])) < cos {
+                    continue;
+                }
+                for k in 0..3 {
+                    let (a, b) = (tris[i][k], tris[i][(k + 1) % 3]);
+                    for l in 0..3 {
+                        if tris[j][l] == b
+                            && tris[j][(l + 1) % 3] == a
+                            && (folded[a as usize] || folded[b as usize])
+                        {
+                            let opp = tris[j][(l + 2) % 3];
+                            joined = Some((j, vec![a, opp, b, tris[i][(k + 2) % 3]]));
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
+        match joined {
+            Some((j, q)) => {
+                used[j] = true;
+                out.push(q);
+            }
+            None => out.push(tris[i].to_vec()),
+        }
+    }
+    out
+}
+
 /// Splits every polygon of `mesh` that deviates from its plane by more than `tolerance`
 /// (relative to its size) into triangles, as the module documentation describes. `None` when
 /// no polygon deviates (the mesh is used as it is). Zero-area polygons are left alone (the
 /// hull names them).
 #[must_use]
 pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
+    split_nonplanar_steep(mesh, tolerance, None)
+}
+
+/// [`split_nonplanar`] with the vertex normals: diagonals avoid steep corners (vertex normal
+/// within [`STEEP_CORNER`] of the polygon's plane) before anything else, so that such a
+/// corner sees one piece of the polygon (one point of T) rather than several crowded ones.
+#[must_use]
+pub fn split_nonplanar_steep(
+    mesh: &Mesh,
+    tolerance: f64,
+    normals: Option<&[DVec3]>,
+) -> Option<PlanarSplit> {
     let bent: Vec<(usize, f64)> = mesh
         .faces
         .iter()
@@ -379,7 +485,7 @@ pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
     for &(f, _) in &bent {
         let face = &mesh.faces[f];
         let c = if face.len() <= MAX_ENUMERATED {
-            candidates(&mesh.positions, face, wanted_sense(mesh, &topo, f))
+            candidates(&mesh.positions, face, wanted_sense(mesh, &topo, f), normals)
         } else {
             Vec::new()
         };
@@ -393,6 +499,7 @@ pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
                 against: 0,
                 against_sum: 0.0,
                 min_upright: 0.0,
+                steep: 0,
             }]
         } else {
             // No triangulation is proper: the polygon overlaps itself in its mean plane (a
@@ -422,6 +529,23 @@ pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
         .collect();
     let repaired = chosen.repaired;
     let chosen = chosen.choice;
+    // Corners whose input normal is not above all their polygons (Appendix C will turn it).
+    let folded: Vec<bool> = match normals {
+        None => vec![false; mesh.positions.len()],
+        Some(ns) => {
+            let mut faces: Vec<Vec<DVec3>> = vec![Vec::new(); mesh.positions.len()];
+            for face in &mesh.faces {
+                let nf = area_vector(&mesh.positions, face).normalize_or_zero();
+                for &v in face {
+                    faces[v as usize].push(nf);
+                }
+            }
+            ns.iter()
+                .zip(&faces)
+                .map(|(&n, fs)| fs.len() > 3 && clearance(n, fs) < ABOVE_MARGIN)
+                .collect()
+        }
+    };
     // Rebuild the mesh with lines and parents.
     let count = mesh.faces.len() + bent.len();
     let mut out = Mesh {
@@ -437,15 +561,17 @@ pub fn split_nonplanar(mesh: &Mesh, tolerance: f64) -> Option<PlanarSplit> {
     for (f, face) in mesh.faces.iter().enumerate() {
         let pieces: Vec<Vec<u32>> = if slot < bent.len() && bent[slot].0 == f {
             let c = &options[slot][chosen[slot]];
+            let pieces = join_flat_pairs(&mesh.positions, &c.triangles, &folded);
             report.push(SplitFace {
                 face: f as u32,
                 line: mesh.face_lines.get(f).copied().unwrap_or(0),
                 deviation: bent[slot].1,
                 triangles: c.triangles.len(),
                 against: c.against,
+                joined: c.triangles.len() - pieces.len(),
             });
             slot += 1;
-            c.triangles.iter().map(|t| t.to_vec()).collect()
+            pieces
         } else {
             vec![face.clone()]
         };
@@ -526,5 +652,50 @@ mod tests {
             );
             assert_eq!(s.faces[0].against, 0);
         }
+    }
+
+    /// The roof of `bent_quad_takes_the_convex_diagonal`, but corner 0's vertex normal lies
+    /// almost in the roof's plane (cosine 0.1 < [`STEEP_CORNER`]): the diagonal 1–3, which
+    /// does not end at that corner, is taken although it folds reflex; with normals that
+    /// face the roof (cosine ≈ 1) the convex diagonal 0–2 stays.
+    #[test]
+    fn steep_corner_is_no_diagonal_end() {
+        let mut positions = vec![
+            DVec3::new(0.0, 0.0, 1.3),
+            DVec3::new(1.0, 0.0, 1.0),
+            DVec3::new(1.0, 1.0, 1.3),
+            DVec3::new(0.0, 1.0, 1.0),
+        ];
+        positions.extend(positions.clone().iter().map(|p| DVec3::new(p.x, p.y, 0.0)));
+        let faces = vec![
+            vec![0, 1, 2, 3],
+            vec![4, 7, 6, 5],
+            vec![0, 4, 5, 1],
+            vec![1, 5, 6, 2],
+            vec![2, 6, 7, 3],
+            vec![3, 7, 4, 0],
+        ];
+        let m = Mesh::new(positions, faces);
+        let roof = area_vector(&m.positions, &m.faces[0]).normalize();
+        let diagonal = |normals: &[DVec3]| {
+            let s = split_nonplanar_steep(&m, DEFAULT_TOLERANCE, Some(normals)).unwrap();
+            let tris: Vec<Vec<u32>> = s.mesh.faces.into_iter().filter(|f| f.len() == 3).collect();
+            assert_eq!(tris.len(), 2);
+            // The two corners both triangles hold.
+            let mut shared: Vec<u32> = tris[0]
+                .iter()
+                .copied()
+                .filter(|v| tris[1].contains(v))
+                .collect();
+            shared.sort_unstable();
+            shared
+        };
+        let mut normals = vec![roof; 8];
+        assert_eq!(diagonal(&normals), vec![0, 2]);
+        // A unit normal whose cosine with the roof's normal is 0.1.
+        let side = roof.any_orthonormal_vector();
+        normals[0] = 0.1 * roof + (1.0f64 - 0.01).sqrt() * side;
+        assert!((normals[0].dot(roof) - 0.1).abs() < 1e-12);
+        assert_eq!(diagonal(&normals), vec![1, 3]);
     }
 }
