@@ -615,55 +615,10 @@ fn boundary_faces_crossed(c: &apatch::complex::PatchComplex) -> usize {
 }
 
 /// The crossed boundary faces of [`boundary_faces_crossed`], each as (patch, opposite corner),
-/// with the largest weight magnitude that scales "zero".
+/// with the largest weight magnitude that scales "zero": a lattice of 15 steps per edge, and
+/// "zero" is 1e-12 of the complex's largest weight (round-off of the degree-5 evaluation).
 fn crossed_boundary_faces(c: &apatch::complex::PatchComplex) -> (Vec<(usize, usize)>, f64) {
-    let key = |v: [f64; 3]| v.map(f64::to_bits);
-    let mut users: std::collections::HashMap<[[u64; 3]; 3], usize> =
-        std::collections::HashMap::new();
-    let face_key = |p: &apatch::complex::Patch, opp: usize| {
-        let mut f: Vec<[u64; 3]> = (0..4)
-            .filter(|&k| k != opp)
-            .map(|k| key(p.tet[k]))
-            .collect();
-        f.sort_unstable();
-        [f[0], f[1], f[2]]
-    };
-    for p in &c.patches {
-        for opp in 0..4 {
-            *users.entry(face_key(p, opp)).or_insert(0) += 1;
-        }
-    }
-    let wmax = c
-        .patches
-        .iter()
-        .flat_map(|p| p.weights.iter())
-        .fold(0.0_f64, |a, w| a.max(w.abs()));
-    let mut crossed = Vec::new();
-    for (k, p) in c.patches.iter().enumerate() {
-        for opp in 0..4 {
-            if users[&face_key(p, opp)] != 1 {
-                continue;
-            }
-            let m = 15;
-            let (mut pos, mut neg) = (false, false);
-            for i in 0..=m {
-                for j in 0..=m - i {
-                    let mut b = [0.0; 4];
-                    let others: Vec<usize> = (0..4).filter(|&k| k != opp).collect();
-                    b[others[0]] = i as f64 / m as f64;
-                    b[others[1]] = j as f64 / m as f64;
-                    b[others[2]] = (m - i - j) as f64 / m as f64;
-                    let f = p.value_bary(b);
-                    pos |= f > 1e-12 * wmax;
-                    neg |= f < -1e-12 * wmax;
-                }
-            }
-            if pos && neg {
-                crossed.push((k, opp));
-            }
-        }
-    }
-    (crossed, wmax)
+    apatch::fixtures::crossed_boundary_faces(c, 15, 1e-12, apatch::fixtures::SignScale::Complex)
 }
 
 /// Exploration: every boundary face of a scene's complex that the surface crosses (as in
