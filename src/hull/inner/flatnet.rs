@@ -528,7 +528,7 @@ fn place_guards(frame: &Frame, pos: &[DVec3], face: &[u32]) -> Option<(Vec<DVec3
 /// True when guard `g` of corner v (edges u → v → w) sees both edges: g lies strictly inside
 /// the corner's wedge, and the triangles g v u, g v w hold no other corner and their sides
 /// from g cross no polygon edge.
-fn sees_corner(
+pub(crate) fn sees_corner(
     g: DVec2,
     u: DVec2,
     v: DVec2,
@@ -568,7 +568,7 @@ fn point_segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
 }
 
 /// True when segment p–q properly crosses a boundary edge (shared endpoints do not count).
-fn crosses(p: DVec2, q: DVec2, boundary: &[(DVec2, DVec2)]) -> bool {
+pub(crate) fn crosses(p: DVec2, q: DVec2, boundary: &[(DVec2, DVec2)]) -> bool {
     boundary
         .iter()
         .any(|&(a, b)| a != p && a != q && b != p && b != q && segments_cross(p, q, a, b))

@@ -21,6 +21,7 @@
 //! convex edge, both guards carrying f's normal).
 
 use super::decompose::GUARD_REACH;
+use super::flatnet;
 use super::guardnet::GuardNet;
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3};
@@ -126,7 +127,7 @@ pub fn add_near_guards(net: &mut GuardNet, mesh: &Mesh) -> NearGuards {
                 let key = (v.min(w), v.max(w));
                 net.cells
                     .retain(|c| (c.v[0].min(c.v[1]), c.v[0].max(c.v[1])) != key);
-                if let Some(cell) = super::flatnet::edge_cell(net, key.0, key.1) {
+                if let Some(cell) = flatnet::edge_cell(net, key.0, key.1) {
                     net.cells.push(cell);
                 }
             }
@@ -161,51 +162,12 @@ fn place(
     let mut r = RADIUS * short;
     for _ in 0..12 {
         let g = fv + r * dir;
-        if sees(g, fu, fv, fw, flat, boundary) && !crosses(g, kernel, boundary) {
+        if flatnet::sees_corner(g, fu, fv, fw, flat, boundary)
+            && !flatnet::crosses(g, kernel, boundary)
+        {
             return Some(g);
         }
         r *= 0.5;
     }
     None
-}
-
-/// True when `g` lies inside both edges' half-planes at v, the triangles g v u and g v w hold
-/// no other corner, and g's segments to u, v, w cross no polygon edge.
-fn sees(
-    g: DVec2,
-    u: DVec2,
-    v: DVec2,
-    w: DVec2,
-    flat: &[DVec2],
-    boundary: &[(DVec2, DVec2)],
-) -> bool {
-    if (w - v).perp_dot(g - v) <= 0.0 || (v - u).perp_dot(g - u) <= 0.0 {
-        return false;
-    }
-    if [u, v, w].iter().any(|&q| crosses(g, q, boundary)) {
-        return false;
-    }
-    let inside = |t: [DVec2; 3], x: DVec2| {
-        let s: Vec<f64> = (0..3)
-            .map(|i| (t[(i + 1) % 3] - t[i]).perp_dot(x - t[i]))
-            .collect();
-        s.iter().all(|&y| y >= 0.0) || s.iter().all(|&y| y <= 0.0)
-    };
-    [[g, v, u], [g, v, w]].iter().all(|&t| {
-        flat.iter()
-            .all(|&a| a == u || a == v || a == w || !inside(t, a))
-    })
-}
-
-/// True when segment p–q crosses or touches a polygon edge that does not end at p or q.
-fn crosses(p: DVec2, q: DVec2, boundary: &[(DVec2, DVec2)]) -> bool {
-    let o = |x: DVec2, y: DVec2, z: DVec2| (y - x).perp_dot(z - x);
-    boundary.iter().any(|&(a, b)| {
-        if a == p || a == q || b == p || b == q {
-            return false;
-        }
-        let (d1, d2) = (o(p, q, a), o(p, q, b));
-        let (d3, d4) = (o(a, b, p), o(a, b, q));
-        d1 * d2 <= 0.0 && d3 * d4 <= 0.0
-    })
 }
