@@ -618,11 +618,9 @@ mod tests {
         }
     }
 
-    /// A quad bent along one diagonal: the convex diagonal is chosen when its neighbours are
-    /// convex (a roof over a box), whichever vertex the quad starts at.
-    #[test]
-    fn bent_quad_takes_the_convex_diagonal() {
-        // Unit box with its top quad's corners 0 and 2 raised: the fold along 0–2 is convex.
+    /// Unit box whose top quad has its corners 0 and 2 raised (the fold along 0–2 is convex),
+    /// the top polygon listed from corner `rot`.
+    fn roof_box(rot: usize) -> Mesh {
         let mut positions = vec![
             DVec3::new(0.0, 0.0, 1.3),
             DVec3::new(1.0, 0.0, 1.0),
@@ -630,17 +628,24 @@ mod tests {
             DVec3::new(0.0, 1.0, 1.0),
         ];
         positions.extend(positions.clone().iter().map(|p| DVec3::new(p.x, p.y, 0.0)));
+        let top: Vec<u32> = (0..4).map(|k| ((k + rot) % 4) as u32).collect();
+        let faces = vec![
+            top,
+            vec![4, 7, 6, 5],
+            vec![0, 4, 5, 1],
+            vec![1, 5, 6, 2],
+            vec![2, 6, 7, 3],
+            vec![3, 7, 4, 0],
+        ];
+        Mesh::new(positions, faces)
+    }
+
+    /// A quad bent along one diagonal: the convex diagonal is chosen when its neighbours are
+    /// convex (a roof over a box), whichever vertex the quad starts at.
+    #[test]
+    fn bent_quad_takes_the_convex_diagonal() {
         for rot in 0..4 {
-            let top: Vec<u32> = (0..4).map(|k| ((k + rot) % 4) as u32).collect();
-            let faces = vec![
-                top,
-                vec![4, 7, 6, 5],
-                vec![0, 4, 5, 1],
-                vec![1, 5, 6, 2],
-                vec![2, 6, 7, 3],
-                vec![3, 7, 4, 0],
-            ];
-            let m = Mesh::new(positions.clone(), faces);
+            let m = roof_box(rot);
             let s = split_nonplanar(&m, DEFAULT_TOLERANCE).unwrap();
             // Only the top is bent (the sides are trapezoids in vertical planes).
             assert_eq!(s.faces.len(), 1);
@@ -660,22 +665,7 @@ mod tests {
     /// face the roof (cosine ≈ 1) the convex diagonal 0–2 stays.
     #[test]
     fn steep_corner_is_no_diagonal_end() {
-        let mut positions = vec![
-            DVec3::new(0.0, 0.0, 1.3),
-            DVec3::new(1.0, 0.0, 1.0),
-            DVec3::new(1.0, 1.0, 1.3),
-            DVec3::new(0.0, 1.0, 1.0),
-        ];
-        positions.extend(positions.clone().iter().map(|p| DVec3::new(p.x, p.y, 0.0)));
-        let faces = vec![
-            vec![0, 1, 2, 3],
-            vec![4, 7, 6, 5],
-            vec![0, 4, 5, 1],
-            vec![1, 5, 6, 2],
-            vec![2, 6, 7, 3],
-            vec![3, 7, 4, 0],
-        ];
-        let m = Mesh::new(positions, faces);
+        let m = roof_box(0);
         let roof = area_vector(&m.positions, &m.faces[0]).normalize();
         let diagonal = |normals: &[DVec3]| {
             let s = split_nonplanar_steep(&m, DEFAULT_TOLERANCE, Some(normals)).unwrap();
