@@ -263,13 +263,7 @@ pub fn spread_guards_folded(
                         }
                         // Only nearly flat vertices (fandisk's strips lie within 4° of their
                         // neighbours); sharp vertices keep their fans (the nut's).
-                        let flat = normals.get(face[i] as usize).is_some_and(|n| {
-                            let n = n.normalize_or_zero();
-                            fan.faces
-                                .iter()
-                                .all(|&g| net.pieces.normal[g as usize].dot(n) > FLAT_VERTEX_COS)
-                        });
-                        if !flat {
+                        if !flat_vertex(net, fan, normals.get(face[i] as usize)) {
                             return false;
                         }
                         let Some(n) = normals
@@ -379,13 +373,7 @@ pub fn diagonal_misses(
     face.iter().zip(fans).any(|(&v, (fan, at))| {
         // Only nearly flat corners, where T's fan lies close to one plane (sharp corners' fans
         // turn round their edges, and the lines' closest points say nothing about a fold).
-        let flat = normals.get(v as usize).is_some_and(|n| {
-            let n = n.normalize_or_zero();
-            fan.faces
-                .iter()
-                .all(|&g| net.pieces.normal[g as usize].dot(n) > FLAT_VERTEX_COS)
-        });
-        if !flat {
+        if !flat_vertex(net, fan, normals.get(v as usize)) {
             return false;
         }
         let m = fan.faces.len();
@@ -409,6 +397,17 @@ pub fn diagonal_misses(
             let s = (a11 * b2 - a12 * b1) / det;
             t <= 0.0 || t >= 1.0 || s <= 0.0 || s >= 1.0
         })
+    })
+}
+
+/// True when every piece round a vertex (its `fan`) faces within `FLAT_VERTEX_COS` of the
+/// vertex normal `n`: the vertex is nearly flat, so T's fan there lies close to one plane.
+fn flat_vertex(net: &GuardNet, fan: &Fan, n: Option<&DVec3>) -> bool {
+    n.is_some_and(|n| {
+        let n = n.normalize_or_zero();
+        fan.faces
+            .iter()
+            .all(|&g| net.pieces.normal[g as usize].dot(n) > FLAT_VERTEX_COS)
     })
 }
 
