@@ -25,7 +25,9 @@
 //! by a hair ([`NUDGE_HEIGHT`]), so the cubic scheme does not move them by its margin
 //! (`scheme::cubic_c1::tangent`).
 
-use crate::hull::simplicial::SimplicialHull;
+use super::degenerate::relative_volume;
+use super::verify::DEGENERATE_VOLUME;
+use crate::hull::simplicial::{HullEdge, SimplicialHull};
 use glam::DVec3;
 
 /// Clearance of a lifted apex over its base vertices' tangent planes, relative to the
@@ -40,6 +42,7 @@ const MIN_RATE: f64 = 0.05;
 /// [`super::sides::MAX_HEIGHT`] times the longest edge over the base. Returns how many moved.
 pub fn lift_apexes(hull: &mut SimplicialHull) -> usize {
     let mut moved = 0;
+    let edges = hull.edges().unwrap_or_default();
     for t in 0..hull.triangles.len() {
         let tri = hull.triangles[t];
         let p = tri.map(|i| hull.points[i as usize]);
@@ -60,12 +63,47 @@ pub fn lift_apexes(hull: &mut SimplicialHull) -> usize {
                 hull.apexes[t][side] = Some(lifted);
                 moved += 1;
             } else if let Some(nudged) = nudge(q, p, n, sign * nn, len, g) {
-                hull.apexes[t][side] = Some(nudged);
-                moved += 1;
+                if keeps_edge_tets(hull, &edges, t, side, nudged) {
+                    hull.apexes[t][side] = Some(nudged);
+                    moved += 1;
+                }
             }
         }
     }
     moved
+}
+
+/// True when the edge tetrahedra [p_i p_j q s] that triangle `t`'s apex on `side` would form
+/// at `q` with each neighbour's apex on that side (s their midpoint, as
+/// [`SimplicialHull::edge_tets`] builds them) all keep a relative volume of at least
+/// [`DEGENERATE_VOLUME`] (the bound `verify` holds them to). Why: a nudge is a hair, but on
+/// mpi_poly's needle face 44 it flattened the edge tetrahedra at edge (66, 60) to −9e-9;
+/// such a nudge is not made (`degenerate::repair` rebuilds face tetrahedra only).
+fn keeps_edge_tets(
+    hull: &SimplicialHull,
+    edges: &[HullEdge],
+    t: usize,
+    side: usize,
+    q: DVec3,
+) -> bool {
+    edges
+        .iter()
+        .filter(|e| e.faces[1] != u32::MAX && e.faces.contains(&(t as u32)))
+        .all(|e| {
+            let other = if e.faces[0] as usize == t {
+                e.faces[1]
+            } else {
+                e.faces[0]
+            };
+            let Some(q1) = hull.apexes[other as usize][side] else {
+                return true;
+            };
+            let s = 0.5 * (q + q1);
+            let [pi, pj] = e.v.map(|i| hull.points[i as usize]);
+            [q, q1]
+                .iter()
+                .all(|&x| relative_volume(pi, pj, x, s).abs() >= DEGENERATE_VOLUME)
+        })
 }
 
 /// The apex `q` moved until it clears the tangent planes of `p` (normals `n`) on its side by
