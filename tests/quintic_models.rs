@@ -28,6 +28,7 @@ fn options() -> QuinticOptions {
         consistent_stars: std::env::var("CONSISTENT").is_ok_and(|s| s == "1"),
         hessian_signs: std::env::var("HSIGNS").is_ok_and(|s| s == "1"),
         contain_tangents: std::env::var("TANGENTS").is_ok_and(|s| s == "1"),
+        zero_groups: std::env::var("ZERO").is_ok_and(|s| s == "1"),
     }
 }
 

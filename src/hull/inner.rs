@@ -123,6 +123,12 @@ pub struct InnerOptions {
     /// into one corner of T before everything else ([`close`]; default 0: off). For cages with
     /// near-duplicate crease rings (spot_control_cage).
     pub merge_close: f64,
+    /// Smallest relative volume 6V / L³ of a face tetrahedron: flatter ones are rebuilt over
+    /// their base by [`degenerate::repair_below`], the hull's last step. Default
+    /// [`verify::DEGENERATE_VOLUME`] (what `verify` calls degenerate, enough for the cubic);
+    /// [`InnerOptions::from_toml`] raises it to [`verify::C2_MIN_VOLUME`] for `type =
+    /// "quintic-c2"`, whose C2 rows carry squared barycentrics.
+    pub min_volume: f64,
 }
 
 impl Default for InnerOptions {
@@ -134,6 +140,7 @@ impl Default for InnerOptions {
             planar_tolerance: planar::DEFAULT_TOLERANCE,
             ring_normals: 0.0,
             merge_close: 0.0,
+            min_volume: verify::DEGENERATE_VOLUME,
         }
     }
 }
@@ -151,7 +158,7 @@ impl InnerOptions {
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
-    /// (number in [0, 1]) and `merge_close` (number in [0, 0.05]) from a scene's `[scheme]` table; absent keys keep their defaults, other keys
+    /// (number in [0, 1]) and `merge_close` (number in [0, 0.05]) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -173,6 +180,11 @@ impl InnerOptions {
             }
         };
         let mut o = InnerOptions::default();
+        // The quintic's C2 rows need face tetrahedra that stand off their base (a degree-aware
+        // bound; the cubic keeps verify's).
+        if table.get("type").and_then(toml::Value::as_str) == Some("quintic-c2") {
+            o.min_volume = verify::C2_MIN_VOLUME;
+        }
         if let Some(a) = number("alpha")? {
             if !(a > 0.0 && a < 1.0) {
                 return Err(bad(format!(
@@ -490,7 +502,8 @@ pub fn build_with_report(
     report.sides = sides::settle(&mut hull);
     report.wedged = wedge::keep_in_wedges(&mut hull);
     report.lifted_apexes = clearance::lift_apexes(&mut hull);
-    report.degenerate_repaired = degenerate::repair(&mut hull, &mesh.vertex_lines)?;
+    report.degenerate_repaired =
+        degenerate::repair_below(&mut hull, &mesh.vertex_lines, options.min_volume)?;
     let (unused_points, renumber) = unused::drop_unused_points(&mut hull);
     if !unused_points.is_empty() {
         for i in &mut report.umbrella_normals {

@@ -10,6 +10,7 @@
 
 pub mod cholesky;
 pub mod dense;
+pub mod flat;
 pub mod jets;
 pub mod ordering;
 pub mod signs;
@@ -70,6 +71,10 @@ pub struct QuinticOptions {
     /// the wrong sign on the boundary faces [p_k q s] of the edge tetrahedra next to p_k (a
     /// hole) whatever the free weights are.
     pub contain_tangents: bool,
+    /// Make T's coplanar groups whose points' normals agree with their plane up to input
+    /// rounding exact zero coplanar groups (Appendix B (5'')(ii), [`flat`]): points on the
+    /// plane with its normal, zero Hessians. Off by default (no shipped scene has one).
+    pub zero_groups: bool,
 }
 
 impl Default for QuinticOptions {
@@ -84,6 +89,7 @@ impl Default for QuinticOptions {
             consistent_stars: false,
             hessian_signs: false,
             contain_tangents: false,
+            zero_groups: false,
         }
     }
 }
@@ -155,6 +161,13 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "zero_groups" => match v.as_bool() {
+                    Some(b) => o.zero_groups = b,
+                    None => bail!(
+                        "{}: `scheme.zero_groups` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => match v.as_bool() {
                     Some(b) => o.signs = b,
                     None => bail!(
@@ -173,7 +186,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -215,10 +228,18 @@ pub fn build_with_stats(
     } else {
         (completed, 0)
     };
+    let (completed, zero_points) = if options.zero_groups {
+        flat::zero_coplanar_groups(&completed)
+    } else {
+        (completed, Vec::new())
+    };
     let hull = &completed;
     let np = hull.points.len() as u32;
     let nt = hull.triangles.len() as u32;
     let mut jets = jets::estimate(hull, options.curvature);
+    for &p in &zero_points {
+        jets[p as usize].h = glam::DMat3::ZERO;
+    }
     let (tets, _pos) = system::tetrahedra(hull)?;
     let sys = system::assemble(&tets, np)?;
     let hessian_fit = if options.hessian_signs {

@@ -130,6 +130,35 @@ pub fn is_degenerate(hull: &SimplicialHull, t: usize, side: Side) -> bool {
 /// A triangle of T whose face tetrahedra cannot be made non-degenerate, naming the hull
 /// triangle, its input element and the element's line.
 pub fn repair(hull: &mut SimplicialHull, vertex_lines: &[u32]) -> Result<usize> {
+    repair_below(hull, vertex_lines, DEGENERATE_VOLUME)
+}
+
+/// True when the face tetrahedron of triangle `t` on `side` has a relative volume below
+/// `bound` in magnitude: its apex does not stand off its base.
+#[must_use]
+pub fn is_flat(hull: &SimplicialHull, t: usize, side: Side, bound: f64) -> bool {
+    hull.face_tet(t, side)
+        .is_some_and(|[a, b, c, q]| relative_volume(a, b, c, q).abs() < bound)
+}
+
+/// [`repair`] with its own bound: face tetrahedra with a relative volume below `min_volume`
+/// (at least [`DEGENERATE_VOLUME`]) are rebuilt over their base too, and rebuilt apexes reach
+/// it. The quintic's bound ([`super::verify::C2_MIN_VOLUME`]): the nut's nearly flat trihedral
+/// corner (input vertex 445, three faces 1.5e-6 rad apart, just beyond
+/// [`super::coplanar::NORMAL_TOL`], so not merged) gets step (3)'s triangle C_1C_2C_3 with the
+/// apex V in (almost) its plane and a second apex on an edge of the same plane: an L-U pair of
+/// relative volumes 7e-8 and 2e-8, above verify's bound and kept by [`repair`]. A flat
+/// tetrahedron whose rebuilt apexes cannot reach `min_volume` keeps its apexes when it is not
+/// degenerate in verify's sense.
+///
+/// # Errors
+/// As [`repair`].
+pub fn repair_below(
+    hull: &mut SimplicialHull,
+    vertex_lines: &[u32],
+    min_volume: f64,
+) -> Result<usize> {
+    let min_volume = min_volume.max(DEGENERATE_VOLUME);
     let mut changed = 0;
     for t in 0..hull.triangles.len() {
         let degenerate: Vec<Side> = Side::BOTH
@@ -138,7 +167,7 @@ pub fn repair(hull: &mut SimplicialHull, vertex_lines: &[u32]) -> Result<usize> 
             .collect();
         let bad: Vec<Side> = Side::BOTH
             .into_iter()
-            .filter(|&s| degenerate.contains(&s) || is_far(hull, t, s))
+            .filter(|&s| is_flat(hull, t, s, min_volume) || is_far(hull, t, s))
             .collect();
         if bad.is_empty() {
             continue;
@@ -158,15 +187,20 @@ pub fn repair(hull: &mut SimplicialHull, vertex_lines: &[u32]) -> Result<usize> 
                 }
                 Some(out)
             });
-        let ok = fresh.filter(|apexes| {
+        let thick = |apexes: &[Option<DVec3>; 2], bound: f64| {
             apexes
                 .iter()
                 .flatten()
-                .all(|&q| relative_volume(base[0], base[1], base[2], q).abs() >= DEGENERATE_VOLUME)
+                .all(|&q| relative_volume(base[0], base[1], base[2], q).abs() >= bound)
+        };
+        // Rebuilt apexes reach the bound asked for; a tetrahedron degenerate in verify's sense
+        // takes any that is not.
+        let ok = fresh.filter(|a| {
+            thick(a, min_volume) || (!degenerate.is_empty() && thick(a, DEGENERATE_VOLUME))
         });
         let Some(apexes) = ok else {
             if degenerate.is_empty() {
-                continue; // far but thick: kept as built
+                continue; // far or flat but not degenerate: kept as built
             }
             let element = hull.element[t];
             let line = vertex_lines.get(element as usize).copied().unwrap_or(0);
@@ -240,6 +274,42 @@ mod tests {
             e.contains("hull triangle 0") && e.contains("input vertex 3") && e.contains("line 13"),
             "{e}"
         );
+    }
+
+    /// An L-U pair over a flat base whose apexes lie 5e-8 of its size off the base's plane (the
+    /// nut's nearly flat trihedral corner, all normals the plane's): not degenerate by verify's
+    /// bound, so [`repair`] keeps it; [`repair_below`] with the quintic's bound rebuilds both
+    /// apexes over the base, each tetrahedron at least that thick and tangent-containing.
+    #[test]
+    fn flat_pair_stands_off_its_base_under_the_c2_bound() {
+        use crate::hull::inner::verify::C2_MIN_VOLUME;
+        let flat = [
+            Some(DVec3::new(0.3, 0.3, 5e-8)),
+            Some(DVec3::new(0.2, 0.4, -5e-8)),
+        ];
+        let mut hull = SimplicialHull {
+            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            normals: vec![DVec3::Z; 3],
+            origins: vec![PointOrigin::Other; 3],
+            triangles: vec![[0, 1, 2]],
+            apexes: vec![flat],
+            element: vec![0],
+        };
+        assert_eq!(repair(&mut hull, &[]).unwrap(), 0);
+        assert_eq!(hull.apexes[0], flat);
+        assert_eq!(repair_below(&mut hull, &[], C2_MIN_VOLUME).unwrap(), 1);
+        let [a, b, c] = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let [o, i] = hull.apexes[0].map(Option::unwrap);
+        // Outer above, inner below the plane z = 0, both at least the bound thick.
+        assert!(o.z > 0.0 && i.z < 0.0, "{o} {i}");
+        for q in [o, i] {
+            assert!(relative_volume(a, b, c, q).abs() >= C2_MIN_VOLUME, "{q}");
+            assert!(tangent_containing([a, b, c], [DVec3::Z; 3], q));
+        }
+        // Rebuilt once, they stay.
+        let kept = hull.apexes[0];
+        assert_eq!(repair_below(&mut hull, &[], C2_MIN_VOLUME).unwrap(), 0);
+        assert_eq!(hull.apexes[0], kept);
     }
 
     /// Thick tetrahedra are left alone.

@@ -27,6 +27,17 @@ use std::collections::HashMap;
 /// what the schemes' continuity checks resolve. (A regular tetrahedron has 0.118.)
 pub const DEGENERATE_VOLUME: f64 = 1e-8;
 
+/// Smallest relative volume 6V / L³ the hull gives a face tetrahedron for the quintic C2 scheme
+/// ([`super::InnerOptions::min_volume`] under `type = "quintic-c2"`; the cubic keeps
+/// [`DEGENERATE_VOLUME`]). The C1 rows across a side face of a face tetrahedron A carry the
+/// barycentrics of the neighbour's opposite vertex in A, about L³ / 6V; the C2 rows of degree 5
+/// carry their squares. A sliver of 1e-8 (the nut's nearly flat trihedral corner, input vertex
+/// 445) puts 1e10–1e11 into those rows; at 1e-3 they stay below 1e6 and the C2 data of the
+/// sliver's neighbourhood are not decided by rounding. Every passing quintic scene's flattest
+/// face tetrahedron is above 7e-3 (double_torus_poly 7.5e-3; measured), so they are unchanged;
+/// the nut's flattest after its sliver is 2.9e-3.
+pub const C2_MIN_VOLUME: f64 = 1e-3;
+
 /// Overlap depth, relative to the smaller tetrahedron's longest edge, above which two
 /// tetrahedra intersect. Shared faces, edges and vertices touch with depth 0 up to rounding of
 /// the coordinates (≈1e-15); a real overlap is a visible fraction of a tetrahedron.
