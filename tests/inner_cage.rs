@@ -225,17 +225,7 @@ fn spot_control_cage_steep_corners_end_no_diagonal() {
         v.len()
     );
     // Independent recount on the split mesh (the merge keeps vertex numbers).
-    let (m, _) = mesh::load(Path::new("scenes/models/spot_control_cage.obj")).unwrap();
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
-    let merged = inner::close::merge_close_vertices(&m, &normals, 0.005)
-        .unwrap()
-        .unwrap();
-    let split = inner::planar::split_nonplanar_steep(
-        &merged.mesh,
-        inner::planar::DEFAULT_TOLERANCE,
-        Some(&merged.normals),
-    )
-    .unwrap();
+    let (merged, split) = merged_and_split();
     let mut checked = 0;
     for sf in split
         .faces
@@ -317,6 +307,21 @@ fn spot_control_cage_folded_corners_join_flat_pieces() {
         .filter(|x| elements(&x.message).contains(&52))
         .count();
     assert!(at_52 <= 28, "{at_52}");
+    let (merged, split) = merged_and_split();
+    let mut joined: Vec<u32> = split
+        .faces
+        .iter()
+        .filter(|f| f.joined > 0)
+        .map(|f| merged.mesh.face_parent[f.face as usize])
+        .collect();
+    joined.sort_unstable();
+    assert_eq!(joined, vec![29, 36, 119, 126]);
+}
+
+/// The cage as its scene's hull starts: close vertices merged (`merge_close = 0.005`, the
+/// vertex numbers kept) and bent polygons split with the merged normals, as
+/// `hull::inner` does; for recounts independent of the hull.
+fn merged_and_split() -> (inner::close::CloseMerge, inner::planar::PlanarSplit) {
     let (m, _) = mesh::load(Path::new("scenes/models/spot_control_cage.obj")).unwrap();
     let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
     let merged = inner::close::merge_close_vertices(&m, &normals, 0.005)
@@ -328,14 +333,7 @@ fn spot_control_cage_folded_corners_join_flat_pieces() {
         Some(&merged.normals),
     )
     .unwrap();
-    let mut joined: Vec<u32> = split
-        .faces
-        .iter()
-        .filter(|f| f.joined > 0)
-        .map(|f| merged.mesh.face_parent[f.face as usize])
-        .collect();
-    joined.sort_unstable();
-    assert_eq!(joined, vec![29, 36, 119, 126]);
+    (merged, split)
 }
 
 /// The elements (input vertices) a violation message names.
