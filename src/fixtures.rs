@@ -3,6 +3,7 @@
 
 use crate::bb::{multi_indices, num_coeffs};
 use crate::complex::{Patch, PatchComplex, Role, SheetRule};
+use crate::hull::simplicial::{Side, SimplicialHull};
 use glam::{DMat3, DVec3};
 
 /// One splitmix64 step: a seeded, reproducible uniform number in [0, 1) (the top 53 bits),
@@ -658,4 +659,30 @@ mod crossed_tests {
         got.sort_unstable();
         assert_eq!(got, vec![(0, 0), (0, 2)]);
     }
+}
+
+/// The smallest relative volume 6V / L³ (L the longest edge) of any face tetrahedron of
+/// `hull`, recomputed from the points (independent of `verify` and `degenerate`, which tests
+/// hold to it).
+#[must_use]
+pub fn flattest_face_tet(hull: &SimplicialHull) -> f64 {
+    let mut worst = f64::INFINITY;
+    for t in 0..hull.triangles.len() {
+        for side in Side::BOTH {
+            let Some(tet) = hull.face_tet(t, side) else {
+                continue;
+            };
+            let mut l: f64 = 0.0;
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    l = l.max(tet[i].distance(tet[j]));
+                }
+            }
+            let v6 = (tet[1] - tet[0])
+                .cross(tet[2] - tet[0])
+                .dot(tet[3] - tet[0]);
+            worst = worst.min(v6.abs() / (l * l * l));
+        }
+    }
+    worst
 }

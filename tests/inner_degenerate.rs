@@ -3,8 +3,8 @@
 //! −4e-13 (hull triangle 12397: its inner apex 9.6 away from a base of size 0.06) that stopped
 //! the cubic scheme, every face tetrahedron of the inner hull is now thick and the scheme builds.
 
+use apatch::fixtures::flattest_face_tet;
 use apatch::hull::inner::{build_with_report, InnerOptions};
-use apatch::hull::simplicial::Side;
 use apatch::mesh::{self, NormalMethod};
 use apatch::scheme::cubic_c1::{build, CubicOptions};
 use std::path::Path;
@@ -21,24 +21,7 @@ fn fandisk_face_tetrahedra_are_thick_and_the_cubic_scheme_builds() {
     // Independent recomputation of every face tetrahedron's relative volume 6V / L³ (L its
     // longest edge); 1e-8 is `verify`'s degeneracy bound (barycentric coordinates keep 8 of
     // f64's 16 digits above it).
-    let mut worst = f64::INFINITY;
-    for t in 0..hull.triangles.len() {
-        for side in Side::BOTH {
-            let Some(tet) = hull.face_tet(t, side) else {
-                continue;
-            };
-            let mut l: f64 = 0.0;
-            for i in 0..4 {
-                for j in i + 1..4 {
-                    l = l.max(tet[i].distance(tet[j]));
-                }
-            }
-            let v6 = (tet[1] - tet[0])
-                .cross(tet[2] - tet[0])
-                .dot(tet[3] - tet[0]);
-            worst = worst.min(v6.abs() / (l * l * l));
-        }
-    }
+    let worst = flattest_face_tet(&hull);
     assert!(worst >= 1e-8, "thinnest face tetrahedron {worst:e}");
     // The cubic scheme stopped here with "face tetrahedron of hull triangle 12397 is
     // degenerate"; now it builds one patch per face and edge tetrahedron.

@@ -5,35 +5,11 @@
 //! The nut has one (input vertex 445, relative volumes 7e-8 and 2e-8); its C2 rows carry the
 //! sliver's barycentrics squared (7e10).
 
+use apatch::fixtures::flattest_face_tet;
 use apatch::hull::inner::{self, verify::C2_MIN_VOLUME, InnerOptions};
-use apatch::hull::simplicial::{Side, SimplicialHull};
 use apatch::mesh::{self, Mesh, NormalMethod};
 use glam::DVec3;
 use std::path::Path;
-
-/// The smallest relative volume 6V / L³ (L the longest edge) of any face tetrahedron,
-/// recomputed from the points.
-fn flattest(hull: &SimplicialHull) -> f64 {
-    let mut worst = f64::INFINITY;
-    for t in 0..hull.triangles.len() {
-        for side in Side::BOTH {
-            let Some(tet) = hull.face_tet(t, side) else {
-                continue;
-            };
-            let mut l: f64 = 0.0;
-            for i in 0..4 {
-                for j in i + 1..4 {
-                    l = l.max(tet[i].distance(tet[j]));
-                }
-            }
-            let v6 = (tet[1] - tet[0])
-                .cross(tet[2] - tet[0])
-                .dot(tet[3] - tet[0]);
-            worst = worst.min(v6.abs() / (l * l * l));
-        }
-    }
-    worst
-}
 
 /// A tetrahedron whose bottom face is split at its centroid, the centre moved out by `h`: the
 /// centre is a trihedral corner whose three faces are nearly coplanar.
@@ -66,7 +42,7 @@ fn nearly_flat_trihedral_corner_stands_off_its_base_for_the_quintic() {
     let m = split_tetrahedron(1e-5);
     let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
     let cubic = inner::build(&m, &normals, &InnerOptions::default()).unwrap();
-    let sliver = flattest(&cubic);
+    let sliver = flattest_face_tet(&cubic);
     // The sliver: the apex V stands ~1e-5 off the centroids' plane (measured below 1e-4).
     assert!(sliver < 1e-4, "{sliver:e}");
     let opts = InnerOptions {
@@ -75,7 +51,7 @@ fn nearly_flat_trihedral_corner_stands_off_its_base_for_the_quintic() {
     };
     let (quintic, report) = inner::build_with_report(&m, &normals, &opts).unwrap();
     assert!(report.degenerate_repaired >= 1, "{report:?}");
-    let thick = flattest(&quintic);
+    let thick = flattest_face_tet(&quintic);
     assert!(thick >= C2_MIN_VOLUME, "{thick:e}");
     let v = inner::verify(&quintic);
     assert!(v.is_empty(), "{v:?}");
@@ -116,11 +92,19 @@ fn nut_quintic_hull_has_no_sliver() {
     };
     let hc = inner::build(&m, &normals, &cubic).unwrap();
     // Measured 1.89e-8 (hull triangle 1967).
-    assert!(flattest(&hc) < 1e-7, "{:e}", flattest(&hc));
+    assert!(
+        flattest_face_tet(&hc) < 1e-7,
+        "{:e}",
+        flattest_face_tet(&hc)
+    );
     let (hq, report) = inner::build_with_report(&m, &normals, &quintic).unwrap();
     assert_eq!(report.degenerate_repaired, 1);
     // Measured 2.906e-3: the next flattest of the cubic's hull.
-    assert!(flattest(&hq) >= C2_MIN_VOLUME, "{:e}", flattest(&hq));
+    assert!(
+        flattest_face_tet(&hq) >= C2_MIN_VOLUME,
+        "{:e}",
+        flattest_face_tet(&hq)
+    );
     let v = inner::verify(&hq);
     assert!(
         v.is_empty(),

@@ -11,6 +11,14 @@ use apatch::mesh::Mesh;
 use apatch::scheme::cubic_c1::{self, CubicOptions};
 use glam::DVec3;
 
+/// fandisk (validated) with its angle-weighted vertex normals, as its scene loads it.
+fn fandisk() -> (Mesh, Vec<DVec3>) {
+    let (m, report) = mesh::load(Path::new("scenes/models/fandisk.obj")).unwrap();
+    report.require(true).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    (m, normals)
+}
+
 /// A prism (height 1) over the outline `outline` (counter-clockwise seen from +z): caps
 /// triangulated (ear clipping: coplanar input triangles, as fandisk's flat regions) and one
 /// quadrilateral per outline edge.
@@ -150,9 +158,7 @@ fn quarter_annulus_caps_get_zero_coplanar_groups() {
 /// violations drop to about 1.5 % of what one far point of T per region gave.
 #[test]
 fn fandisk_flat_regions_get_zero_coplanar_groups() {
-    let (m, report) = mesh::load(Path::new("scenes/models/fandisk.obj")).unwrap();
-    report.require(true).unwrap();
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (m, normals) = fandisk();
     let (hull, rep) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
     assert_eq!(rep.flat_nets, 12);
     assert_eq!(inner::verify::euler_characteristic(&hull), Some(2));
@@ -170,9 +176,7 @@ fn fandisk_flat_regions_get_zero_coplanar_groups() {
 /// to the faces across the fold pass beside their edges) get zero coplanar groups.
 #[test]
 fn fandisk_strips_along_the_fold_get_zero_coplanar_groups() {
-    let (m, report) = mesh::load(Path::new("scenes/models/fandisk.obj")).unwrap();
-    report.require(true).unwrap();
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (m, normals) = fandisk();
     let (merged, counts) = coplanar::merge_coplanar_counted(&m);
     let mut net = GuardNet::build(&merged, decompose::convex_pieces(&merged).unwrap());
     let flat = flatnet::spread_guards_folded(&mut net, &merged, &counts, Some(&normals));
@@ -200,9 +204,7 @@ fn fandisk_strips_along_the_fold_get_zero_coplanar_groups() {
 #[test]
 #[ignore = "exploration for humans: fandisk's flat regions and violations"]
 fn explore_fandisk() {
-    let (m, report) = mesh::load(Path::new("scenes/models/fandisk.obj")).unwrap();
-    report.require(true).unwrap();
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (m, normals) = fandisk();
     let merged = coplanar::merge_coplanar(&m);
     eprintln!(
         "input {} faces, merged {}",
@@ -463,9 +465,7 @@ fn explore_fandisk_small_faces() {
 #[test]
 #[ignore = "exploration for humans: violations at fandisk's worst fans"]
 fn explore_fandisk_worst_fans() {
-    let (m, report) = mesh::load(Path::new("scenes/models/fandisk.obj")).unwrap();
-    report.require(true).unwrap();
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (m, normals) = fandisk();
     let (hull, _) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
     let v = inner::verify(&hull);
     for t in [3213usize, 3735, 2741] {
@@ -521,9 +521,7 @@ fn explore_fandisk_worst_fans() {
 #[test]
 fn fandisk_folded_strip_fan_is_an_umbrella() {
     use apatch::hull::simplicial::PointOrigin;
-    let (m, report) = mesh::load(Path::new("scenes/models/fandisk.obj")).unwrap();
-    report.require(true).unwrap();
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (m, normals) = fandisk();
     let (hull, _) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
     let c0 = hull
         .origins
@@ -550,9 +548,7 @@ fn fandisk_folded_strip_fan_is_an_umbrella() {
 #[test]
 #[ignore = "exploration for humans: corners of chosen merged faces (FACES=rep,rep) and their diagonals"]
 fn explore_fandisk_diagonals() {
-    let (m, report) = mesh::load(Path::new("scenes/models/fandisk.obj")).unwrap();
-    report.require(true).unwrap();
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (m, normals) = fandisk();
     let (merged, counts) = coplanar::merge_coplanar_counted(&m);
     let mut net = GuardNet::build(&merged, decompose::convex_pieces(&merged).unwrap());
     let flat = flatnet::spread_guards_folded(&mut net, &merged, &counts, Some(&normals));
