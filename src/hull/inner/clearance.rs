@@ -42,7 +42,8 @@ const MIN_RATE: f64 = 0.05;
 /// [`super::sides::MAX_HEIGHT`] times the longest edge over the base. Returns how many moved.
 pub fn lift_apexes(hull: &mut SimplicialHull) -> usize {
     let mut moved = 0;
-    let edges = hull.edges().unwrap_or_default();
+    // T's edges, built at the first nudge only (most hulls have none).
+    let mut edges: Option<Vec<HullEdge>> = None;
     for t in 0..hull.triangles.len() {
         let tri = hull.triangles[t];
         let p = tri.map(|i| hull.points[i as usize]);
@@ -63,7 +64,8 @@ pub fn lift_apexes(hull: &mut SimplicialHull) -> usize {
                 hull.apexes[t][side] = Some(lifted);
                 moved += 1;
             } else if let Some(nudged) = nudge(q, p, n, sign * nn, len, g) {
-                if keeps_edge_tets(hull, &edges, t, side, nudged) {
+                let edges = edges.get_or_insert_with(|| hull.edges().unwrap_or_default());
+                if keeps_edge_tets(hull, edges, t, side, nudged) {
                     hull.apexes[t][side] = Some(nudged);
                     moved += 1;
                 }
