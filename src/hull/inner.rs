@@ -81,6 +81,7 @@ pub mod flatnet;
 pub mod guardnet;
 pub mod nearguard;
 pub mod normals;
+pub mod overlapnet;
 pub mod planar;
 pub mod remesh;
 pub mod sides;
@@ -293,6 +294,12 @@ pub struct InnerReport {
     pub umbrella_normals: Vec<u32>,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
+    /// Input faces of the merged polygons that could take a flat net but have none
+    /// ([`flatnet::FlatNets::eligible`]).
+    pub flat_net_candidates: Vec<u32>,
+    /// Input faces whose merged polygons were given flat nets because their triangles of T
+    /// overlapped in an earlier build ([`overlapnet`]).
+    pub overlap_nets: Vec<u32>,
     /// Corners of star faces given a guard of their own ([`nearguard`]): (input face, vertex).
     pub near_guards: Vec<(u32, u32)>,
     /// Points of T no triangle used (guards the guard net gave no corner), dropped
@@ -324,6 +331,28 @@ pub fn build_with_report(
     mesh: &Mesh,
     normals: &[DVec3],
     options: &InnerOptions,
+) -> Result<(SimplicialHull, InnerReport)> {
+    let none = std::collections::BTreeSet::new();
+    let (hull, report) = build_forced(mesh, normals, options, &none)?;
+    if report.flat_nets == 0 {
+        return Ok((hull, report));
+    }
+    // Merged regions whose triangles of T overlap get flat nets too ([`overlapnet`]).
+    Ok(overlapnet::force_nets(hull, report, |forced| {
+        build_forced(mesh, normals, options, forced)
+    }))
+}
+
+/// [`build_with_report`] without its rebuilds, with the merged regions of the input faces
+/// `forced` given flat nets ([`flatnet::spread_guards_forced`]).
+///
+/// # Errors
+/// See [`build_with_report`].
+pub fn build_forced(
+    mesh: &Mesh,
+    normals: &[DVec3],
+    options: &InnerOptions,
+    forced: &std::collections::BTreeSet<u32>,
 ) -> Result<(SimplicialHull, InnerReport)> {
     if !(options.alpha > 0.0 && options.alpha < 1.0) {
         return Err(Error::Invalid(format!(
@@ -383,8 +412,10 @@ pub fn build_with_report(
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.
     let mut net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
     // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
-    let flat = flatnet::spread_guards_folded(&mut net, mesh, &merged_counts, Some(normals));
+    let flat = flatnet::spread_guards_forced(&mut net, mesh, &merged_counts, Some(normals), forced);
     report.flat_nets = flat.groups.len();
+    report.flat_net_candidates.clone_from(&flat.eligible);
+    report.overlap_nets = forced.iter().copied().collect();
     // Star faces' corners served from far where the face folds nearly flat into a neighbour.
     report.near_guards = nearguard::add_near_guards(&mut net, mesh)
         .into_iter()

@@ -48,7 +48,7 @@ use super::guardnet::{EdgeCell, GuardNet};
 use crate::hull::simplicial::{PointOrigin, SimplicialHull};
 use crate::mesh::{ear_clip, Fan, Mesh};
 use glam::{DVec2, DVec3};
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 
 /// Distance of a corner's guard from the corner on the bisector of its interior angle, as a
 /// share of the corner's shorter edge (halved until the guard sees both edges).
@@ -78,6 +78,10 @@ pub struct FlatNets {
     /// Per polygon: (piece index of the polygon, guard points of its corners in order,
     /// interior triangles as guard point indices, counter-clockwise from outside).
     pub groups: Vec<FlatGroup>,
+    /// Input faces (`face_parent`) of the merged polygons that have what a net needs (several
+    /// input faces, at least [`MIN_CORNERS`] corners, one region, every corner's fan holding
+    /// it once) but did not qualify for one: the candidates [`super::overlapnet`] may force.
+    pub eligible: Vec<u32>,
 }
 
 /// One flat polygon's zero coplanar group.
@@ -164,6 +168,20 @@ pub fn spread_guards_folded(
     mesh: &Mesh,
     merged: &[usize],
     normals: Option<&[DVec3]>,
+) -> FlatNets {
+    spread_guards_forced(net, mesh, merged, normals, &BTreeSet::new())
+}
+
+/// [`spread_guards_folded`], also giving a flat net to every merged polygon whose input face
+/// (`mesh.face_parent`) is in `forced` (the polygons whose triangles of T overlapped in an
+/// earlier build, [`super::overlapnet`]), when it has the structure a net needs (several
+/// input faces, at least [`MIN_CORNERS`] corners, one region, a guard polygon).
+pub fn spread_guards_forced(
+    net: &mut GuardNet,
+    mesh: &Mesh,
+    merged: &[usize],
+    normals: Option<&[DVec3]>,
+    forced: &BTreeSet<u32>,
 ) -> FlatNets {
     let pos = &mesh.positions;
     let mut out = FlatNets::default();
@@ -280,7 +298,14 @@ pub fn spread_guards_folded(
                     })
                 });
             let misses = normals.is_some_and(|n| diagonal_misses(net, pos, n, &face, &fans));
-            if !far && !folds && !misses {
+            let overlapped = mesh
+                .face_parent
+                .get(f as usize)
+                .is_some_and(|p| forced.contains(p));
+            if !far && !folds && !misses && !overlapped {
+                if let Some(&p) = mesh.face_parent.get(f as usize) {
+                    out.eligible.push(p);
+                }
                 continue;
             }
             let n = net.pieces.normal[own[0] as usize];
@@ -332,6 +357,14 @@ pub fn spread_guards_folded(
             break;
         }
     }
+    let netted: BTreeSet<u32> = out
+        .groups
+        .iter()
+        .filter_map(|g| mesh.face_parent.get(g.face as usize).copied())
+        .collect();
+    out.eligible.sort_unstable();
+    out.eligible.dedup();
+    out.eligible.retain(|p| !netted.contains(p));
     if out.groups.is_empty() {
         return out;
     }
