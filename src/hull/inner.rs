@@ -59,7 +59,10 @@
 //! C_0C_iC_{i+1} is an umbrella round n_V with convex edges (beyond the paper: on coarse or
 //! sharply folded models the paper's C_0 folds a fan triangle back over its neighbours).
 //!
-//! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull.
+//! [`verify`] checks Definition 3.6 and Lemmas 4.1–4.3 on any hull. A hull with flat nets
+//! that fails it is rebuilt by [`overlapnet`]: merged regions whose triangles of T overlap get
+//! flat nets too, one at a time, each kept only when the rebuilt hull has fewer violations
+//! (fandisk's strips along its 90° edges; hulls without flat nets are built once).
 //!
 //! Shape control (§7.1) splits into a hull part and a weight part. The hull part is α
 //! ([`InnerOptions::alpha`]): how deep a non-trihedral corner is cut. For a trihedral corner the
