@@ -751,3 +751,25 @@ fn explore_fandisk_forced_one_by_one() {
         );
     }
 }
+
+#[test]
+#[ignore = "exploration for humans: points, normals and apexes of chosen triangles of fandisk's hull (TRIS=a,b)"]
+fn explore_fandisk_triangles() {
+    let (m, normals) = fandisk();
+    let (hull, _) = inner::build_with_report(&m, &normals, &InnerOptions::default()).unwrap();
+    for t in std::env::var("TRIS")
+        .unwrap_or_default()
+        .split(',')
+        .filter_map(|x| x.parse::<usize>().ok())
+    {
+        eprintln!("triangle {t} element {}", hull.element[t]);
+        for p in hull.triangles[t] {
+            let i = p as usize;
+            eprintln!(
+                "  point {p} {:?} at {:.5} n {:.4}",
+                hull.origins[i], hull.points[i], hull.normals[i]
+            );
+        }
+        eprintln!("  apexes {:?}", hull.apexes[t]);
+    }
+}
