@@ -14,9 +14,13 @@
 //!
 //! [`lift_apexes`] moves every apex that lies below a base vertex's tangent plane (beyond the
 //! non-planarity the input may have, [`crate::mesh::PLANARITY_TOL`]) until it clears all three
-//! planes by [`CLEARANCE`] times the longest edge, staying on its side of the triangle: along
-//! the triangle's normal, or straight across the plane it is furthest below where the normal
-//! barely crosses it. Then every apex of an L-U pair is on its own side of every tangent plane,
+//! planes by [`CLEARANCE`] times the longest edge, staying on its side of the triangle: by the
+//! shortest of three moves, along the triangle's normal, straight across the plane it is
+//! furthest below, or between the two ([`move_over`]). Why the shortest: a triangle that
+//! stands almost edge-on to a base vertex's tangent plane crosses it slowly along its normal
+//! (mpi_poly's step (5') cell over edge 73–83, from needle face 44's plane x = 6 to face 26:
+//! the normal crosses x = 6 at a rate of 0.14, so the apex rose 4.5 over a base 3.4 long and
+//! its tetrahedron overlapped 56 times; straight across, it moves 0.6). Then every apex of an L-U pair is on its own side of every tangent plane,
 //! which keeps the pair tangent-containing (Definition 3.5): at a vertex whose plane does not
 //! cut the base, the other two base vertices are on one side and the apex of the other side is
 //! across it. Apexes already on or above all three planes (the trihedral corners' V lies in
@@ -151,8 +155,9 @@ fn nudge(q: DVec3, p: [DVec3; 3], n: [DVec3; 3], up: DVec3, len: f64, g: DVec3) 
 }
 
 /// The apex `q` moved by the least step along `up`, across the plane it is furthest below, or
-/// between the two, until it clears every tangent plane by `target` and stays on its side of
-/// the triangle; `None` when no direction works.
+/// between the two (whichever of the three moves least), until it clears every tangent plane
+/// by `target` and stays on its side of the triangle within [`super::sides::MAX_HEIGHT`];
+/// `None` when no direction works.
 fn move_over(
     q: DVec3,
     p: [DVec3; 3],
@@ -168,6 +173,7 @@ fn move_over(
         .min_by(|&a, &b| h(a, q).total_cmp(&h(b, q)))
         .expect("three vertices");
     let across = side * n[worst];
+    let mut best: Option<(f64, DVec3)> = None;
     for dir in [up, across, (up + across).normalize_or_zero()] {
         // λ ≥ 0 with every height h_k + λ r_k ≥ target and the side up·(x − g) ≥ target.
         let (mut lo, mut hi) = (0.0f64, f64::INFINITY);
@@ -197,10 +203,13 @@ fn move_over(
         }
         let lifted = q + lo * dir;
         if (lifted - g).length() <= super::sides::MAX_HEIGHT * len {
-            return Some(lifted);
+            let step = (lifted - q).length();
+            if best.is_none_or(|(b, _)| step < b) {
+                best = Some((step, lifted));
+            }
         }
     }
-    None
+    best.map(|(_, x)| x)
 }
 
 #[cfg(test)]
@@ -209,7 +218,8 @@ mod tests {
 
     /// A flat triangle whose vertex normals lean outwards (a convex cap) with its outer apex
     /// dropped below one vertex's tangent plane: the lift brings it over all three planes by
-    /// the clearance, measured directly; an apex already above all three stays.
+    /// the clearance, measured directly, moving no further than straight up would; an apex
+    /// already above all three stays.
     #[test]
     fn apex_below_a_tangent_plane_is_lifted_over_all_three() {
         let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
@@ -224,10 +234,41 @@ mod tests {
             // Rounding of the step: far below the clearance.
             assert!(n[k].dot(lifted - p[k]) >= CLEARANCE * len - 1e-12);
         }
-        // Straight up works here: only the height changed.
-        assert_eq!(lifted.x, q.x);
-        assert_eq!(lifted.y, q.y);
+        // Straight up works here, by the largest (target − h_k) / n_k·z over the planes; the
+        // lift moves no further than that (it takes the shortest move; rounding ~1e-12).
+        let up_step = (0..3)
+            .map(|k| (CLEARANCE * len - n[k].dot(q - p[k])) / n[k].z)
+            .fold(0.0, f64::max);
+        assert!(up_step > 0.0);
+        assert!((lifted - q).length() <= up_step + 1e-12);
         assert!(lift(lifted, p, n, DVec3::Z, len, g).is_none());
+    }
+
+    /// A vertex normal that stands almost in the triangle's plane (the triangle edge-on to that
+    /// tangent plane): the normal `up` crosses the plane at a rate of 0.44 only, so lifting
+    /// along it moves the apex (target + depth) / 0.44; straight across the plane moves it
+    /// (target + depth) / 1. The lift takes the shorter move, measured against both.
+    #[test]
+    fn apex_below_a_steep_plane_takes_the_shortest_move() {
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let g = (p[0] + p[1] + p[2]) / 3.0;
+        let n = [DVec3::Z, DVec3::Z, DVec3::new(-0.9, 0.0, 0.44).normalize()];
+        let len = 2f64.sqrt();
+        let target = CLEARANCE * len;
+        let q = g + 0.3 * DVec3::Z;
+        let depth = -n[2].dot(q - p[2]);
+        assert!(depth > 0.1, "q lies {depth} below vertex 2's plane");
+        let lifted = lift(q, p, n, DVec3::Z, len, g).expect("lifted");
+        for k in 0..3 {
+            // Rounding of the step: far below the clearance.
+            assert!(n[k].dot(lifted - p[k]) >= target - 1e-12);
+        }
+        let along_up = (target + depth) / n[2].z;
+        let across = target + depth;
+        let step = (lifted - q).length();
+        // Rounding of the step (coordinates ~1): the moves differ by 0.25.
+        assert!((step - across).abs() < 1e-12, "{step} vs {across}");
+        assert!(step < along_up - 0.2, "{step} vs {along_up}");
     }
 
     /// A trihedral-like apex 1e-5 below one vertex's tangent plane (within the planarity
