@@ -10,7 +10,10 @@
 //!    their size: subdivision control cages) are split into triangles, no vertex moved, with
 //!    diagonals that fold like their neighbouring edges and do not end at steep corners
 //!    (vertex normal almost in the polygon's plane, [`planar::STEEP_CORNER`]); nearly
-//!    coplanar triangles meeting at a folded corner are joined back ([`planar::JOIN_ANGLE`]). (The mesh must be a closed 2-manifold;
+//!    coplanar triangles meeting at a folded corner are joined back ([`planar::JOIN_ANGLE`]);
+//!    with [`InnerOptions::split_search`], where the finished hull fails [`verify`], the splits
+//!    at the corners its violations name are chosen by rebuilding and verifying
+//!    ([`retriangulate`]). (The mesh must be a closed 2-manifold;
 //!    [`closed::require_closed`] says why one is not, for the scenes.)
 //! 1. [`coplanar`]: edge-adjacent coplanar faces are merged into one polygon (one face per
 //!    plane, as the paper's polyhedra have; Appendix B's coplanarity treated at its source).
@@ -83,6 +86,7 @@ pub mod nearguard;
 pub mod normals;
 pub mod planar;
 pub mod remesh;
+pub mod retriangulate;
 pub mod sides;
 pub mod umbrella;
 pub mod unfold;
@@ -129,6 +133,11 @@ pub struct InnerOptions {
     /// [`InnerOptions::from_toml`] raises it to [`verify::C2_MIN_VOLUME`] for `type =
     /// "quintic-c2"`, whose C2 rows carry squared barycentrics.
     pub min_volume: f64,
+    /// Where the hull of the ranked splits of bent polygons fails `verify`, change those splits
+    /// by verification ([`retriangulate`]; default false: opt-in, it rebuilds the hull up to
+    /// [`retriangulate::MAX_TRIALS`] times). For strongly bent control cages
+    /// (spot_control_cage).
+    pub split_search: bool,
 }
 
 impl Default for InnerOptions {
@@ -141,24 +150,26 @@ impl Default for InnerOptions {
             ring_normals: 0.0,
             merge_close: 0.0,
             min_volume: verify::DEGENERATE_VOLUME,
+            split_search: false,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 6] = [
+    pub const KEYS: [&'static str; 7] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
         "planar_tolerance",
         "ring_normals",
         "merge_close",
+        "split_search",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
-    /// (number in [0, 1]) and `merge_close` (number in [0, 0.05]) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
+    /// (number in [0, 1]), `merge_close` (number in [0, 0.05]) and `split_search` (boolean) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -249,6 +260,16 @@ impl InnerOptions {
                 )))
             }
         }
+        match table.get("split_search") {
+            None => {}
+            Some(toml::Value::Boolean(b)) => o.split_search = *b,
+            Some(v) => {
+                return Err(bad(format!(
+                    "`scheme.split_search`: expected a boolean, found {}",
+                    v.type_str()
+                )))
+            }
+        }
         Ok(o)
     }
 }
@@ -291,6 +312,9 @@ pub struct InnerReport {
     /// Points of T (pseudo-centroids) whose normals were turned to face their fan triangles
     /// ([`umbrella`]).
     pub umbrella_normals: Vec<u32>,
+    /// Bent polygons whose split the verification search changed ([`retriangulate`]; faces of
+    /// the mesh after the close-vertex merge), with the violations before and after.
+    pub retriangulated: retriangulate::Search,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
     /// Corners of star faces given a guard of their own ([`nearguard`]): (input face, vertex).
@@ -325,6 +349,37 @@ pub fn build_with_report(
     normals: &[DVec3],
     options: &InnerOptions,
 ) -> Result<(SimplicialHull, InnerReport)> {
+    let (hull, report, bent) = build_forced(mesh, normals, options, &[])?;
+    if !options.split_search || bent.is_empty() {
+        return Ok((hull, report));
+    }
+    let violations = verify(&hull);
+    if violations.is_empty() {
+        return Ok((hull, report));
+    }
+    // Bent polygons' splits chosen by verification where the ranked ones fail.
+    let search = retriangulate::improve(&bent, &violations, |forced| {
+        build_forced(mesh, normals, options, forced)
+            .ok()
+            .map(|(h, _, _)| verify(&h))
+    });
+    if search.forced.is_empty() {
+        return Ok((hull, report));
+    }
+    let (hull, mut report, _) = build_forced(mesh, normals, options, &search.forced)?;
+    report.retriangulated = search;
+    Ok((hull, report))
+}
+
+/// [`build_with_report`] with the splits of some bent polygons forced
+/// ([`planar::split_nonplanar_forced`]; faces of the mesh after the close-vertex merge), also
+/// returning the split polygons the search may change.
+fn build_forced(
+    mesh: &Mesh,
+    normals: &[DVec3],
+    options: &InnerOptions,
+    forced: &[(u32, planar::Forced)],
+) -> Result<(SimplicialHull, InnerReport, Vec<retriangulate::Bent>)> {
     if !(options.alpha > 0.0 && options.alpha < 1.0) {
         return Err(Error::Invalid(format!(
             "inner hull: alpha = {} must lie strictly between 0 and 1",
@@ -349,7 +404,24 @@ pub fn build_with_report(
         None => (mesh, normals),
     };
     // Polygons that are not planar are split into triangles (no vertex moves).
-    let split = planar::split_nonplanar_steep(mesh, options.planar_tolerance, Some(normals));
+    let split =
+        planar::split_nonplanar_forced(mesh, options.planar_tolerance, Some(normals), forced);
+    let bent: Vec<retriangulate::Bent> = split.as_ref().map_or(Vec::new(), |s| {
+        s.faces
+            .iter()
+            .enumerate()
+            .map(|(i, sf)| retriangulate::Bent {
+                face: sf.face,
+                corners: mesh.faces[sf.face as usize].clone(),
+                candidates: s.candidates[i],
+                ranked: planar::Forced {
+                    triangulation: s.chosen[i],
+                    join: s.join[i],
+                },
+                joinable: s.joinable[i].clone(),
+            })
+            .collect()
+    });
     let mesh = match &split {
         Some(s) => {
             report.planar_split.clone_from(&s.faces);
@@ -511,5 +583,5 @@ pub fn build_with_report(
         }
     }
     report.unused_points = unused_points;
-    Ok((hull, report))
+    Ok((hull, report, bent))
 }
