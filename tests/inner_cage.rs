@@ -477,3 +477,18 @@ fn spot_control_cage_split_search_lowers_violations() {
         assert!(merged.mesh.faces[*face as usize].len() > 3);
     }
 }
+
+/// The `split_search` key: a boolean, off by default; any other type is an error naming it.
+#[test]
+fn split_search_key_is_parsed_and_checked() {
+    let read = |s: &str| {
+        let t: toml::Table = toml::from_str(s).unwrap();
+        InnerOptions::from_toml(&t, Path::new("s.toml"))
+    };
+    assert!(read("split_search = true").unwrap().split_search);
+    assert!(!read("").unwrap().split_search);
+    for bad in ["split_search = 1", "split_search = \"yes\""] {
+        let e = read(bad).unwrap_err().to_string();
+        assert!(e.contains("split_search"), "{bad}: {e}");
+    }
+}
