@@ -10,7 +10,10 @@
 //!    their size: subdivision control cages) are split into triangles, no vertex moved, with
 //!    diagonals that fold like their neighbouring edges and do not end at steep corners
 //!    (vertex normal almost in the polygon's plane, [`planar::STEEP_CORNER`]); nearly
-//!    coplanar triangles meeting at a folded corner are joined back ([`planar::JOIN_ANGLE`]). (The mesh must be a closed 2-manifold;
+//!    coplanar triangles meeting at a folded corner are joined back ([`planar::JOIN_ANGLE`]);
+//!    with [`InnerOptions::split_search`], where the finished hull fails [`verify`], the splits
+//!    at the corners its violations name are chosen by rebuilding and verifying
+//!    ([`retriangulate`]). (The mesh must be a closed 2-manifold;
 //!    [`closed::require_closed`] says why one is not, for the scenes.)
 //! 1. [`coplanar`]: edge-adjacent coplanar faces are merged into one polygon (one face per
 //!    plane, as the paper's polyhedra have; Appendix B's coplanarity treated at its source).
@@ -87,6 +90,7 @@ pub mod normals;
 pub mod overlapnet;
 pub mod planar;
 pub mod remesh;
+pub mod retriangulate;
 pub mod sides;
 pub mod umbrella;
 pub mod unfold;
@@ -133,6 +137,11 @@ pub struct InnerOptions {
     /// [`InnerOptions::from_toml`] raises it to [`verify::C2_MIN_VOLUME`] for `type =
     /// "quintic-c2"`, whose C2 rows carry squared barycentrics.
     pub min_volume: f64,
+    /// Where the hull of the ranked splits of bent polygons fails `verify`, change those splits
+    /// by verification ([`retriangulate`]; default false: opt-in, it rebuilds the hull up to
+    /// [`retriangulate::MAX_TRIALS`] times). For strongly bent control cages
+    /// (spot_control_cage).
+    pub split_search: bool,
 }
 
 impl Default for InnerOptions {
@@ -145,24 +154,26 @@ impl Default for InnerOptions {
             ring_normals: 0.0,
             merge_close: 0.0,
             min_volume: verify::DEGENERATE_VOLUME,
+            split_search: false,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 6] = [
+    pub const KEYS: [&'static str; 7] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
         "planar_tolerance",
         "ring_normals",
         "merge_close",
+        "split_search",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
-    /// (number in [0, 1]) and `merge_close` (number in [0, 0.05]) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
+    /// (number in [0, 1]), `merge_close` (number in [0, 0.05]) and `split_search` (boolean) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -253,6 +264,16 @@ impl InnerOptions {
                 )))
             }
         }
+        match table.get("split_search") {
+            None => {}
+            Some(toml::Value::Boolean(b)) => o.split_search = *b,
+            Some(v) => {
+                return Err(bad(format!(
+                    "`scheme.split_search`: expected a boolean, found {}",
+                    v.type_str()
+                )))
+            }
+        }
         Ok(o)
     }
 }
@@ -295,6 +316,9 @@ pub struct InnerReport {
     /// Points of T (pseudo-centroids) whose normals were turned to face their fan triangles
     /// ([`umbrella`]).
     pub umbrella_normals: Vec<u32>,
+    /// Bent polygons whose split the verification search changed ([`retriangulate`]; faces of
+    /// the mesh after the close-vertex merge), with the violations before and after.
+    pub retriangulated: retriangulate::Search,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
     /// Input faces of the merged polygons that could take a flat net but have none
@@ -336,14 +360,35 @@ pub fn build_with_report(
     options: &InnerOptions,
 ) -> Result<(SimplicialHull, InnerReport)> {
     let none = std::collections::BTreeSet::new();
-    let (hull, report) = build_forced(mesh, normals, options, &none)?;
-    if report.flat_nets == 0 {
+    let (hull, report, bent) = build_with(mesh, normals, options, &none, &[])?;
+    // Merged regions whose triangles of T overlap get flat nets too ([`overlapnet`]).
+    let (hull, report) = if report.flat_nets == 0 {
+        (hull, report)
+    } else {
+        overlapnet::force_nets(hull, report, |forced| {
+            build_forced(mesh, normals, options, forced)
+        })
+    };
+    if !options.split_search || bent.is_empty() {
         return Ok((hull, report));
     }
-    // Merged regions whose triangles of T overlap get flat nets too ([`overlapnet`]).
-    Ok(overlapnet::force_nets(hull, report, |forced| {
-        build_forced(mesh, normals, options, forced)
-    }))
+    let violations = verify(&hull);
+    if violations.is_empty() {
+        return Ok((hull, report));
+    }
+    // Bent polygons' splits chosen by verification where the ranked ones fail.
+    let nets: std::collections::BTreeSet<u32> = report.overlap_nets.iter().copied().collect();
+    let search = retriangulate::improve(&bent, &violations, |forced| {
+        build_with(mesh, normals, options, &nets, forced)
+            .ok()
+            .map(|(h, _, _)| verify(&h))
+    });
+    if search.forced.is_empty() {
+        return Ok((hull, report));
+    }
+    let (hull, mut report, _) = build_with(mesh, normals, options, &nets, &search.forced)?;
+    report.retriangulated = search;
+    Ok((hull, report))
 }
 
 /// [`build_with_report`] without its rebuilds, with the merged regions of the input faces
@@ -357,6 +402,20 @@ pub fn build_forced(
     options: &InnerOptions,
     forced: &std::collections::BTreeSet<u32>,
 ) -> Result<(SimplicialHull, InnerReport)> {
+    build_with(mesh, normals, options, forced, &[]).map(|(h, r, _)| (h, r))
+}
+
+/// One build without rebuilds: the merged regions of the input faces `nets` given flat nets
+/// ([`flatnet::spread_guards_forced`]) and the splits of some bent polygons forced
+/// ([`planar::split_nonplanar_forced`]; faces of the mesh after the close-vertex merge); also
+/// returns the split polygons the split search may change.
+fn build_with(
+    mesh: &Mesh,
+    normals: &[DVec3],
+    options: &InnerOptions,
+    nets: &std::collections::BTreeSet<u32>,
+    splits: &[(u32, planar::Forced)],
+) -> Result<(SimplicialHull, InnerReport, Vec<retriangulate::Bent>)> {
     if !(options.alpha > 0.0 && options.alpha < 1.0) {
         return Err(Error::Invalid(format!(
             "inner hull: alpha = {} must lie strictly between 0 and 1",
@@ -381,7 +440,24 @@ pub fn build_forced(
         None => (mesh, normals),
     };
     // Polygons that are not planar are split into triangles (no vertex moves).
-    let split = planar::split_nonplanar_steep(mesh, options.planar_tolerance, Some(normals));
+    let split =
+        planar::split_nonplanar_forced(mesh, options.planar_tolerance, Some(normals), splits);
+    let bent: Vec<retriangulate::Bent> = split.as_ref().map_or(Vec::new(), |s| {
+        s.faces
+            .iter()
+            .enumerate()
+            .map(|(i, sf)| retriangulate::Bent {
+                face: sf.face,
+                corners: mesh.faces[sf.face as usize].clone(),
+                candidates: s.candidates[i],
+                ranked: planar::Forced {
+                    triangulation: s.chosen[i],
+                    join: s.join[i],
+                },
+                joinable: s.joinable[i].clone(),
+            })
+            .collect()
+    });
     let mesh = match &split {
         Some(s) => {
             report.planar_split.clone_from(&s.faces);
@@ -415,10 +491,10 @@ pub fn build_forced(
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.
     let mut net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
     // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
-    let flat = flatnet::spread_guards_forced(&mut net, mesh, &merged_counts, Some(normals), forced);
+    let flat = flatnet::spread_guards_forced(&mut net, mesh, &merged_counts, Some(normals), nets);
     report.flat_nets = flat.groups.len();
     report.flat_net_candidates.clone_from(&flat.eligible);
-    report.overlap_nets = forced.iter().copied().collect();
+    report.overlap_nets = nets.iter().copied().collect();
     // Star faces' corners served from far where the face folds nearly flat into a neighbour.
     report.near_guards = nearguard::add_near_guards(&mut net, mesh)
         .into_iter()
@@ -545,5 +621,5 @@ pub fn build_forced(
         }
     }
     report.unused_points = unused_points;
-    Ok((hull, report))
+    Ok((hull, report, bent))
 }

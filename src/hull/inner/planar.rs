@@ -114,6 +114,30 @@ pub struct PlanarSplit {
     /// Split polygons whose triangulation the above-face repair changed from the best-scored
     /// one.
     pub repaired: usize,
+    /// For every split polygon (as in `faces`), how many ranked triangulations it has: the
+    /// range of [`Forced::triangulation`].
+    pub candidates: Vec<usize>,
+    /// For every split polygon (as in `faces`), the index of the triangulation taken (forced,
+    /// or else the ranked choice after the above-face repair).
+    pub chosen: Vec<usize>,
+    /// For every split polygon (as in `faces`), whether its nearly coplanar pairs at folded
+    /// corners were allowed to join ([`Forced::join`]; true unless forced off).
+    pub join: Vec<bool>,
+    /// For every split polygon (as in `faces`) and each of its ranked triangulations, whether
+    /// joining ([`Forced::join`]) would join any pair (else both settings give one split).
+    pub joinable: Vec<Vec<bool>>,
+}
+
+/// A split forced on one bent polygon instead of the ranked choice (see
+/// [`super::retriangulate`], which picks these by the hull's own verification).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Forced {
+    /// Index into the polygon's triangulations ranked as [`split_nonplanar_steep`] ranks them
+    /// (best first).
+    pub triangulation: usize,
+    /// Whether nearly coplanar pairs meeting at a folded corner are joined back
+    /// ([`JOIN_ANGLE`]).
+    pub join: bool,
 }
 
 /// All triangulations of a convex-position polygon with corners `0..n` by diagonals, each as a
@@ -465,6 +489,19 @@ pub fn split_nonplanar_steep(
     tolerance: f64,
     normals: Option<&[DVec3]>,
 ) -> Option<PlanarSplit> {
+    split_nonplanar_forced(mesh, tolerance, normals, &[])
+}
+
+/// [`split_nonplanar_steep`] with the splits of some polygons forced: `forced` lists (face of
+/// `mesh`, split); a triangulation index beyond the polygon's candidates, or a face that is not
+/// split, is ignored. The above-face repair runs before the forced choices replace its own.
+#[must_use]
+pub fn split_nonplanar_forced(
+    mesh: &Mesh,
+    tolerance: f64,
+    normals: Option<&[DVec3]>,
+    forced: &[(u32, Forced)],
+) -> Option<PlanarSplit> {
     let bent: Vec<(usize, f64)> = mesh
         .faces
         .iter()
@@ -519,16 +556,25 @@ pub fn split_nonplanar_steep(
     options.retain(|c| !c.is_empty());
     let around = Around::new(mesh, &bent);
     let chosen = repair_above_face(mesh, &bent, &options, &around);
+    let repaired = chosen.repaired;
+    let mut chosen = chosen.choice;
+    let mut join = vec![true; bent.len()];
+    for &(face, f) in forced {
+        if let Some(k) = bent.iter().position(|&(b, _)| b == face as usize) {
+            if f.triangulation < options[k].len() {
+                chosen[k] = f.triangulation;
+                join[k] = f.join;
+            }
+        }
+    }
     let corners_without_above = (0..mesh.positions.len())
         .filter(|&v| {
             around
-                .clearance(mesh, &options, &chosen.choice, v)
+                .clearance(mesh, &options, &chosen, v)
                 .is_some_and(|c| c < ABOVE_MARGIN)
         })
         .map(|v| v as u32)
         .collect();
-    let repaired = chosen.repaired;
-    let chosen = chosen.choice;
     // Corners whose input normal is not above all their polygons (Appendix C will turn it).
     let folded: Vec<bool> = match normals {
         None => vec![false; mesh.positions.len()],
@@ -546,6 +592,17 @@ pub fn split_nonplanar_steep(
                 .collect()
         }
     };
+    let joinable: Vec<Vec<bool>> = options
+        .iter()
+        .map(|o| {
+            o.iter()
+                .map(|c| {
+                    join_flat_pairs(&mesh.positions, &c.triangles, &folded).len()
+                        < c.triangles.len()
+                })
+                .collect()
+        })
+        .collect();
     // Rebuild the mesh with lines and parents.
     let count = mesh.faces.len() + bent.len();
     let mut out = Mesh {
@@ -561,7 +618,11 @@ pub fn split_nonplanar_steep(
     for (f, face) in mesh.faces.iter().enumerate() {
         let pieces: Vec<Vec<u32>> = if slot < bent.len() && bent[slot].0 == f {
             let c = &options[slot][chosen[slot]];
-            let pieces = join_flat_pairs(&mesh.positions, &c.triangles, &folded);
+            let pieces = if join[slot] {
+                join_flat_pairs(&mesh.positions, &c.triangles, &folded)
+            } else {
+                c.triangles.iter().map(|t| t.to_vec()).collect()
+            };
             report.push(SplitFace {
                 face: f as u32,
                 line: mesh.face_lines.get(f).copied().unwrap_or(0),
@@ -589,6 +650,10 @@ pub fn split_nonplanar_steep(
         corners_without_above,
         kept,
         repaired,
+        candidates: options.iter().map(Vec::len).collect(),
+        chosen,
+        join,
+        joinable,
     })
 }
 
