@@ -9,8 +9,8 @@ use std::path::Path;
 /// The scheme's defaults, with `LIFT=x`, `CURV=x`, `SIGNS=1`, `LU=0` and `JOINT=1` in the
 /// environment overriding the lift, the curvature, the sign pins, the L-U completion and the
 /// joint stars, `RELAX=0` turning off the relaxed stars, `CONSISTENT=1` the consistent
-/// stars, `HSIGNS=1` the Hessian sign fit and `TANGENTS=1` the tangent containment (to
-/// explore).
+/// stars, `HSIGNS=1` the Hessian sign fit, `TANGENTS=1` the tangent containment and
+/// `STAR_TAU` the stars' near-null threshold (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -29,6 +29,10 @@ fn options() -> QuinticOptions {
         hessian_signs: std::env::var("HSIGNS").is_ok_and(|s| s == "1"),
         contain_tangents: std::env::var("TANGENTS").is_ok_and(|s| s == "1"),
         zero_groups: std::env::var("ZERO").is_ok_and(|s| s == "1"),
+        star_tau: std::env::var("STAR_TAU")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(0.0),
     }
 }
 

@@ -118,13 +118,40 @@ fn nut_zero_groups_build_c2() {
     // groups' data in the sparse passes).
     assert!(stats.max_residual < 1e-9, "{stats:?}");
     // Measured 1.4e-10 (gradient) and 1.5e-8 (Hessian).
-    assert_c2_but_signs(&c);
+    let plain = assert_c2_but_signs(&c);
+
+    // The stars' near-null conditions (`star_tau`): still C2, and the surface leaves the hull
+    // and folds back far less (measured: holes 2174 → 456 of 18174 boundary faces, j-line
+    // patches 1138 → 74), because the nearly singular stars no longer amplify their data.
+    let near = QuinticOptions {
+        star_tau: 1e-3,
+        ..opts
+    };
+    let (c, stats) = build_with_stats(&hull, &near).unwrap();
+    // As above: only C1/C2 equations count; the near-null conditions are wishes.
+    assert!(stats.max_residual < 1e-9, "{stats:?}");
+    // Measured 7.4e-11 (gradient) and 8.1e-9 (Hessian).
+    let r = assert_c2_but_signs(&c);
+    // A factor 3 on each: far beyond the sampling's variation between two such surfaces,
+    // far below the measured factors (4.8 and 15).
+    assert!(
+        3 * r.holes.crossing < plain.holes.crossing,
+        "{:?} vs {:?}",
+        r.holes,
+        plain.holes
+    );
+    assert!(
+        3 * r.sheets.j_multi_patches < plain.sheets.j_multi_patches,
+        "{} vs {}",
+        r.sheets.j_multi_patches,
+        plain.sheets.j_multi_patches
+    );
 }
 
 /// Issue 8's C2 tolerances (relative gradient jumps ≤ 1e-9, Hessian jumps ≤ 1e-7), and
 /// interpolation, value jumps and everything else but the sign-dependent measures (sheets
 /// along j-lines, holes: the relaxed stars' subject) at the checker's default tolerances.
-fn assert_c2_but_signs(c: &apatch::complex::PatchComplex) {
+fn assert_c2_but_signs(c: &apatch::complex::PatchComplex) -> apatch::check::CheckReport {
     let r = check(c, &CheckOptions::default());
     assert!(r.gradient_jump.worst <= 1e-9, "{:?}", r.gradient_jump);
     assert!(r.hessian_jump.worst <= 1e-7, "{:?}", r.hessian_jump);
@@ -134,4 +161,5 @@ fn assert_c2_but_signs(c: &apatch::complex::PatchComplex) {
         .filter(|f| *f != "multiple sheets along j-lines" && *f != "holes")
         .collect();
     assert!(f.is_empty(), "{f:?}");
+    r
 }

@@ -75,6 +75,11 @@ pub struct QuinticOptions {
     /// rounding exact zero coplanar groups (Appendix B (5'')(ii), [`flat`]): points on the
     /// plane with its normal, zero Hessians. Off by default (no shipped scene has one).
     pub zero_groups: bool,
+    /// Near-null threshold of the vertex-star systems (0 = off, the default): where a star's
+    /// σ/σ_max ≤ this, the matching left singular vector's condition on the weights solved
+    /// before the star (edge middles) is imposed, as `consistent_stars` does for exact
+    /// dependencies, so the star's weights do not follow their data's noise amplified by 1/σ.
+    pub star_tau: f64,
 }
 
 impl Default for QuinticOptions {
@@ -85,6 +90,7 @@ impl Default for QuinticOptions {
             signs: false,
             complete_lu_pairs: true,
             joint_stars: false,
+            star_tau: 0.0,
             relax_stars: true,
             consistent_stars: false,
             hessian_signs: false,
@@ -168,6 +174,13 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "star_tau" => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
+                    Some(t) if (0.0..1.0).contains(&t) => o.star_tau = t,
+                    _ => bail!(
+                        "{}: `scheme.star_tau` must be a number in [0, 1), got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => match v.as_bool() {
                     Some(b) => o.signs = b,
                     None => bail!(
@@ -186,7 +199,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -241,7 +254,8 @@ pub fn build_with_stats(
         jets[p as usize].h = glam::DMat3::ZERO;
     }
     let (tets, _pos) = system::tetrahedra(hull)?;
-    let sys = system::assemble(&tets, np)?;
+    let mut sys = system::assemble(&tets, np)?;
+    sys.star_tau = options.star_tau;
     let hessian_fit = if options.hessian_signs {
         signs::fit_hessians(&tets, np, &mut jets, &|t, l| sys.required_sign(t, l))
     } else {

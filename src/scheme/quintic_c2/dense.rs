@@ -158,22 +158,13 @@ pub fn dependencies(a: &[f64], m: usize, n: usize, rank_tol: f64) -> Vec<Vec<f64
     out
 }
 
-/// The singular values of A (`m`×`n`, row-major), largest first: one-sided Jacobi rotations
-/// of A's columns until they are orthogonal to rounding (small singular values keep their
-/// relative accuracy, so σ_min/σ_max near 1e-16 is told apart from 1e-10). A diagnostic for the
-/// vertex-star systems; O(m n² · sweeps).
-#[must_use]
-pub fn singular_values(a: &[f64], m: usize, n: usize) -> Vec<f64> {
-    debug_assert_eq!(a.len(), m * n);
-    // Columns of A (or of Aᵀ when it has fewer), which the rotations orthogonalise.
-    let (rows, cols) = if m >= n { (m, n) } else { (n, m) };
-    let mut c: Vec<Vec<f64>> = (0..cols)
-        .map(|j| {
-            (0..rows)
-                .map(|i| if m >= n { a[i * n + j] } else { a[j * n + i] })
-                .collect()
-        })
-        .collect();
+/// One-sided Jacobi: rotates the columns `c` (each of the same length) until they are
+/// orthogonal to rounding, applying the same rotations to the columns of `acc` (one per column
+/// of `c`, any length) when given. Afterwards the column norms of `c` are the singular values
+/// of the matrix whose columns `c` were, and `acc` (started as the identity) holds the
+/// matching right singular vectors.
+fn jacobi_columns(c: &mut [Vec<f64>], mut acc: Option<&mut [Vec<f64>]>) {
+    let cols = c.len();
     for _sweep in 0..60 {
         let mut rotated = false;
         for p in 0..cols {
@@ -194,16 +185,17 @@ pub fn singular_values(a: &[f64], m: usize, n: usize) -> Vec<f64> {
                 let t = if zeta == 0.0 { 1.0 } else { t };
                 let cs = 1.0 / (1.0 + t * t).sqrt();
                 let sn = cs * t;
-                let (cp, cq) = if p < q {
-                    let (lo, hi) = c.split_at_mut(q);
-                    (&mut lo[p], &mut hi[0])
-                } else {
-                    unreachable!()
+                let rotate = |v: &mut [Vec<f64>]| {
+                    let (lo, hi) = v.split_at_mut(q);
+                    for (x, y) in lo[p].iter_mut().zip(hi[0].iter_mut()) {
+                        let (u, w) = (*x, *y);
+                        *x = cs * u - sn * w;
+                        *y = sn * u + cs * w;
+                    }
                 };
-                for (x, y) in cp.iter_mut().zip(cq.iter_mut()) {
-                    let (u, v) = (*x, *y);
-                    *x = cs * u - sn * v;
-                    *y = sn * u + cs * v;
+                rotate(c);
+                if let Some(a) = acc.as_deref_mut() {
+                    rotate(a);
                 }
             }
         }
@@ -211,12 +203,60 @@ pub fn singular_values(a: &[f64], m: usize, n: usize) -> Vec<f64> {
             break;
         }
     }
+}
+
+/// The singular values of A (`m`×`n`, row-major), largest first: one-sided Jacobi rotations
+/// of A's columns until they are orthogonal to rounding (small singular values keep their
+/// relative accuracy, so σ_min/σ_max near 1e-16 is told apart from 1e-10). A diagnostic for the
+/// vertex-star systems; O(m n² · sweeps).
+#[must_use]
+pub fn singular_values(a: &[f64], m: usize, n: usize) -> Vec<f64> {
+    debug_assert_eq!(a.len(), m * n);
+    // Columns of A (or of Aᵀ when it has fewer), which the rotations orthogonalise.
+    let (rows, cols) = if m >= n { (m, n) } else { (n, m) };
+    let mut c: Vec<Vec<f64>> = (0..cols)
+        .map(|j| {
+            (0..rows)
+                .map(|i| if m >= n { a[i * n + j] } else { a[j * n + i] })
+                .collect()
+        })
+        .collect();
+    jacobi_columns(&mut c, None);
     let mut s: Vec<f64> = c
         .iter()
         .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
         .collect();
     s.sort_unstable_by(|a, b| b.total_cmp(a));
     s
+}
+
+/// The left singular vectors u of A (`m`×`n`, row-major) whose singular value is at most
+/// `tau` × the largest, as pairs (σ, u), smallest σ first; rows of A beyond its column count
+/// give σ = 0. A x = c amplifies the component uᵀc by 1/σ, so where these are small and c is
+/// data, requiring uᵀc = 0 keeps the solution from following the data's noise.
+#[must_use]
+pub fn near_null_left(a: &[f64], m: usize, n: usize, tau: f64) -> Vec<(f64, Vec<f64>)> {
+    debug_assert_eq!(a.len(), m * n);
+    // The columns of Aᵀ are A's rows; rotating them (Aᵀ W = B) leaves A = W Bᵀ with B's
+    // columns orthogonal, so W's columns are the left singular vectors, B's norms the σ.
+    let mut c: Vec<Vec<f64>> = (0..m).map(|i| a[i * n..(i + 1) * n].to_vec()).collect();
+    let mut w: Vec<Vec<f64>> = (0..m)
+        .map(|i| (0..m).map(|k| if k == i { 1.0 } else { 0.0 }).collect())
+        .collect();
+    jacobi_columns(&mut c, Some(&mut w));
+    let sigma: Vec<f64> = c
+        .iter()
+        .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .collect();
+    let top = sigma.iter().fold(0.0_f64, |a, s| a.max(*s));
+    let mut out: Vec<(f64, Vec<f64>)> = sigma
+        .iter()
+        .zip(w)
+        .filter(|(s, _)| **s <= tau * top)
+        .map(|(s, u)| (*s, u))
+        .collect();
+    out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    out
 }
 
 #[cfg(test)]
@@ -279,6 +319,35 @@ mod tests {
         let at: Vec<f64> = (0..9).map(|k| a[(k % 3) * 3 + k / 3]).collect();
         let st = singular_values(&at[..6], 2, 3);
         assert_eq!(st.len(), 2);
+    }
+
+    /// The same U·diag(3, 1e-9, 0)·Vᵀ: the left singular vectors below 1e-6 × σ_max are U's
+    /// last two columns (up to sign), smallest σ first.
+    #[test]
+    fn near_null_left_vectors_of_a_known_matrix() {
+        let (c1, s1) = (0.6_f64, 0.8_f64);
+        let (c2, s2) = (0.28_f64, 0.96_f64);
+        let u = [[c1, -s1, 0.0], [s1, c1, 0.0], [0.0, 0.0, 1.0]];
+        let v = [[1.0, 0.0, 0.0], [0.0, c2, -s2], [0.0, s2, c2]];
+        let d = [3.0, 1e-9, 0.0];
+        let mut a = [0.0; 9];
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i * 3 + j] = (0..3).map(|k| u[i][k] * d[k] * v[j][k]).sum();
+            }
+        }
+        let near = near_null_left(&a, 3, 3, 1e-6);
+        assert_eq!(near.len(), 2, "{near:?}");
+        for ((sigma, w), k) in near.iter().zip([2, 1]) {
+            // Rounding of Jacobi rotations on entries O(1): a few ulps of σ_max.
+            assert!((sigma - d[k]).abs() < 1e-14, "{sigma} vs {}", d[k]);
+            let dot: f64 = (0..3).map(|i| w[i] * u[i][k]).sum();
+            // Unit vectors equal up to sign; the 1e-9 one is separated from 0 by 1e-9 / 3,
+            // so rounding of 1e-16 rotates it by at most ~1e-7.
+            assert!((dot.abs() - 1.0).abs() < 1e-12, "{dot}");
+        }
+        // Nothing is that small in a well-conditioned matrix.
+        assert!(near_null_left(&[2.0, 1.0, 1.0, 3.0], 2, 2, 1e-6).is_empty());
     }
 
     /// Row 3 = row 1 + 2·row 2: one dependency, yᵀA = 0, against the construction.

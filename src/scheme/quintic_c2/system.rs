@@ -164,6 +164,7 @@ fn unkey(mut k: u128) -> Vec<(u32, u8)> {
 type FaceUsers = ([u32; 3], Vec<(u32, usize)>);
 
 /// A linear equation Σ c·x_slot = 0.
+#[derive(Clone)]
 struct Equation {
     terms: Vec<(u32, f64)>,
 }
@@ -183,6 +184,10 @@ pub struct System {
     req: Vec<i8>,
     /// Slots on a boundary face of the hull (a face of one tetrahedron only).
     boundary: Vec<bool>,
+    /// Near-null threshold of the star systems (`QuinticOptions::star_tau`, 0 = off): the
+    /// left singular vectors u of a star whose σ ≤ this × σ_max give conditions uᵀc = 0 on
+    /// the weights solved before it, so the star does not amplify their noise by 1/σ.
+    pub star_tau: f64,
 }
 
 /// Builds the slots and the C1/C2 equations of every shared face.
@@ -291,6 +296,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         np,
         req,
         boundary,
+        star_tau: 0.0,
     })
 }
 
@@ -465,6 +471,51 @@ pub struct StarSystem {
     pub unknowns: Vec<(u32, [u8; 4])>,
 }
 
+/// The pseudo-stage of [`Failure`]s that carry a solved star's near-null conditions
+/// (`System::star_tau`), not a failure.
+const NEAR_NULL: u8 = 7;
+
+/// The largest residual of the scheme's C1/C2 equations, each relative to its own terms
+/// (`System::scheme_residual`), with which a pass whose near-null conditions could not all be
+/// met is kept: the 1e-9 a consistent group is held to ([`consistent`]). (On the nut with
+/// curvature 0.4 a pass at 2.6e-8 gave Hessian jumps of 2.3e-7; the kept passes measure
+/// 7.3e-10 and 9.8e-10 and give 8e-9.)
+const NEAR_NULL_RESIDUAL: f64 = 1e-9;
+
+/// The condition Σ_i y_i·(known part of equation `eqs[i]`) = 0 over the weights outside the
+/// group (`col`): what the known weights must meet so that the group's right-hand side has no
+/// component along y. `None` when it cancels to nothing.
+fn known_condition(
+    all: &[&Equation],
+    eqs: &[usize],
+    col: &HashMap<u32, usize>,
+    y: &[f64],
+) -> Option<Equation> {
+    let mut terms: Vec<(u32, f64)> = Vec::new();
+    for (i, &e) in eqs.iter().enumerate() {
+        if y[i] == 0.0 {
+            continue;
+        }
+        for &(s, k) in &all[e].terms {
+            if !col.contains_key(&s) {
+                terms.push((s, y[i] * k));
+            }
+        }
+    }
+    terms.sort_unstable_by_key(|t| t.0);
+    let mut merged: Vec<(u32, f64)> = Vec::new();
+    for (s, k) in terms {
+        match merged.last_mut() {
+            Some(last) if last.0 == s => last.1 += k,
+            _ => merged.push((s, k)),
+        }
+    }
+    let big = merged.iter().fold(0.0_f64, |a, t| a.max(t.1.abs()));
+    // Cancellation of the dependency's rounding.
+    merged.retain(|t| t.1.abs() > 1e-12 * big);
+    (!merged.is_empty()).then_some(Equation { terms: merged })
+}
+
 /// A group whose equations could not be met in one pass.
 struct Failure {
     stage: u8,
@@ -492,7 +543,9 @@ impl System {
     /// singular face-middle or edge-tetrahedron group that the weights before it make
     /// inconsistent imposes its consistency conditions on them before the global fallback; with `relax_stars`, points
     /// whose star weights miss Theorem 2.1's signs are relaxed the same way and the whole
-    /// solve repeated, while the number of misses falls (at most `RELAX_ROUNDS` rounds).
+    /// solve repeated, while the number of misses falls (at most `RELAX_ROUNDS` rounds); with
+    /// `System::star_tau` > 0, the stars' near-null conditions are imposed after the first pass
+    /// without failures and kept while the scheme's own equations hold.
     ///
     /// # Errors
     /// A group whose equations cannot be met even so, naming where.
@@ -633,6 +686,24 @@ impl System {
             .collect()
     }
 
+    /// The largest residual of the scheme's own C1/C2 equations (not the added conditions)
+    /// in `value`, each relative to the size of its own terms (Σ|c·x|; weights below 1e-12 of
+    /// the largest count as that): the checker measures jumps relative to the local size of F,
+    /// so a residual small against the largest weight can still be a jump where F is small.
+    fn scheme_residual(&self, value: &[f64]) -> f64 {
+        let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
+        self.equations
+            .iter()
+            .map(|eq| {
+                let (r, size) = eq.terms.iter().fold((0.0, 0.0), |(r, size), (s, c)| {
+                    let x = value[*s as usize];
+                    (r + c * x, size + c.abs() * x.abs().max(1e-12 * wmax))
+                });
+                r.abs() / size
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// Whether slot `s` misses Theorem 2.1's sign in `value` (`tiny`: zero up to rounding).
     fn misses(&self, value: &[f64], s: usize, tiny: f64) -> bool {
         let r = self.req[s];
@@ -690,20 +761,86 @@ impl System {
         let mut first_failure = None;
         let mut extra: Vec<Equation> = Vec::new();
         let mut conditioned: std::collections::HashSet<Vec<u32>> = Default::default();
-        for _pass in 0..6 {
-            let (value, mut stats, failures) =
-                self.solve_pass(tets, jets, nt, target, level, false, pin, &extra);
+        // Near-null conditions of nearly singular stars (`star_tau`): imposed only after a
+        // pass without failures, and dropped for good if the pass after them fails (they can
+        // make the edge-middle group inconsistent).
+        let mut near_extra: Vec<Equation> = Vec::new();
+        let mut near_off = self.star_tau <= 0.0;
+        // The stars' singular vectors are only needed from a pass without failures (earlier
+        // ones change the stars' data): the first pass after one computes them.
+        let mut prev_failed = true;
+        let mut near_asked = false;
+        // Two more passes with near-null conditions: one to find them, one to impose them.
+        let passes = if near_off { 6 } else { 8 };
+        for _pass in 0..passes {
+            let all_extra: Vec<Equation> = extra.iter().chain(&near_extra).cloned().collect();
+            let want_near = !near_off && near_extra.is_empty() && !prev_failed;
+            near_asked |= want_near;
+            let (value, mut stats, mut failures) = self.solve_pass(
+                tets, jets, nt, target, level, false, pin, &all_extra, want_near,
+            );
+            if std::env::var_os("APATCH_SIGN_TRACE").is_some() {
+                // Opt-in exploration on stderr (results unaffected).
+                let near = failures.iter().filter(|f| f.stage == NEAR_NULL).count();
+                let mut other = [0usize; 8];
+                for f in failures.iter().filter(|f| f.stage != NEAR_NULL) {
+                    other[usize::from(f.stage)] += 1;
+                }
+                eprintln!(
+                    "quintic-c2 pass: {} + {} near-null conditions imposed; nearly singular stars {near}, failures by stage {other:?}",
+                    extra.len(),
+                    near_extra.len()
+                );
+            }
+            let failed = failures.iter().any(|f| f.stage != NEAR_NULL);
+            if failed && !near_extra.is_empty() {
+                // The near-null conditions are wishes, the scheme's equations are not: a pass
+                // whose only failures are groups that could not meet every wish is kept when
+                // every C1/C2 equation still holds as closely as a consistent group must.
+                let residual = self.scheme_residual(&value);
+                if std::env::var_os("APATCH_SIGN_TRACE").is_some() {
+                    eprintln!("quintic-c2 near-null pass: scheme residual {residual:.3e}");
+                }
+                if residual <= NEAR_NULL_RESIDUAL {
+                    stats.relaxed_points = level.len();
+                    stats.consistency_conditions = all_extra.len();
+                    stats.max_residual = residual;
+                    return Ok((value, stats));
+                }
+                near_extra.clear();
+                near_off = true;
+                continue;
+            }
+            prev_failed = failed;
+            if near_off || failed || !near_extra.is_empty() {
+                failures.retain(|f| f.stage != NEAR_NULL);
+            }
+            if failures.is_empty() && !near_off && !near_asked {
+                // A solution, but the stars' singular vectors were not looked at yet.
+                continue;
+            }
             if failures.is_empty() {
                 stats.relaxed_points = level.len();
-                stats.consistency_conditions = extra.len();
+                stats.consistency_conditions = all_extra.len();
                 return Ok((value, stats));
             }
+            let message = failures
+                .iter()
+                .find(|f| f.stage != NEAR_NULL)
+                .map(|f| f.message.clone());
             if first_failure.is_none() {
-                first_failure = Some(failures[0].message.clone());
+                first_failure.clone_from(&message);
             }
             let mut bumped = false;
-            let last_message = failures[0].message.clone();
+            let last_message = message.unwrap_or_default();
             for f in failures {
+                // A nearly singular star (after a pass without failures): its near-null
+                // conditions.
+                if f.stage == NEAR_NULL {
+                    near_extra.extend(f.consistency);
+                    bumped = true;
+                    continue;
+                }
                 // A singular star whose consistency conditions were not imposed yet: impose
                 // them on the weights solved before it (edge middles) instead of relaxing it.
                 if consistent
@@ -758,8 +895,9 @@ impl System {
         // The staged solve fixed free weights that a later stage cannot live with (e.g. the
         // number 10 system of an edge whose apexes lie in the planes of its points' faces, as on
         // cube_poly): solve every unknown at once, each connected group closest to its targets.
-        let (value, mut stats, failures) =
-            self.solve_pass(tets, jets, nt, target, level, true, pin, &extra);
+        let (value, mut stats, mut failures) =
+            self.solve_pass(tets, jets, nt, target, level, true, pin, &extra, false);
+        failures.retain(|f| f.stage != NEAR_NULL);
         if failures.is_empty() {
             stats.relaxed_points = level.len();
             stats.consistency_conditions = extra.len();
@@ -784,6 +922,7 @@ impl System {
         global: bool,
         pin: bool,
         extra: &[Equation],
+        near: bool,
     ) -> (Vec<f64>, SolveStats, Vec<Failure>) {
         // The scheme's equations, then the consistency conditions of singular stars
         // (`QuinticOptions::consistent_stars`).
@@ -1019,31 +1158,7 @@ impl System {
                             }
                         }
                         for y in dense::dependencies(&a, m, n, 1e-11) {
-                            let mut terms: Vec<(u32, f64)> = Vec::new();
-                            for (i, &e) in eqs.iter().enumerate() {
-                                if y[i] == 0.0 {
-                                    continue;
-                                }
-                                for &(s, k) in &all[e].terms {
-                                    if !col.contains_key(&s) {
-                                        terms.push((s, y[i] * k));
-                                    }
-                                }
-                            }
-                            terms.sort_unstable_by_key(|t| t.0);
-                            let mut merged: Vec<(u32, f64)> = Vec::new();
-                            for (s, k) in terms {
-                                match merged.last_mut() {
-                                    Some(last) if last.0 == s => last.1 += k,
-                                    _ => merged.push((s, k)),
-                                }
-                            }
-                            let big = merged.iter().fold(0.0_f64, |a, t| a.max(t.1.abs()));
-                            // Cancellation of the dependency's rounding.
-                            merged.retain(|t| t.1.abs() > 1e-12 * big);
-                            if !merged.is_empty() {
-                                consistency.push(Equation { terms: merged });
-                            }
+                            consistency.extend(known_condition(&all, &eqs, &col, &y));
                         }
                     }
                     failures.push(Failure {
@@ -1055,6 +1170,39 @@ impl System {
                             sol.rank, sol.residual
                         ),
                     });
+                }
+                // A star solved exactly but nearly singular: the conditions that keep it from
+                // amplifying its data's noise (`star_tau`), for the next pass.
+                if st == 3 && near && n <= DENSE_LIMIT && consistent(&sol, scale) {
+                    let mut a = vec![0.0; m * n];
+                    let mut norm = vec![0.0_f64; m];
+                    for (i, row) in rows.iter().enumerate().take(m) {
+                        norm[i] = row
+                            .iter()
+                            .map(|t| t.1 * t.1)
+                            .sum::<f64>()
+                            .sqrt()
+                            .max(1e-300);
+                        for &(j, k) in row {
+                            a[i * n + j] += k / norm[i];
+                        }
+                    }
+                    let conds: Vec<Equation> = dense::near_null_left(&a, m, n, self.star_tau)
+                        .into_iter()
+                        .filter_map(|(_, u)| {
+                            // uᵀ(row_i / |row_i|): the condition on the unscaled equations.
+                            let y: Vec<f64> = u.iter().zip(&norm).map(|(u, r)| u / r).collect();
+                            known_condition(&all, &eqs, &col, &y)
+                        })
+                        .collect();
+                    if !conds.is_empty() {
+                        failures.push(Failure {
+                            stage: NEAR_NULL,
+                            points: where_(),
+                            message: String::new(),
+                            consistency: conds,
+                        });
+                    }
                 }
                 for (j, &s) in unk.iter().enumerate() {
                     if sol.x[j].is_finite() {
