@@ -343,15 +343,7 @@ fn merged_and_split() -> (inner::close::CloseMerge, inner::planar::PlanarSplit) 
 
 /// The elements (input vertices) a violation message names.
 fn elements(message: &str) -> Vec<u32> {
-    message
-        .split("element ")
-        .skip(1)
-        .filter_map(|s| {
-            s.split(|c: char| !c.is_ascii_digit())
-                .next()
-                .and_then(|d| d.parse().ok())
-        })
-        .collect()
+    apatch::hull::inner::retriangulate::named_elements(message)
 }
 
 /// Survey: a scene's hull violations by kind, by element and by element pair (default the

@@ -288,18 +288,7 @@ fn explore_fandisk() {
     let mut per = std::collections::BTreeMap::new();
     let mut per_tri = std::collections::HashMap::new();
     for x in &v {
-        let mut ts = Vec::new();
-        let msg = &x.message;
-        let mut rest = msg.as_str();
-        while let Some(i) = rest.find("triangle ") {
-            rest = &rest[i + 9..];
-            let num: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
-            if let Ok(t) = num.parse::<usize>() {
-                ts.push(t);
-            }
-        }
-        ts.sort_unstable();
-        ts.dedup();
+        let ts = triangles_named(x);
         for t in ts {
             *per.entry(class(t)).or_insert(0) += 1;
             *per_tri.entry(t).or_insert(0) += 1;
@@ -635,17 +624,7 @@ fn explore_fandisk_pairs() {
     };
     let mut kinds = std::collections::BTreeMap::new();
     for x in &v {
-        let mut ts = Vec::new();
-        let mut rest = x.message.as_str();
-        while let Some(i) = rest.find("triangle ") {
-            rest = &rest[i + 9..];
-            let num: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
-            if let Ok(t) = num.parse::<usize>() {
-                ts.push(t);
-            }
-        }
-        ts.sort_unstable();
-        ts.dedup();
+        let ts = triangles_named(x);
         let key = if ts.len() == 2 {
             let (a, b) = (hull.triangles[ts[0]], hull.triangles[ts[1]]);
             let shared = a.iter().filter(|p| b.contains(p)).count();
@@ -772,4 +751,12 @@ fn explore_fandisk_triangles() {
         }
         eprintln!("  apexes {:?}", hull.apexes[t]);
     }
+}
+
+/// The hull triangles a violation names (its message's "triangle N"), sorted, as indices.
+fn triangles_named(v: &apatch::hull::inner::verify::HullViolation) -> Vec<usize> {
+    apatch::hull::inner::overlapnet::named_triangles(v)
+        .into_iter()
+        .map(|t| t as usize)
+        .collect()
 }

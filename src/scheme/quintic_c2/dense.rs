@@ -294,10 +294,9 @@ mod tests {
         assert!(s.residual > 0.1);
     }
 
-    /// Singular values of a product U·diag(3, 1e-9, 0)·Vᵀ of rotations: found to their own
-    /// relative accuracy, the rank drop as an exact zero up to rounding.
-    #[test]
-    fn singular_values_of_a_known_matrix() {
+    /// U·diag(3, 1e-9, 0)·Vᵀ (row-major) with U, V rotations: U (rotating axes 0, 1), the
+    /// singular values, and the product.
+    fn known_matrix() -> ([[f64; 3]; 3], [f64; 3], [f64; 9]) {
         let (c1, s1) = (0.6_f64, 0.8_f64);
         let (c2, s2) = (0.28_f64, 0.96_f64);
         // U rotates axes 0, 1; V rotates axes 1, 2.
@@ -310,6 +309,14 @@ mod tests {
                 a[i * 3 + j] = (0..3).map(|k| u[i][k] * d[k] * v[j][k]).sum();
             }
         }
+        (u, d, a)
+    }
+
+    /// Singular values of a product U·diag(3, 1e-9, 0)·Vᵀ of rotations: found to their own
+    /// relative accuracy, the rank drop as an exact zero up to rounding.
+    #[test]
+    fn singular_values_of_a_known_matrix() {
+        let (_, _, a) = known_matrix();
         let s = singular_values(&a, 3, 3);
         // Relative accuracy of one-sided Jacobi: a few ulps of the largest for each.
         assert!((s[0] - 3.0).abs() < 1e-14, "{s:?}");
@@ -325,17 +332,7 @@ mod tests {
     /// last two columns (up to sign), smallest σ first.
     #[test]
     fn near_null_left_vectors_of_a_known_matrix() {
-        let (c1, s1) = (0.6_f64, 0.8_f64);
-        let (c2, s2) = (0.28_f64, 0.96_f64);
-        let u = [[c1, -s1, 0.0], [s1, c1, 0.0], [0.0, 0.0, 1.0]];
-        let v = [[1.0, 0.0, 0.0], [0.0, c2, -s2], [0.0, s2, c2]];
-        let d = [3.0, 1e-9, 0.0];
-        let mut a = [0.0; 9];
-        for i in 0..3 {
-            for j in 0..3 {
-                a[i * 3 + j] = (0..3).map(|k| u[i][k] * d[k] * v[j][k]).sum();
-            }
-        }
+        let (u, d, a) = known_matrix();
         let near = near_null_left(&a, 3, 3, 1e-6);
         assert_eq!(near.len(), 2, "{near:?}");
         for ((sigma, w), k) in near.iter().zip([2, 1]) {
