@@ -610,25 +610,32 @@ pub fn crossed_boundary_faces(
             if users[&face_key(p, opp)] != 1 {
                 continue;
             }
-            let others: Vec<usize> = (0..4).filter(|&x| x != opp).collect();
-            let (mut pos, mut neg) = (false, false);
-            for i in 0..=steps {
-                for j in 0..=steps - i {
-                    let mut b = [0.0; 4];
-                    b[others[0]] = i as f64 / steps as f64;
-                    b[others[1]] = j as f64 / steps as f64;
-                    b[others[2]] = (steps - i - j) as f64 / steps as f64;
-                    let f = p.value_bary(b);
-                    pos |= f > tol;
-                    neg |= f < -tol;
-                }
-            }
-            if pos && neg {
+            if face_takes_both_signs(p, opp, steps, tol) {
                 crossed.push((k, opp));
             }
         }
     }
     (crossed, wmax)
+}
+
+/// Whether F of `p` takes both strict signs (beyond ±`tol`) at the points of a lattice of
+/// `steps` steps per edge (barycentric i/steps) on the face opposite its corner `opp`.
+#[must_use]
+pub fn face_takes_both_signs(p: &Patch, opp: usize, steps: usize, tol: f64) -> bool {
+    let others: Vec<usize> = (0..4).filter(|&x| x != opp).collect();
+    let (mut pos, mut neg) = (false, false);
+    for i in 0..=steps {
+        for j in 0..=steps - i {
+            let mut b = [0.0; 4];
+            b[others[0]] = i as f64 / steps as f64;
+            b[others[1]] = j as f64 / steps as f64;
+            b[others[2]] = (steps - i - j) as f64 / steps as f64;
+            let f = p.value_bary(b);
+            pos |= f > tol;
+            neg |= f < -tol;
+        }
+    }
+    pos && neg
 }
 
 #[cfg(test)]

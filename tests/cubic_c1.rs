@@ -377,22 +377,8 @@ fn convex_triangles_stay_single_sided() {
 /// (a lattice of 16 steps per edge; values within 1e-9 of the largest weight count as zero,
 /// far above the weights' round-off and far below the crossings' depth of 1e-3 and more).
 fn face_changes_sign(patch: &apatch::complex::Patch, opp: usize) -> bool {
-    const RES: usize = 16;
     let scale = patch.weights.iter().fold(0.0f64, |m, w| m.max(w.abs()));
-    let verts: Vec<usize> = (0..4).filter(|&v| v != opp).collect();
-    let (mut pos, mut neg) = (false, false);
-    for i in 0..=RES {
-        for j in 0..=RES - i {
-            let mut a = [0.0; 4];
-            a[verts[0]] = i as f64 / RES as f64;
-            a[verts[1]] = j as f64 / RES as f64;
-            a[verts[2]] = (RES - i - j) as f64 / RES as f64;
-            let f = apatch::check::eval::poly_value(&patch.weights, 3, a);
-            pos |= f > 1e-9 * scale;
-            neg |= f < -1e-9 * scale;
-        }
-    }
-    pos && neg
+    apatch::fixtures::face_takes_both_signs(patch, opp, 16, 1e-9 * scale)
 }
 
 /// The bunny's L-U pairs used to leave apexes beyond a tangent plane of their triangle

@@ -164,7 +164,6 @@ fn unkey(mut k: u128) -> Vec<(u32, u8)> {
 type FaceUsers = ([u32; 3], Vec<(u32, usize)>);
 
 /// A linear equation Σ c·x_slot = 0.
-#[derive(Clone)]
 struct Equation {
     terms: Vec<(u32, f64)>,
 }
@@ -764,7 +763,8 @@ impl System {
         // Near-null conditions of nearly singular stars (`star_tau`): imposed only after a
         // pass without failures, and dropped for good if the pass after them fails (they can
         // make the edge-middle group inconsistent).
-        let mut near_extra: Vec<Equation> = Vec::new();
+        // Where in `extra` the near-null conditions begin, once imposed.
+        let mut near_start: Option<usize> = None;
         let mut near_off = self.star_tau <= 0.0;
         // The stars' singular vectors are only needed from a pass without failures (earlier
         // ones change the stars' data): the first pass after one computes them.
@@ -773,12 +773,11 @@ impl System {
         // Two more passes with near-null conditions: one to find them, one to impose them.
         let passes = if near_off { 6 } else { 8 };
         for _pass in 0..passes {
-            let all_extra: Vec<Equation> = extra.iter().chain(&near_extra).cloned().collect();
-            let want_near = !near_off && near_extra.is_empty() && !prev_failed;
+            let imposed = near_start.is_some();
+            let want_near = !near_off && !imposed && !prev_failed;
             near_asked |= want_near;
-            let (value, mut stats, mut failures) = self.solve_pass(
-                tets, jets, nt, target, level, false, pin, &all_extra, want_near,
-            );
+            let (value, mut stats, mut failures) =
+                self.solve_pass(tets, jets, nt, target, level, false, pin, &extra, want_near);
             if std::env::var_os("APATCH_SIGN_TRACE").is_some() {
                 // Opt-in exploration on stderr (results unaffected).
                 let near = failures.iter().filter(|f| f.stage == NEAR_NULL).count();
@@ -788,12 +787,12 @@ impl System {
                 }
                 eprintln!(
                     "quintic-c2 pass: {} + {} near-null conditions imposed; nearly singular stars {near}, failures by stage {other:?}",
-                    extra.len(),
-                    near_extra.len()
+                    near_start.unwrap_or(extra.len()),
+                    extra.len() - near_start.unwrap_or(extra.len())
                 );
             }
             let failed = failures.iter().any(|f| f.stage != NEAR_NULL);
-            if failed && !near_extra.is_empty() {
+            if let (true, Some(start)) = (failed, near_start) {
                 // The near-null conditions are wishes, the scheme's equations are not: a pass
                 // whose only failures are groups that could not meet every wish is kept when
                 // every C1/C2 equation still holds as closely as a consistent group must.
@@ -803,16 +802,17 @@ impl System {
                 }
                 if residual <= NEAR_NULL_RESIDUAL {
                     stats.relaxed_points = level.len();
-                    stats.consistency_conditions = all_extra.len();
+                    stats.consistency_conditions = extra.len();
                     stats.max_residual = residual;
                     return Ok((value, stats));
                 }
-                near_extra.clear();
+                extra.truncate(start);
+                near_start = None;
                 near_off = true;
                 continue;
             }
             prev_failed = failed;
-            if near_off || failed || !near_extra.is_empty() {
+            if near_off || failed || imposed {
                 failures.retain(|f| f.stage != NEAR_NULL);
             }
             if failures.is_empty() && !near_off && !near_asked {
@@ -821,7 +821,7 @@ impl System {
             }
             if failures.is_empty() {
                 stats.relaxed_points = level.len();
-                stats.consistency_conditions = all_extra.len();
+                stats.consistency_conditions = extra.len();
                 return Ok((value, stats));
             }
             let message = failures
@@ -837,7 +837,8 @@ impl System {
                 // A nearly singular star (after a pass without failures): its near-null
                 // conditions.
                 if f.stage == NEAR_NULL {
-                    near_extra.extend(f.consistency);
+                    near_start.get_or_insert(extra.len());
+                    extra.extend(f.consistency);
                     bumped = true;
                     continue;
                 }
@@ -894,7 +895,11 @@ impl System {
         }
         // The staged solve fixed free weights that a later stage cannot live with (e.g. the
         // number 10 system of an edge whose apexes lie in the planes of its points' faces, as on
-        // cube_poly): solve every unknown at once, each connected group closest to its targets.
+        // cube_poly): solve every unknown at once, each connected group closest to its targets
+        // (without the near-null conditions).
+        if let Some(start) = near_start {
+            extra.truncate(start);
+        }
         let (value, mut stats, mut failures) =
             self.solve_pass(tets, jets, nt, target, level, true, pin, &extra, false);
         failures.retain(|f| f.stage != NEAR_NULL);
