@@ -484,3 +484,31 @@ fn split_search_key_is_parsed_and_checked() {
         assert!(e.contains("split_search"), "{bad}: {e}");
     }
 }
+
+/// Survey: what the cage's corner search (`corner_search`, `hull::inner::recut`) kept.
+/// `cargo test --release --test inner_cage recut_survey -- --ignored --nocapture`
+#[test]
+#[ignore = "survey: prints the corner search's cuts"]
+fn recut_survey() {
+    let (m, _) = mesh::load(Path::new("scenes/models/spot_control_cage.obj")).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let options = InnerOptions {
+        merge_close: 0.005,
+        split_search: true,
+        corner_search: true,
+        ..InnerOptions::default()
+    };
+    let (hull, report) = inner::build_with_report(&m, &normals, &options).unwrap();
+    println!("split search: {:?}", report.retriangulated);
+    println!("corner search: {:?}", report.recut);
+    let v = inner::verify(&hull);
+    let mut by_element: HashMap<u32, usize> = HashMap::new();
+    for x in &v {
+        for k in elements(&x.message) {
+            *by_element.entry(k).or_default() += 1;
+        }
+    }
+    let mut els: Vec<_> = by_element.into_iter().collect();
+    els.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    println!("{} violations; by element: {els:?}", v.len());
+}
