@@ -394,43 +394,98 @@ pub fn build_with_report(
         return Ok((hull, report));
     }
     let nets: std::collections::BTreeSet<u32> = report.overlap_nets.iter().copied().collect();
-    // Bent polygons' splits chosen by verification where the ranked ones fail.
-    let (hull, report, violations, forced) = if options.split_search && !bent.is_empty() {
-        let search = retriangulate::improve(&bent, &violations, |forced| {
-            build_with(mesh, normals, options, &nets, forced, &[])
-                .ok()
-                .map(|(h, _, _)| verify(&h))
-        });
-        if search.forced.is_empty() {
-            (hull, report, violations, Vec::new())
-        } else {
-            let (hull, mut report, _) =
-                build_with(mesh, normals, options, &nets, &search.forced, &[])?;
-            let forced = search.forced.clone();
-            report.retriangulated = search;
-            let violations = verify(&hull);
-            (hull, report, violations, forced)
-        }
+    // Bent polygons' splits (`split_search`) and corners' cuts (`corner_search`) chosen by
+    // verification where the ranked ones fail, in turns while either still improves.
+    let (mut forced, mut cuts) = (Vec::new(), Vec::new());
+    let mut current = violations;
+    let (mut split_log, mut cut_log) = (retriangulate::Search::default(), recut::Search::default());
+    let mut changed = false;
+    // The split search alone is one pass (it converged within its rounds).
+    let passes = if options.corner_search {
+        SEARCH_PASSES
     } else {
-        (hull, report, violations, Vec::new())
+        1
     };
-    if !options.corner_search || violations.is_empty() {
+    for pass in 0..passes {
+        let mut improved = false;
+        if options.split_search && !bent.is_empty() && !current.is_empty() {
+            let s = retriangulate::improve_from(&bent, &forced, &current, |f| {
+                build_with(mesh, normals, options, &nets, f, &cuts)
+                    .ok()
+                    .map(|(h, _, _)| verify(&h))
+            });
+            if s.after < s.before {
+                forced.clone_from(&s.forced);
+                current = build_with(mesh, normals, options, &nets, &forced, &cuts)
+                    .map(|(h, _, _)| verify(&h))?;
+                improved = true;
+            }
+            split_log = merge_log(split_log, s, pass);
+        }
+        if options.corner_search && !current.is_empty() {
+            let s = recut::improve_from(&cuts, &recut::CUTS, &current, |c| {
+                build_with(mesh, normals, options, &nets, &forced, c)
+                    .ok()
+                    .map(|(h, _, _)| verify(&h))
+            });
+            if s.after < s.before {
+                cuts.clone_from(&s.cuts);
+                current = build_with(mesh, normals, options, &nets, &forced, &cuts)
+                    .map(|(h, _, _)| verify(&h))?;
+                improved = true;
+            }
+            cut_log = merge_log(cut_log, s, pass);
+        }
+        changed |= improved;
+        if !improved {
+            break;
+        }
+    }
+    if !changed {
         return Ok((hull, report));
     }
-    // Corners re-cut (normal, α) by verification where the hull still fails.
-    let search = recut::improve(&violations, |cuts| {
-        build_with(mesh, normals, options, &nets, &forced, cuts)
-            .ok()
-            .map(|(h, _, _)| verify(&h))
-    });
-    if search.cuts.is_empty() {
-        return Ok((hull, report));
-    }
-    let retriangulated = report.retriangulated.clone();
-    let (hull, mut report, _) = build_with(mesh, normals, options, &nets, &forced, &search.cuts)?;
-    report.retriangulated = retriangulated;
-    report.recut = search;
+    let (hull, mut report, _) = build_with(mesh, normals, options, &nets, &forced, &cuts)?;
+    report.retriangulated = split_log;
+    report.recut = cut_log;
     Ok((hull, report))
+}
+
+/// Turns of the split search and the corner search ([`build_with_report`]).
+pub const SEARCH_PASSES: usize = 3;
+
+/// A search log over passes: the first pass's `before`, the last's choices and `after`, the
+/// trials summed.
+fn merge_log<S: SearchLog>(old: S, new: S, pass: usize) -> S {
+    if pass == 0 {
+        return new;
+    }
+    S::join(old, new)
+}
+
+/// What [`merge_log`] needs of a search's record.
+trait SearchLog {
+    /// `old`'s start, `new`'s choices and end, trials of both.
+    fn join(old: Self, new: Self) -> Self;
+}
+
+impl SearchLog for retriangulate::Search {
+    fn join(old: Self, new: Self) -> Self {
+        retriangulate::Search {
+            before: old.before,
+            trials: old.trials + new.trials,
+            ..new
+        }
+    }
+}
+
+impl SearchLog for recut::Search {
+    fn join(old: Self, new: Self) -> Self {
+        recut::Search {
+            before: old.before,
+            trials: old.trials + new.trials,
+            ..new
+        }
+    }
 }
 
 /// [`build_with_report`] without its rebuilds, with the merged regions of the input faces
@@ -670,7 +725,13 @@ fn build_with(
             faces: &fan.faces,
             reflex,
         };
-        if !corner::build_corner(&mut hull, &c, corner_options, &mut report.cases, &mut hallway) {
+        if !corner::build_corner(
+            &mut hull,
+            &c,
+            corner_options,
+            &mut report.cases,
+            &mut hallway,
+        ) {
             report.unseparable.push(v as u32);
         }
     }

@@ -28,7 +28,7 @@ pub const MAX_ROUNDS: usize = 3;
 
 /// Rebuilds of the hull the search may make in all (each costs one hull build and verification:
 /// 30–60 ms on spot_control_cage in release).
-pub const MAX_TRIALS: usize = 400;
+pub const MAX_TRIALS: usize = 600;
 
 /// One corner's cut: how far n_V turns from the normal the hull would take (the given normal,
 /// or Appendix C's least turn of it) towards the direction most above the corner's faces, and
@@ -43,7 +43,7 @@ pub struct Cut {
 }
 
 /// The cuts tried at a named corner besides the hull's own (turn 0, the global α).
-pub const CUTS: [Cut; 6] = [
+pub const CUTS: [Cut; 8] = [
     Cut {
         turn: 0.5,
         alpha: None,
@@ -51,6 +51,10 @@ pub const CUTS: [Cut; 6] = [
     Cut {
         turn: 1.0,
         alpha: None,
+    },
+    Cut {
+        turn: 0.0,
+        alpha: Some(0.2),
     },
     Cut {
         turn: 0.0,
@@ -63,6 +67,10 @@ pub const CUTS: [Cut; 6] = [
     Cut {
         turn: 0.5,
         alpha: Some(0.3),
+    },
+    Cut {
+        turn: 1.0,
+        alpha: Some(0.65),
     },
     Cut {
         turn: 1.0,
@@ -95,7 +103,22 @@ pub struct Search {
 /// The greedy search of the module documentation. `violations` are the starting hull's;
 /// `build` rebuilds the hull with the given cuts and returns its violations (`None` when that
 /// hull cannot be built, which rejects the trial).
-pub fn improve<F>(violations: &[HullViolation], mut build: F) -> Search
+pub fn improve<F>(violations: &[HullViolation], build: F) -> Search
+where
+    F: FnMut(&[(u32, Cut)]) -> Option<Vec<HullViolation>>,
+{
+    improve_from(&[], &CUTS, violations, build)
+}
+
+/// [`improve`] starting from the cuts `start` (whose hull has `violations`): a second pass
+/// after other choices changed ([`super::retriangulate`]), trying the cuts `tried`. The result lists `start`'s cuts
+/// too, changed or not.
+pub fn improve_from<F>(
+    start: &[(u32, Cut)],
+    tried: &[Cut],
+    violations: &[HullViolation],
+    mut build: F,
+) -> Search
 where
     F: FnMut(&[(u32, Cut)]) -> Option<Vec<HullViolation>>,
 {
@@ -105,9 +128,9 @@ where
         ..Search::default()
     };
     let mut current = violations.to_vec();
-    let mut cuts: Vec<(u32, Cut)> = Vec::new();
+    let mut cuts: Vec<(u32, Cut)> = start.to_vec();
     for _ in 0..MAX_ROUNDS {
-        if current.is_empty() || search.trials >= MAX_TRIALS {
+        if current.is_empty() {
             break;
         }
         // Corners named by violations, most named first (ties: vertex order).
@@ -128,7 +151,7 @@ where
         for (_, corner) in order {
             let now = cuts.iter().find(|(v, _)| *v == corner).map(|(_, c)| *c);
             let mut best: Option<(Option<Cut>, Vec<HullViolation>)> = None;
-            let options = std::iter::once(None).chain(CUTS.iter().copied().map(Some));
+            let options = std::iter::once(None).chain(tried.iter().copied().map(Some));
             for alt in options {
                 if alt == now || search.trials >= MAX_TRIALS {
                     continue;
