@@ -89,6 +89,7 @@ pub mod nearguard;
 pub mod normals;
 pub mod overlapnet;
 pub mod planar;
+pub mod recut;
 pub mod remesh;
 pub mod retriangulate;
 pub mod sides;
@@ -142,6 +143,11 @@ pub struct InnerOptions {
     /// [`retriangulate::MAX_TRIALS`] times). For strongly bent control cages
     /// (spot_control_cage).
     pub split_search: bool,
+    /// Where the hull (after the split search, if on) still fails `verify`, re-cut the
+    /// corners its violations name: n_V turned further above face and α per corner, chosen by
+    /// rebuilding and verifying ([`recut`]; default false: opt-in, up to
+    /// [`recut::MAX_TRIALS`] rebuilds). For strongly folded control cages (spot_control_cage).
+    pub corner_search: bool,
 }
 
 impl Default for InnerOptions {
@@ -155,13 +161,14 @@ impl Default for InnerOptions {
             merge_close: 0.0,
             min_volume: verify::DEGENERATE_VOLUME,
             split_search: false,
+            corner_search: false,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 7] = [
+    pub const KEYS: [&'static str; 8] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
@@ -169,11 +176,13 @@ impl InnerOptions {
         "ring_normals",
         "merge_close",
         "split_search",
+        "corner_search",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
-    /// (number in [0, 1]), `merge_close` (number in [0, 0.05]) and `split_search` (boolean) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
+    /// (number in [0, 1]), `merge_close` (number in [0, 0.05]), `split_search` and `corner_search`
+    /// (booleans) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -264,14 +273,19 @@ impl InnerOptions {
                 )))
             }
         }
-        match table.get("split_search") {
-            None => {}
-            Some(toml::Value::Boolean(b)) => o.split_search = *b,
-            Some(v) => {
-                return Err(bad(format!(
-                    "`scheme.split_search`: expected a boolean, found {}",
-                    v.type_str()
-                )))
+        for (key, slot) in [
+            ("split_search", &mut o.split_search),
+            ("corner_search", &mut o.corner_search),
+        ] {
+            match table.get(key) {
+                None => {}
+                Some(toml::Value::Boolean(b)) => *slot = *b,
+                Some(v) => {
+                    return Err(bad(format!(
+                        "`scheme.{key}`: expected a boolean, found {}",
+                        v.type_str()
+                    )))
+                }
             }
         }
         Ok(o)
@@ -319,6 +333,9 @@ pub struct InnerReport {
     /// Bent polygons whose split the verification search changed ([`retriangulate`]; faces of
     /// the mesh after the close-vertex merge), with the violations before and after.
     pub retriangulated: retriangulate::Search,
+    /// Corners whose normal or α the verification search changed ([`recut`],
+    /// `corner_search`), with the violations before and after.
+    pub recut: recut::Search,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
     /// Input faces of the merged polygons that could take a flat net but have none
@@ -360,7 +377,7 @@ pub fn build_with_report(
     options: &InnerOptions,
 ) -> Result<(SimplicialHull, InnerReport)> {
     let none = std::collections::BTreeSet::new();
-    let (hull, report, bent) = build_with(mesh, normals, options, &none, &[])?;
+    let (hull, report, bent) = build_with(mesh, normals, options, &none, &[], &[])?;
     // Merged regions whose triangles of T overlap get flat nets too ([`overlapnet`]).
     let (hull, report) = if report.flat_nets == 0 {
         (hull, report)
@@ -369,26 +386,106 @@ pub fn build_with_report(
             build_forced(mesh, normals, options, forced)
         })
     };
-    if !options.split_search || bent.is_empty() {
+    if !options.split_search && !options.corner_search {
         return Ok((hull, report));
     }
     let violations = verify(&hull);
     if violations.is_empty() {
         return Ok((hull, report));
     }
-    // Bent polygons' splits chosen by verification where the ranked ones fail.
     let nets: std::collections::BTreeSet<u32> = report.overlap_nets.iter().copied().collect();
-    let search = retriangulate::improve(&bent, &violations, |forced| {
-        build_with(mesh, normals, options, &nets, forced)
-            .ok()
-            .map(|(h, _, _)| verify(&h))
-    });
-    if search.forced.is_empty() {
+    // Bent polygons' splits (`split_search`) and corners' cuts (`corner_search`) chosen by
+    // verification where the ranked ones fail, in turns while either still improves.
+    let (mut forced, mut cuts) = (Vec::new(), Vec::new());
+    let mut current = violations;
+    let (mut split_log, mut cut_log) = (retriangulate::Search::default(), recut::Search::default());
+    let mut changed = false;
+    // The split search alone is one pass (it converged within its rounds).
+    let passes = if options.corner_search {
+        SEARCH_PASSES
+    } else {
+        1
+    };
+    for pass in 0..passes {
+        let mut improved = false;
+        if options.split_search && !bent.is_empty() && !current.is_empty() {
+            let s = retriangulate::improve_from(&bent, &forced, &current, |f| {
+                build_with(mesh, normals, options, &nets, f, &cuts)
+                    .ok()
+                    .map(|(h, _, _)| verify(&h))
+            });
+            if s.after < s.before {
+                forced.clone_from(&s.forced);
+                current = build_with(mesh, normals, options, &nets, &forced, &cuts)
+                    .map(|(h, _, _)| verify(&h))?;
+                improved = true;
+            }
+            split_log = merge_log(split_log, s, pass);
+        }
+        if options.corner_search && !current.is_empty() {
+            let s = recut::improve_from(&cuts, &recut::CUTS, &current, |c| {
+                build_with(mesh, normals, options, &nets, &forced, c)
+                    .ok()
+                    .map(|(h, _, _)| verify(&h))
+            });
+            if s.after < s.before {
+                cuts.clone_from(&s.cuts);
+                current = build_with(mesh, normals, options, &nets, &forced, &cuts)
+                    .map(|(h, _, _)| verify(&h))?;
+                improved = true;
+            }
+            cut_log = merge_log(cut_log, s, pass);
+        }
+        changed |= improved;
+        if !improved {
+            break;
+        }
+    }
+    if !changed {
         return Ok((hull, report));
     }
-    let (hull, mut report, _) = build_with(mesh, normals, options, &nets, &search.forced)?;
-    report.retriangulated = search;
+    let (hull, mut report, _) = build_with(mesh, normals, options, &nets, &forced, &cuts)?;
+    report.retriangulated = split_log;
+    report.recut = cut_log;
     Ok((hull, report))
+}
+
+/// Turns of the split search and the corner search ([`build_with_report`]).
+pub const SEARCH_PASSES: usize = 3;
+
+/// A search log over passes: the first pass's `before`, the last's choices and `after`, the
+/// trials summed.
+fn merge_log<S: SearchLog>(old: S, new: S, pass: usize) -> S {
+    if pass == 0 {
+        return new;
+    }
+    S::join(old, new)
+}
+
+/// What [`merge_log`] needs of a search's record.
+trait SearchLog {
+    /// `old`'s start, `new`'s choices and end, trials of both.
+    fn join(old: Self, new: Self) -> Self;
+}
+
+impl SearchLog for retriangulate::Search {
+    fn join(old: Self, new: Self) -> Self {
+        retriangulate::Search {
+            before: old.before,
+            trials: old.trials + new.trials,
+            ..new
+        }
+    }
+}
+
+impl SearchLog for recut::Search {
+    fn join(old: Self, new: Self) -> Self {
+        recut::Search {
+            before: old.before,
+            trials: old.trials + new.trials,
+            ..new
+        }
+    }
 }
 
 /// [`build_with_report`] without its rebuilds, with the merged regions of the input faces
@@ -402,19 +499,21 @@ pub fn build_forced(
     options: &InnerOptions,
     forced: &std::collections::BTreeSet<u32>,
 ) -> Result<(SimplicialHull, InnerReport)> {
-    build_with(mesh, normals, options, forced, &[]).map(|(h, r, _)| (h, r))
+    build_with(mesh, normals, options, forced, &[], &[]).map(|(h, r, _)| (h, r))
 }
 
 /// One build without rebuilds: the merged regions of the input faces `nets` given flat nets
 /// ([`flatnet::spread_guards_forced`]) and the splits of some bent polygons forced
 /// ([`planar::split_nonplanar_forced`]; faces of the mesh after the close-vertex merge); also
-/// returns the split polygons the split search may change.
+/// returns the split polygons the split search may change. Corners listed in `cuts` take their
+/// normal turn and α from it ([`recut`]).
 fn build_with(
     mesh: &Mesh,
     normals: &[DVec3],
     options: &InnerOptions,
     nets: &std::collections::BTreeSet<u32>,
     splits: &[(u32, planar::Forced)],
+    cuts: &[(u32, recut::Cut)],
 ) -> Result<(SimplicialHull, InnerReport, Vec<retriangulate::Bent>)> {
     if !(options.alpha > 0.0 && options.alpha < 1.0) {
         return Err(Error::Invalid(format!(
@@ -582,6 +681,33 @@ fn build_with(
                 report.adjusted_normals.push((v as u32, n));
             }
         }
+        let cut = cuts.iter().find(|(w, _)| *w == v as u32).map(|(_, c)| *c);
+        let recut_options;
+        let corner_options = match cut {
+            Some(cut) if fan.faces.len() != 3 => {
+                if cut.turn > 0.0 {
+                    let face_normals: Vec<DVec3> = fan
+                        .faces
+                        .iter()
+                        .map(|&f| pieces.normal[f as usize])
+                        .collect();
+                    let best = above::most_above(&face_normals);
+                    // Both ends are above face, so is their blend (a convex cone); kept only
+                    // if rounding agrees.
+                    if let Some(t) = (n + cut.turn * (best - n)).try_normalize() {
+                        if above::clearance(t, &face_normals) >= above::ABOVE_MARGIN {
+                            n = t;
+                        }
+                    }
+                }
+                recut_options = InnerOptions {
+                    alpha: cut.alpha.unwrap_or(options.alpha),
+                    ..options.clone()
+                };
+                &recut_options
+            }
+            _ => options,
+        };
         ring.clear();
         ring.extend(fan.ring.iter().map(|&w| mesh.positions[w as usize]));
         let reflex = (0..fan.faces.len()).find(|&i| {
@@ -599,7 +725,13 @@ fn build_with(
             faces: &fan.faces,
             reflex,
         };
-        if !corner::build_corner(&mut hull, &c, options, &mut report.cases, &mut hallway) {
+        if !corner::build_corner(
+            &mut hull,
+            &c,
+            corner_options,
+            &mut report.cases,
+            &mut hallway,
+        ) {
             report.unseparable.push(v as u32);
         }
     }

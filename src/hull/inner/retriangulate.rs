@@ -80,7 +80,22 @@ pub struct Search {
 /// The greedy search of the module documentation. `violations` are the ranked splits' hull's;
 /// `build` rebuilds the hull with the given forced splits and returns its violations (`None`
 /// when that hull cannot be built, which rejects the trial).
-pub fn improve<F>(bent: &[Bent], violations: &[HullViolation], mut build: F) -> Search
+pub fn improve<F>(bent: &[Bent], violations: &[HullViolation], build: F) -> Search
+where
+    F: FnMut(&[(u32, Forced)]) -> Option<Vec<HullViolation>>,
+{
+    improve_from(bent, &[], violations, build)
+}
+
+/// [`improve`] starting from the forced splits `start` (whose hull has `violations`): a
+/// second pass after other choices changed ([`super::recut`]). The result lists `start`'s
+/// splits too, changed or not.
+pub fn improve_from<F>(
+    bent: &[Bent],
+    start: &[(u32, Forced)],
+    violations: &[HullViolation],
+    mut build: F,
+) -> Search
 where
     F: FnMut(&[(u32, Forced)]) -> Option<Vec<HullViolation>>,
 {
@@ -90,7 +105,7 @@ where
         ..Search::default()
     };
     let mut current = violations.to_vec();
-    let mut forced: Vec<(u32, Forced)> = Vec::new();
+    let mut forced: Vec<(u32, Forced)> = start.to_vec();
     for _ in 0..MAX_ROUNDS {
         if current.is_empty() {
             break;
