@@ -179,12 +179,18 @@ fn jacobi_columns(c: &mut [Vec<f64>], mut acc: Option<&mut [Vec<f64>]>) {
                 if gamma == 0.0 || gamma.abs() <= 1e-15 * (alpha * beta).sqrt() {
                     continue;
                 }
-                rotated = true;
                 let zeta = (beta - alpha) / (2.0 * gamma);
                 let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
                 let t = if zeta == 0.0 { 1.0 } else { t };
                 let cs = 1.0 / (1.0 + t * t).sqrt();
                 let sn = cs * t;
+                // ζ overflowed (γ tiny against a column far larger than the other): the
+                // rotation is the identity. Not counted, so that sweeps made only of these
+                // end the loop instead of running to the sweep limit.
+                if sn == 0.0 {
+                    continue;
+                }
+                rotated = true;
                 let rotate = |v: &mut [Vec<f64>]| {
                     let (lo, hi) = v.split_at_mut(q);
                     for (x, y) in lo[p].iter_mut().zip(hi[0].iter_mut()) {

@@ -37,6 +37,7 @@ use crate::complex::Role;
 use crate::error::{Error, Result};
 use crate::hull::simplicial::{EdgePoint, Side, SimplicialHull};
 use glam::DVec3;
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Degree of the scheme.
@@ -524,6 +525,32 @@ struct Failure {
     /// consistent (one per dependent equation, Σ coefficient · known slot = 0).
     consistency: Vec<Equation>,
 }
+
+/// One connected group of a stage's unknowns, set up for its solve ([`System::solve_group`]).
+struct Group {
+    /// The group's own equations (its first `m` rows; sign pins are appended after them).
+    m: usize,
+    /// Unknown slots, in column order.
+    unk: Vec<u32>,
+    /// Its equations (indices into the pass's equations), in row order.
+    eqs: Vec<usize>,
+    /// Column of each unknown slot.
+    col: HashMap<u32, usize>,
+    /// Coefficients of the unknowns per equation.
+    rows: Vec<sparse::Row>,
+    /// Right-hand sides: minus the known weights' terms.
+    c: Vec<f64>,
+    /// Target of each unknown.
+    tgt: Vec<f64>,
+    /// Largest |datum| (right-hand side or target).
+    scale: f64,
+    /// Whether it is solved in the parallel phase of its stage: its sign conditions read no
+    /// other group of the stage, and it is dense.
+    parallel: bool,
+}
+
+/// A group's solution with the sign pins it made and gave up ([`pin_signs`]).
+type GroupSolution = (dense::Solution, usize, usize);
 
 impl System {
     /// Solves every slot: jets, then the stages, each group closest to its target
@@ -1070,8 +1097,96 @@ impl System {
             }
             let mut glist: Vec<(Vec<u32>, Vec<usize>)> = groups.into_values().collect();
             glist.sort_unstable_by_key(|g| g.0[0]);
-            for (unk, eqs) in glist {
-                stats.largest_group = stats.largest_group.max(unk.len());
+            // Set up every group (serially: the targets come from a caller's closure). They read
+            // only weights of earlier stages: an equation's unknowns of this stage are all in its
+            // group.
+            let groups: Vec<Group> = glist
+                .into_iter()
+                .map(|(unk, eqs)| {
+                    let col: HashMap<u32, usize> =
+                        unk.iter().enumerate().map(|(i, s)| (*s, i)).collect();
+                    let mut rows: Vec<sparse::Row> = Vec::with_capacity(eqs.len() + unk.len());
+                    let mut c = vec![0.0; eqs.len()];
+                    for (i, &e) in eqs.iter().enumerate() {
+                        let mut row = Vec::new();
+                        for &(s, k) in &all[e].terms {
+                            match col.get(&s) {
+                                Some(&j) => row.push((j, k)),
+                                None => c[i] -= k * value[s as usize],
+                            }
+                        }
+                        rows.push(row);
+                    }
+                    let tgt: Vec<f64> = unk
+                        .iter()
+                        .map(|&s| {
+                            let (t, l) = self.home[s as usize];
+                            if relaxed_jet[s as usize] {
+                                // A relaxed Hessian weight: its estimate.
+                                value[s as usize]
+                            } else {
+                                target(t as usize, l)
+                            }
+                        })
+                        .collect();
+                    let scale = c
+                        .iter()
+                        .chain(tgt.iter())
+                        .fold(1e-300_f64, |acc, x| acc.max(x.abs()));
+                    // Solved in parallel unless its sign conditions read another group of this
+                    // stage (solved before it or not, as in serial order) or it is sparse
+                    // (one large factorisation at a time).
+                    let parallel = unk.len() <= DENSE_LIMIT
+                        && !(pin
+                            && unk.iter().any(|&s| {
+                                eqs_of[s as usize].iter().any(|&e| {
+                                    self.equations[e as usize].terms.iter().any(|t| {
+                                        stage_of[t.0 as usize] == st && !col.contains_key(&t.0)
+                                    })
+                                })
+                            }));
+                    Group {
+                        m: eqs.len(),
+                        unk,
+                        eqs,
+                        col,
+                        rows,
+                        c,
+                        tgt,
+                        scale,
+                        parallel,
+                    }
+                })
+                .collect();
+            // Groups of one stage have disjoint unknowns: solved in parallel (ordered collect:
+            // the same bits whatever the thread count), the others below in order.
+            let mut groups = groups;
+            let solved: Vec<Option<GroupSolution>> = {
+                let (value, known, stage_of, eqs_of) = (&value, &known, &stage_of, &eqs_of);
+                groups
+                    .par_iter_mut()
+                    .map(|g| {
+                        g.parallel
+                            .then(|| self.solve_group(g, value, known, stage_of, st, eqs_of, pin))
+                    })
+                    .collect()
+            };
+            // Stars whose near-null conditions are wanted: (group, index of its placeholder in
+            // `failures`), factored together after the stage.
+            let mut near_jobs: Vec<(usize, usize)> = Vec::new();
+            for (gi, (g, pre)) in groups.iter_mut().zip(solved).enumerate() {
+                let (m, n) = (g.m, g.unk.len());
+                stats.largest_group = stats.largest_group.max(n);
+                if n > DENSE_LIMIT {
+                    stats.sparse_groups += 1;
+                }
+                let (sol, pinned, given_up) = match pre {
+                    Some(s) => s,
+                    None => self.solve_group(g, &value, &known, &stage_of, st, &eqs_of, pin),
+                };
+                stats.signs.pinned += pinned;
+                stats.signs.given_up += given_up;
+                let unk = &g.unk;
                 let where_ = || {
                     let mut pts: Vec<u32> = unk
                         .iter()
@@ -1096,50 +1211,7 @@ impl System {
                     }
                     pts
                 };
-                let col: HashMap<u32, usize> =
-                    unk.iter().enumerate().map(|(i, s)| (*s, i)).collect();
-                let (m, n) = (eqs.len(), unk.len());
-                let mut rows: Vec<sparse::Row> = Vec::with_capacity(m + n);
-                let mut c = vec![0.0; m];
-                for (i, &e) in eqs.iter().enumerate() {
-                    let mut row = Vec::new();
-                    for &(s, k) in &all[e].terms {
-                        match col.get(&s) {
-                            Some(&j) => row.push((j, k)),
-                            None => c[i] -= k * value[s as usize],
-                        }
-                    }
-                    rows.push(row);
-                }
-                let tgt: Vec<f64> = unk
-                    .iter()
-                    .map(|&s| {
-                        let (t, l) = self.home[s as usize];
-                        if relaxed_jet[s as usize] {
-                            // A relaxed Hessian weight: its estimate.
-                            value[s as usize]
-                        } else {
-                            target(t as usize, l)
-                        }
-                    })
-                    .collect();
-                let scale = c
-                    .iter()
-                    .chain(tgt.iter())
-                    .fold(1e-300_f64, |acc, x| acc.max(x.abs()));
-                if n > DENSE_LIMIT {
-                    stats.sparse_groups += 1;
-                }
-                let mut sol = solve_rows(&rows, n, &c, &tgt, scale);
-                if pin && consistent(&sol, scale) {
-                    let conds =
-                        self.sign_conditions(&unk, &col, &value, &known, &stage_of, st, &eqs_of);
-                    let (pinned, given_up) =
-                        pin_signs(&mut sol, &mut rows, &mut c, &conds, &tgt, scale);
-                    stats.signs.pinned += pinned;
-                    stats.signs.given_up += given_up;
-                }
-                if !consistent(&sol, scale) {
+                if !consistent(&sol, g.scale) {
                     let pts = where_();
                     let what = match st {
                         1 => format!("the middle of hull edge {pts:?}"),
@@ -1157,13 +1229,13 @@ impl System {
                     let mut consistency = Vec::new();
                     if n <= DENSE_LIMIT {
                         let mut a = vec![0.0; m * n];
-                        for (i, row) in rows.iter().enumerate().take(m) {
+                        for (i, row) in g.rows.iter().enumerate().take(m) {
                             for &(j, k) in row {
                                 a[i * n + j] += k;
                             }
                         }
                         for y in dense::dependencies(&a, m, n, 1e-11) {
-                            consistency.extend(known_condition(&all, &eqs, &col, &y));
+                            consistency.extend(known_condition(&all, &g.eqs, &g.col, &y));
                         }
                     }
                     failures.push(Failure {
@@ -1177,49 +1249,28 @@ impl System {
                     });
                 }
                 // A star solved exactly but nearly singular: the conditions that keep it from
-                // amplifying its data's noise (`star_tau`), for the next pass.
-                if st == 3 && near && n <= DENSE_LIMIT && consistent(&sol, scale) {
-                    let mut a = vec![0.0; m * n];
-                    let mut norm = vec![0.0_f64; m];
-                    for (i, row) in rows.iter().enumerate().take(m) {
-                        norm[i] = row
-                            .iter()
-                            .map(|t| t.1 * t.1)
-                            .sum::<f64>()
-                            .sqrt()
-                            .max(1e-300);
-                        for &(j, k) in row {
-                            a[i * n + j] += k / norm[i];
-                        }
-                    }
-                    let conds: Vec<Equation> = dense::near_null_left(&a, m, n, self.star_tau)
-                        .into_iter()
-                        .filter_map(|(_, u)| {
-                            // uᵀ(row_i / |row_i|): the condition on the unscaled equations.
-                            let y: Vec<f64> = u.iter().zip(&norm).map(|(u, r)| u / r).collect();
-                            known_condition(&all, &eqs, &col, &y)
-                        })
-                        .collect();
-                    if !conds.is_empty() {
-                        failures.push(Failure {
-                            stage: NEAR_NULL,
-                            points: where_(),
-                            message: String::new(),
-                            consistency: conds,
-                        });
-                    }
+                // amplifying its data's noise (`star_tau`), for the next pass; a placeholder
+                // keeps its place among the failures.
+                if st == 3 && near && n <= DENSE_LIMIT && consistent(&sol, g.scale) {
+                    near_jobs.push((gi, failures.len()));
+                    failures.push(Failure {
+                        stage: NEAR_NULL,
+                        points: where_(),
+                        message: String::new(),
+                        consistency: Vec::new(),
+                    });
                 }
                 for (j, &s) in unk.iter().enumerate() {
                     if sol.x[j].is_finite() {
                         value[s as usize] = sol.x[j];
                         if trace {
-                            let d = (sol.x[j] - tgt[j]).abs();
+                            let d = (sol.x[j] - g.tgt[j]).abs();
                             dev.0 = dev.0.max(d);
                             dev.1 += d;
-                            dev.2 += tgt[j].abs();
+                            dev.2 += g.tgt[j].abs();
                             dev.3 += 1;
                             let r = self.req[s as usize];
-                            if (r == 1 || r == -1) && f64::from(r) * tgt[j] < 0.0 {
+                            if (r == 1 || r == -1) && f64::from(r) * g.tgt[j] < 0.0 {
                                 dev.4 += 1;
                             }
                             if (r == 1 || r == -1) && f64::from(r) * sol.x[j] < 0.0 {
@@ -1229,6 +1280,18 @@ impl System {
                     }
                     known[s as usize] = true;
                 }
+            }
+            if !near_jobs.is_empty() {
+                // The stars' singular vectors, all at once in parallel (they depend on the
+                // groups' rows only), then their conditions in their places.
+                let conds: Vec<Vec<Equation>> = near_jobs
+                    .par_iter()
+                    .map(|&(gi, _)| self.near_null_conditions(&groups[gi], &all))
+                    .collect();
+                for (&(_, at), conds) in near_jobs.iter().zip(conds) {
+                    failures[at].consistency = conds;
+                }
+                failures.retain(|f| f.stage != NEAR_NULL || !f.consistency.is_empty());
             }
             if trace {
                 // Opt-in exploration on stderr (results unaffected).
@@ -1260,6 +1323,58 @@ impl System {
         stats.signs.pinned = pinned;
         stats.signs.given_up = given_up;
         (value, stats, failures)
+    }
+
+    /// Solves one group closest to its targets, with Theorem 2.1's signs pinned where it can
+    /// (`pin`, [`pin_signs`], which append their pins to the group's rows). Reads `value` and
+    /// `known` only through [`System::sign_conditions`].
+    #[allow(clippy::too_many_arguments)]
+    fn solve_group(
+        &self,
+        g: &mut Group,
+        value: &[f64],
+        known: &[bool],
+        stage_of: &[u8],
+        st: u8,
+        eqs_of: &[Vec<u32>],
+        pin: bool,
+    ) -> GroupSolution {
+        let mut sol = solve_rows(&g.rows, g.unk.len(), &g.c, &g.tgt, g.scale);
+        let (mut pinned, mut given_up) = (0, 0);
+        if pin && consistent(&sol, g.scale) {
+            let conds = self.sign_conditions(&g.unk, &g.col, value, known, stage_of, st, eqs_of);
+            (pinned, given_up) =
+                pin_signs(&mut sol, &mut g.rows, &mut g.c, &conds, &g.tgt, g.scale);
+        }
+        (sol, pinned, given_up)
+    }
+
+    /// A solved star's near-null conditions (`star_tau`): the left singular vectors u of its
+    /// rows scaled to unit norm with σ ≤ `star_tau` × σ_max, each as the condition uᵀc = 0 on
+    /// the known weights its right-hand side reads ([`known_condition`]).
+    fn near_null_conditions(&self, g: &Group, all: &[&Equation]) -> Vec<Equation> {
+        let (m, n) = (g.m, g.unk.len());
+        let mut a = vec![0.0; m * n];
+        let mut norm = vec![0.0_f64; m];
+        for (i, row) in g.rows.iter().enumerate().take(m) {
+            norm[i] = row
+                .iter()
+                .map(|t| t.1 * t.1)
+                .sum::<f64>()
+                .sqrt()
+                .max(1e-300);
+            for &(j, k) in row {
+                a[i * n + j] += k / norm[i];
+            }
+        }
+        dense::near_null_left(&a, m, n, self.star_tau)
+            .into_iter()
+            .filter_map(|(_, u)| {
+                // uᵀ(row_i / |row_i|): the condition on the unscaled equations.
+                let y: Vec<f64> = u.iter().zip(&norm).map(|(u, r)| u / r).collect();
+                known_condition(all, &g.eqs, &g.col, &y)
+            })
+            .collect()
     }
 
     /// Theorem 2.1's sign conditions on the group `unk` (columns `col`) at stage `st`: its own
