@@ -292,8 +292,10 @@ pub fn build_with_stats(
             rings: std::env::var("APATCH_HOLE_RINGS")
                 .ok()
                 .and_then(|x| x.parse().ok())
-                .unwrap_or(1),
-            stars: std::env::var_os("APATCH_HOLE_STARS").is_some(),
+                .unwrap_or(2),
+            // Exploration overrides (`APATCH_HOLE_RINGS`, `APATCH_HOLE_STARS=0`); the defaults
+            // are the measured best on the torus (docs/quintic.md).
+            stars: std::env::var("APATCH_HOLE_STARS").map_or(true, |v| v != "0"),
         };
         stats.hole_repair = holes::repair(&sys, &tets, &mut value, reach);
         if std::env::var_os("APATCH_SIGN_TRACE").is_some() {
