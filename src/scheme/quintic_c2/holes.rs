@@ -66,10 +66,8 @@ pub fn boundary_faces(tets: &[HullTet]) -> Vec<(u32, usize)> {
     let mut users: HashMap<[u32; 3], u32> = HashMap::new();
     let face = |t: &HullTet, opp: usize| {
         let mut f = [0u32; 3];
-        let mut c = 0;
-        for k in (0..4).filter(|&k| k != opp) {
+        for (c, k) in (0..4).filter(|&k| k != opp).enumerate() {
             f[c] = t.gid[k];
-            c += 1;
         }
         f.sort_unstable();
         f
@@ -346,7 +344,9 @@ fn repair_face(
             pins.push((col[&s], sign(s) * m));
         }
         let sol = solve(&rows, &c, &pins, n, &x0);
-        if !(sol.residual <= CONSISTENT * scale) || sol.x.iter().any(|v| !(v.abs() <= bound)) {
+        // NaN-safe: a NaN residual or weight refuses the repair too.
+        let ok = sol.residual <= CONSISTENT * scale && sol.x.iter().all(|v| v.abs() <= bound);
+        if !ok {
             trace(|| {
                 format!(
                     "face {t}/{opp}: {n} unknowns, {} equations, {} pins: residual {:.2e} of {scale:.2e}, largest {:.2e}",
