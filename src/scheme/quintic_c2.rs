@@ -11,6 +11,7 @@
 pub mod cholesky;
 pub mod dense;
 pub mod flat;
+pub mod holes;
 pub mod jets;
 pub mod ordering;
 pub mod signs;
@@ -80,6 +81,11 @@ pub struct QuinticOptions {
     /// before the star (edge middles) is imposed, as `consistent_stars` does for exact
     /// dependencies, so the star's weights do not follow their data's noise amplified by 1/σ.
     pub star_tau: f64,
+    /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2) of the
+    /// tetrahedra around every boundary face the surface crosses (a hole), with all their
+    /// C1/C2 equations and the face's weights pinned to Theorem 2.1's signs ([`holes`]): C2
+    /// is kept exactly and nothing changes away from holes. Off by default.
+    pub repair_holes: bool,
 }
 
 impl Default for QuinticOptions {
@@ -96,6 +102,7 @@ impl Default for QuinticOptions {
             hessian_signs: false,
             contain_tangents: false,
             zero_groups: false,
+            repair_holes: false,
         }
     }
 }
@@ -167,6 +174,13 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "repair_holes" => match v.as_bool() {
+                    Some(b) => o.repair_holes = b,
+                    None => bail!(
+                        "{}: `scheme.repair_holes` must be true or false, got {v}",
+                        scene.display()
+                    ),
+                },
                 "zero_groups" => match v.as_bool() {
                     Some(b) => o.zero_groups = b,
                     None => bail!(
@@ -199,7 +213,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, `repair_holes`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -262,7 +276,7 @@ pub fn build_with_stats(
         signs::HessianFit::default()
     };
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
-    let (value, mut stats) = sys.solve(
+    let (mut value, mut stats) = sys.solve(
         &tets,
         &jets,
         nt,
@@ -273,6 +287,22 @@ pub fn build_with_stats(
         options.consistent_stars,
         options.hessian_signs,
     )?;
+    if options.repair_holes {
+        let reach = holes::Reach {
+            rings: std::env::var("APATCH_HOLE_RINGS")
+                .ok()
+                .and_then(|x| x.parse().ok())
+                .unwrap_or(2),
+            // Exploration overrides (`APATCH_HOLE_RINGS`, `APATCH_HOLE_STARS=0`); the defaults
+            // are the measured best on the torus (docs/quintic.md).
+            stars: std::env::var("APATCH_HOLE_STARS").map_or(true, |v| v != "0"),
+        };
+        stats.hole_repair = holes::repair(&sys, &tets, &mut value, reach);
+        if std::env::var_os("APATCH_SIGN_TRACE").is_some() {
+            // Opt-in exploration on stderr (results unaffected).
+            eprintln!("quintic-c2 hole repair: {:?}", stats.hole_repair);
+        }
+    }
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
     stats.lu_completed = lu_completed.len();
     stats.tangent_moved = tangent_moved;

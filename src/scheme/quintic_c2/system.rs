@@ -151,7 +151,7 @@ fn key(gid: &[u32; 4], lambda: [u8; 4]) -> u128 {
 }
 
 /// Unpacks a key into (global id, multiplicity) pairs.
-fn unkey(mut k: u128) -> Vec<(u32, u8)> {
+pub(super) fn unkey(mut k: u128) -> Vec<(u32, u8)> {
     let mut v = Vec::new();
     while k != 0 {
         let e = (k & 0xffff_ffff) as u32;
@@ -165,8 +165,8 @@ fn unkey(mut k: u128) -> Vec<(u32, u8)> {
 type FaceUsers = ([u32; 3], Vec<(u32, usize)>);
 
 /// A linear equation Σ c·x_slot = 0.
-struct Equation {
-    terms: Vec<(u32, f64)>,
+pub(super) struct Equation {
+    pub(super) terms: Vec<(u32, f64)>,
 }
 
 /// The whole linear system of the scheme.
@@ -174,14 +174,14 @@ pub struct System {
     /// Slot of every weight of every tetrahedron.
     pub slot_of: Vec<[u32; NW]>,
     /// Domain-point key of every slot.
-    keys: Vec<u128>,
+    pub(super) keys: Vec<u128>,
     /// One tetrahedron and multi-index per slot (for targets).
     home: Vec<(u32, [u8; 4])>,
-    equations: Vec<Equation>,
+    pub(super) equations: Vec<Equation>,
     /// Number of points of T (global ids below are points of T).
-    np: u32,
+    pub(super) np: u32,
     /// Sign Theorem 2.1 asks of every slot ([`signs::required`] combined over its tetrahedra).
-    req: Vec<i8>,
+    pub(super) req: Vec<i8>,
     /// Slots on a boundary face of the hull (a face of one tetrahedron only).
     boundary: Vec<bool>,
     /// Near-null threshold of the star systems (`QuinticOptions::star_tau`, 0 = off): the
@@ -454,6 +454,8 @@ pub struct SolveStats {
     pub consistency_conditions: usize,
     /// What [`signs::fit_hessians`] changed (`QuinticOptions::hessian_signs`).
     pub hessian_fit: signs::HessianFit,
+    /// What [`super::holes::repair`] changed (`QuinticOptions::repair_holes`).
+    pub hole_repair: super::holes::HoleRepair,
 }
 
 /// One point's vertex-star system ([`System::star_systems`]).

@@ -1,0 +1,137 @@
+//! The quintic's holes on boundary faces of the hull (issue 8): explorations on a cached complex.
+
+use apatch::complex::{PatchComplex, Role};
+use std::path::PathBuf;
+
+/// The complex of `SCENE`, read from `CACHE` (a patches JSON) when it exists, else built and
+/// written there (building the knot takes minutes).
+fn complex() -> PatchComplex {
+    let cache = std::env::var_os("CACHE").map(PathBuf::from);
+    if let Some(c) = &cache {
+        if c.exists() {
+            return apatch::complex_io::read_json_file(c).unwrap();
+        }
+    }
+    let path = PathBuf::from(std::env::var("SCENE").unwrap());
+    let sc = apatch::scene::load(&path).unwrap();
+    let c = apatch::scene::build_complex(&sc).unwrap();
+    if let Some(f) = &cache {
+        apatch::complex_io::write_json_file(&c, f).unwrap();
+    }
+    c
+}
+
+/// Exploration: every crossed boundary face of an edge tetrahedron, with its 21 weights as a
+/// triangle (rows by the opposite point's multiplicity), where F is most negative on it, and
+/// how far the apex-side sign goes.
+/// `SCENE=… CACHE=/tmp/x.json cargo test --release --test quintic_holes edge_hole_faces --
+/// --ignored --nocapture`.
+#[test]
+#[ignore = "exploration: SCENE=path [CACHE=json]"]
+fn edge_hole_faces() {
+    let c = complex();
+    let (crossed, wmax) = apatch::fixtures::crossed_boundary_faces(
+        &c,
+        24,
+        1e-12,
+        apatch::fixtures::SignScale::Complex,
+    );
+    eprintln!("{} crossed boundary faces, wmax {wmax:.3e}", crossed.len());
+    let mut by: std::collections::BTreeMap<String, usize> = Default::default();
+    for (k, opp) in crossed {
+        let p = &c.patches[k];
+        *by.entry(format!("{:?} opp {opp}", p.role)).or_default() += 1;
+        if p.role != Role::Edge {
+            continue;
+        }
+        let s = p.weights[apatch::bb::index_of([0, 0, 0, 5])].signum();
+        let others: Vec<usize> = (0..4).filter(|&x| x != opp).collect();
+        // Most negative (apex-side sign) point of F on the face.
+        let steps = 40;
+        let (mut worst, mut at) = (f64::INFINITY, [0.0; 4]);
+        for i in 0..=steps {
+            for j in 0..=steps - i {
+                let mut b = [0.0; 4];
+                b[others[0]] = i as f64 / steps as f64;
+                b[others[1]] = j as f64 / steps as f64;
+                b[others[2]] = (steps - i - j) as f64 / steps as f64;
+                let f = s * p.value_bary(b);
+                if f < worst {
+                    worst = f;
+                    at = b;
+                }
+            }
+        }
+        eprintln!(
+            "patch {k} el {} opp {opp}: min sF {worst:.3e} at {at:.2?}; weights (index: [l0 l1 l2 l3])",
+            p.element
+        );
+        // Rows: the first of the other corners (a point of T for opp = 0 or 1).
+        for a in (0..=5u8).rev() {
+            let mut line = format!("  {}^{a}:", others[0]);
+            for b in (0..=5 - a).rev() {
+                let mut l = [0u8; 4];
+                l[others[0]] = a;
+                l[others[1]] = b;
+                l[others[2]] = 5 - a - b;
+                let w = s * p.weights[apatch::bb::index_of(l)];
+                line += &format!(" {l:?}={w:+.2e}");
+            }
+            eprintln!("{line}");
+        }
+    }
+    eprintln!("{by:?}");
+}
+
+/// The hole repair on a small model with the knot's hole pattern: the 12×8 quad torus without
+/// `relax_stars` crosses hundreds of outer faces [p q s] of edge tetrahedra (its star weights,
+/// determined by the square star systems, miss their signs there). With `repair_holes` the
+/// late weights around each such face are re-solved with the face's weights pinned: fewer
+/// crossed faces by an independent sampling (not the scheme's own test), and the checker's
+/// C1/C2 measures unchanged in kind (the re-solve keeps every C1/C2 equation).
+#[test]
+#[ignore = "slow (107 s release): repair_holes is opt-in and no scene sets it yet"]
+fn repair_holes_reduces_the_torus_holes_and_keeps_c2() {
+    use apatch::check::{check, CheckOptions};
+    use apatch::mesh::{self, NormalMethod};
+    use apatch::scheme::quintic_c2::{build_with_stats, QuinticOptions};
+    let (m, _) = mesh::load(std::path::Path::new("scenes/models/torus_quad12x8.obj")).unwrap();
+    let normals = mesh::vertex_normals(&m, NormalMethod::default_for(&m)).unwrap();
+    let hull =
+        apatch::hull::inner::build(&m, &normals, &apatch::hull::inner::InnerOptions::default())
+            .unwrap();
+    let mut crossed = Vec::new();
+    for repair in [false, true] {
+        let o = QuinticOptions {
+            relax_stars: false,
+            repair_holes: repair,
+            ..QuinticOptions::default()
+        };
+        let (c, stats) = build_with_stats(&hull, &o).unwrap();
+        let r = check(&c, &CheckOptions::default());
+        // Issue 8's C2 acceptance on the checker's relative measures.
+        assert!(r.gradient_jump.worst <= 1e-9, "{:?}", r.gradient_jump);
+        assert!(r.hessian_jump.worst <= 1e-7, "{:?}", r.hessian_jump);
+        // A lattice of 15 steps; "zero" is 1e-12 of the largest weight (rounding of the
+        // degree-5 evaluation; F = 0 at the points of T on the faces).
+        let sampled = apatch::fixtures::crossed_boundary_faces(
+            &c,
+            15,
+            1e-12,
+            apatch::fixtures::SignScale::Complex,
+        )
+        .0
+        .len();
+        eprintln!(
+            "repair {repair}: {:?}, checker holes {:?}, sampled {sampled}, j-sheets {}",
+            stats.hole_repair, r.holes.crossing_by_role, r.sheets.j_multi_patches
+        );
+        crossed.push((r.holes.crossing, sampled, stats.hole_repair));
+    }
+    assert!(crossed[0].0 > 100 && crossed[0].1 > 100, "{crossed:?}");
+    assert!(crossed[1].2.repaired > 0, "{crossed:?}");
+    assert!(
+        crossed[1].0 < crossed[0].0 && crossed[1].1 < crossed[0].1,
+        "{crossed:?}"
+    );
+}
