@@ -209,8 +209,13 @@ fn spot_control_cage_merged_and_umbrella_normals() {
 /// from the split mesh).
 #[test]
 fn spot_control_cage_steep_corners_end_no_diagonal() {
+    // The split rules alone: the scene's `corner_search` re-cuts corners after them (104 among
+    // them, whose recut fan overlaps elsewhere), which is not what this test is about.
     let path = Path::new("scenes/pending/paper1994/spot_control_cage.toml");
-    let scene = apatch::scene::load(path).unwrap();
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("corner_search = true", "corner_search = false");
+    let scene = apatch::scene::parse(&text, path).unwrap();
     let hull = apatch::scene::inner_hull(&scene).unwrap().unwrap();
     let by_face = fan_points_by_face(&hull, 104);
     let mut faces: Vec<u32> = by_face.keys().copied().collect();
