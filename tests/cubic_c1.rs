@@ -208,31 +208,9 @@ fn torus_complexes() -> (
     (sc, hull, before, after)
 }
 
-/// Primary rays (160×160, 1 spp) of the scene's camera whose first hit faces away from the
-/// camera: a ray that meets the inside of the surface first went through a hole.
+/// Primary rays of the scene's camera whose first hit faces away: through a hole.
 fn back_facing_hits(sc: &apatch::scene::Scene, c: &apatch::complex::PatchComplex) -> usize {
-    use apatch::trace::{self, Geometry, Mode};
-    let geo = Geometry::new(c).unwrap();
-    let mut s = sc.settings.clone();
-    s.camera = s.camera.resized(160, 160).unwrap();
-    s.spp = 1;
-    s.threads = 1;
-    s.mode = Mode::Normal;
-    let origin = s.camera.origin;
-    let frame =
-        trace::render(&geo, &s, &|| {}, &std::sync::atomic::AtomicBool::new(false)).unwrap();
-    frame
-        .pixels
-        .iter()
-        .filter(|p| p.alpha > 0.0)
-        .filter(|p| {
-            let n = glam::DVec3::from(p.normal.map(f64::from));
-            let d = (glam::DVec3::from(p.position.map(f64::from)) - origin).normalize();
-            // Through a hole the first hit faces away clearly; grazing silhouette hits are
-            // within a few degrees of 0 (f32 normals).
-            n.dot(d) > 0.1
-        })
-        .count()
+    apatch::fixtures::back_facing_hits(&sc.settings, c).unwrap()
 }
 
 /// Rays from points inside the solid torus (within 0.1 of the tube's centre circle, radius 1;
