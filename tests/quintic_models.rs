@@ -259,7 +259,7 @@ fn c2_of(name: &str, min_group: usize) -> apatch::complex::PatchComplex {
 
 /// Exploration: `SCENE=path cargo test --release --test quintic_models crack_count -- --ignored
 /// --nocapture` prints the back-facing first hits of a scene (`tests/scenes_all.rs` requires
-/// none on every shipped scene).
+/// none on every shipped 1994 scene).
 #[test]
 #[ignore = "exploration: SCENE=path"]
 fn crack_count() {
