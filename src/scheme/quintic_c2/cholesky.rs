@@ -16,8 +16,6 @@
 
 use super::dense::Solution;
 use super::sparse::Row;
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 /// Squared distance of a unit row from the span of the rows before it below which it is taken
 /// as dependent: exact dependencies leave pivots at the rounding of the elimination (≲ 1e-15
@@ -28,15 +26,6 @@ pub const DEPENDENT_PIVOT: f64 = 1e-13;
 /// (nearly dependent equations whose pivots are mostly rounding): rows within 3e-5 of the span
 /// of the rows before them are dropped; whether they are met shows in the residual.
 pub const RETRY_PIVOT: f64 = 1e-9;
-
-/// Largest group (equations) ordered by the exact minimum degree with explicit cliques
-/// ([`min_degree`]); larger ones use the quotient graph
-/// ([`super::ordering::quotient_min_degree`]), whose cost does not grow with the cliques (the
-/// exact order did not finish spot's relaxed group of 972k equations). Below it the exact order
-/// is kept: the groups that build today (double_torus_poly 43k–70k, bunny 96k, knot 156k,
-/// spot 170k) keep their bits, and on double_torus_poly's third group the approximate order
-/// left a nearly dependent row undropped (residual 4.7e-6 instead of 9.8e-13, one more pass).
-pub const QUOTIENT_LIMIT: usize = 200_000;
 
 /// Rounds of iterative refinement after the first solve.
 const REFINE: usize = 4;
@@ -80,68 +69,6 @@ impl Factor {
     }
 }
 
-/// Minimum-degree elimination order of the graph `adj` (sorted neighbour lists without the
-/// node itself) and the pattern of L's columns it gives (each node's neighbours when it is
-/// eliminated), sorted by elimination position.
-pub(crate) fn min_degree(mut adj: Vec<Vec<u32>>) -> (Vec<u32>, Vec<Vec<u32>>, Vec<usize>) {
-    let m = adj.len();
-    let mut heap: BinaryHeap<Reverse<(usize, u32)>> =
-        (0..m).map(|v| Reverse((adj[v].len(), v as u32))).collect();
-    let mut done = vec![false; m];
-    let mut order = Vec::with_capacity(m);
-    let mut pattern: Vec<Vec<u32>> = vec![Vec::new(); m];
-    let mut merged: Vec<u32> = Vec::new();
-    while let Some(Reverse((deg, v))) = heap.pop() {
-        let vi = v as usize;
-        if done[vi] || deg != adj[vi].len() {
-            continue;
-        }
-        done[vi] = true;
-        order.push(v);
-        let nb = std::mem::take(&mut adj[vi]);
-        // The neighbours become a clique: adj[u] ∪ nb \ {u, v}.
-        for &u in &nb {
-            let au = &adj[u as usize];
-            merged.clear();
-            let (mut i, mut j) = (0, 0);
-            while i < au.len() || j < nb.len() {
-                let next = match (au.get(i), nb.get(j)) {
-                    (Some(&a), Some(&b)) if a == b => {
-                        i += 1;
-                        j += 1;
-                        a
-                    }
-                    (Some(&a), Some(&b)) if a < b => {
-                        i += 1;
-                        a
-                    }
-                    (Some(_), Some(&b)) => {
-                        j += 1;
-                        b
-                    }
-                    (Some(&a), None) => {
-                        i += 1;
-                        a
-                    }
-                    (None, Some(&b)) => {
-                        j += 1;
-                        b
-                    }
-                    (None, None) => unreachable!(),
-                };
-                if next != u && next != v {
-                    merged.push(next);
-                }
-            }
-            adj[u as usize].clone_from(&merged);
-            heap.push(Reverse((merged.len(), u)));
-        }
-        pattern[vi] = nb;
-    }
-    let pos = sort_by_position(&order, &mut pattern);
-    (order, pattern, pos)
-}
-
 /// Each node's position in the elimination `order`; sorts every column pattern by it.
 fn sort_by_position(order: &[u32], pattern: &mut [Vec<u32>]) -> Vec<usize> {
     let mut pos = vec![0usize; order.len()];
@@ -174,13 +101,8 @@ fn symbolic(m: usize, off: &[(u32, u32, f64)]) -> Symbolic {
         a.dedup();
     }
     let t = std::time::Instant::now();
-    let (order, pattern, pos) = if m > QUOTIENT_LIMIT {
-        let (order, mut pattern) = super::ordering::quotient_min_degree(adj);
-        let pos = sort_by_position(&order, &mut pattern);
-        (order, pattern, pos)
-    } else {
-        min_degree(adj)
-    };
+    let (order, mut pattern) = super::ordering::quotient_min_degree(adj);
+    let pos = sort_by_position(&order, &mut pattern);
     if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
         // Opt-in timing of the ordering on stderr (exploration; results unaffected).
         let nnz: usize = pattern.iter().map(Vec::len).sum();
