@@ -90,7 +90,7 @@ fn edge_hole_faces() {
 /// crossed faces by an independent sampling (not the scheme's own test), and the checker's
 /// C1/C2 measures unchanged in kind (the re-solve keeps every C1/C2 equation).
 #[test]
-#[ignore = "slow (107 s release): repair_holes is opt-in and no scene sets it yet"]
+#[ignore = "slow (107 s release): repair_holes is opt-in; only the pending knot scene sets it"]
 fn repair_holes_reduces_the_torus_holes_and_keeps_c2() {
     use apatch::check::{check, CheckOptions};
     use apatch::mesh::{self, NormalMethod};
