@@ -407,6 +407,22 @@ fn repair_face(
     for (j, &s) in unk.iter().enumerate() {
         trial[s as usize] = x[j];
     }
+    // The checker measures jumps relative to the local size of F: each re-solved equation's
+    // residual relative to its own terms may not grow past what it was and the staged solve's
+    // standard (on the nut, residuals small against the group's largest datum still gave
+    // Hessian jumps of 6.5e-7 where F is small).
+    let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
+    let worst = |value: &[f64]| {
+        eqs.iter()
+            .map(|&e| sys.relative_residual(e as usize, value, wmax))
+            .fold(0.0, f64::max)
+    };
+    let limit = worst(value).max(super::system::NEAR_NULL_RESIDUAL);
+    let grown = worst(&trial);
+    if grown.is_nan() || grown > limit {
+        trace(|| format!("face {t}/{opp}: relative residual {grown:.2e} > {limit:.2e}"));
+        return None;
+    }
     let after = crossed_now(&trial);
     if after.contains(&(t, opp)) || after.iter().any(|f| !before.contains(f)) {
         trace(|| {

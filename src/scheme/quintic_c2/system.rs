@@ -482,7 +482,7 @@ const NEAR_NULL: u8 = 7;
 /// met is kept: the 1e-9 a consistent group is held to ([`consistent`]). (On the nut with
 /// curvature 0.4 a pass at 2.6e-8 gave Hessian jumps of 2.3e-7; the kept passes measure
 /// 7.3e-10 and 9.8e-10 and give 8e-9.)
-const NEAR_NULL_RESIDUAL: f64 = 1e-9;
+pub(super) const NEAR_NULL_RESIDUAL: f64 = 1e-9;
 
 /// The condition Σ_i y_i·(known part of equation `eqs[i]`) = 0 over the weights outside the
 /// group (`col`): what the known weights must meet so that the group's right-hand side has no
@@ -720,16 +720,22 @@ impl System {
     /// so a residual small against the largest weight can still be a jump where F is small.
     fn scheme_residual(&self, value: &[f64]) -> f64 {
         let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
-        self.equations
-            .iter()
-            .map(|eq| {
-                let (r, size) = eq.terms.iter().fold((0.0, 0.0), |(r, size), (s, c)| {
-                    let x = value[*s as usize];
-                    (r + c * x, size + c.abs() * x.abs().max(1e-12 * wmax))
-                });
-                r.abs() / size
-            })
+        (0..self.equations.len())
+            .map(|e| self.relative_residual(e, value, wmax))
             .fold(0.0, f64::max)
+    }
+
+    /// Equation `e`'s residual in `value` relative to the size of its terms, as
+    /// [`Self::scheme_residual`] measures it (`wmax`: the largest |weight|).
+    pub(super) fn relative_residual(&self, e: usize, value: &[f64], wmax: f64) -> f64 {
+        let (r, size) = self.equations[e]
+            .terms
+            .iter()
+            .fold((0.0, 0.0), |(r, size), (s, c)| {
+                let x = value[*s as usize];
+                (r + c * x, size + c.abs() * x.abs().max(1e-12 * wmax))
+            });
+        r.abs() / size
     }
 
     /// Whether slot `s` misses Theorem 2.1's sign in `value` (`tiny`: zero up to rounding).
