@@ -40,7 +40,7 @@ mod faces;
 pub mod holes;
 mod interp;
 mod report;
-mod sheets;
+pub(crate) mod sheets;
 pub mod tjunction;
 
 use crate::complex::PatchComplex;

@@ -59,7 +59,7 @@ fn merge(a: SheetStats, b: SheetStats) -> SheetStats {
 
 /// Interior lattice points of the simplex on `verts` (tetrahedron-local indices), `res` steps per
 /// edge, as barycentric 4-vectors; a single vertex gives itself.
-fn simplex_lattice(verts: &[u8], res: usize) -> Vec<[f64; 4]> {
+pub(crate) fn simplex_lattice(verts: &[u8], res: usize) -> Vec<[f64; 4]> {
     let res = res.max(verts.len() + 1);
     let mut out = Vec::new();
     let mut put = |w: &[usize]| {
@@ -211,7 +211,15 @@ fn interior_roots_beyond_one(
     b: &[f64; 4],
     n: usize,
 ) -> Option<f64> {
-    let (mut c, mut len, _) = segment(e, a, b);
+    let (c, len, _) = segment(e, a, b);
+    roots_beyond_one(c, len, n)
+}
+
+/// `Some(first root)` when the univariate Bernstein polynomial `c[..len]` on [0, 1] has more
+/// than one root in (0, 1) once roots at the ends are divided out (see
+/// [`interior_roots_beyond_one`]); shared with the quintic scheme's repair, which must judge
+/// a patch's j-lines as this check does.
+pub(crate) fn roots_beyond_one(mut c: [f64; 16], mut len: usize, n: usize) -> Option<f64> {
     let scale = c[..len].iter().fold(0.0f64, |m, x| m.max(x.abs()));
     // An end coefficient this small relative to the rest is a root at the end (the j-vertex on
     // the surface, a zero-convex edge): 1e-12 is far above the round-off of the weights (1e-16

@@ -296,6 +296,7 @@ pub fn build_with_stats(
             // Exploration overrides (`APATCH_HOLE_RINGS`, `APATCH_HOLE_STARS=0`); the defaults
             // are the measured best on the torus (docs/quintic.md).
             stars: std::env::var("APATCH_HOLE_STARS").map_or(true, |v| v != "0"),
+            hessians: std::env::var("APATCH_HOLE_HESSIANS").is_ok_and(|v| v != "0"),
         };
         stats.hole_repair = holes::repair(&sys, &tets, &mut value, reach);
         if std::env::var_os("APATCH_SIGN_TRACE").is_some() {

@@ -1,5 +1,5 @@
-//! Local repair of holes: boundary faces of the hull that the solved surface crosses
-//! (`QuinticOptions::repair_holes`).
+//! Local repair of holes, boundary faces of the hull that the solved surface crosses, and of
+//! j-sheets, patches it crosses twice along a j-line (`QuinticOptions::repair_holes`).
 //!
 //! A boundary face of the hull (the outer faces [p q s] of edge tetrahedra, the base of a
 //! single-sided face tetrahedron) has no tetrahedron on its other side, so where F takes both
@@ -20,10 +20,18 @@
 //! pass are tried again with one and two more rings ([`WIDEN`]). On the knot: 107 crossed
 //! faces; hard pins at 2 rings leave 20, widened 14, with weighted pins 0 (48 repairs, 10
 //! of them weighted).
+//!
+//! A j-sheet is repaired the same way with every signed weight of the patch lifted to its
+//! sign (Theorem 2.1: then every j-line crosses once), judged by [`j_sheeted`] on the
+//! checker's j-lines. A boundary face or j-patch of the re-solved tetrahedra that a solution
+//! turns defective joins the defect (its weights are lifted too, and the group solved again)
+//! instead of refusing the repair at once.
 
 use super::dense;
 use super::system::{HullTet, System};
 use crate::bb::{multi_indices, poly};
+use crate::check::sheets::{roots_beyond_one, simplex_lattice};
+use crate::complex::Role;
 use std::collections::{HashMap, HashSet};
 
 /// What [`repair`] did.
@@ -41,6 +49,20 @@ pub struct HoleRepair {
     pub widened: usize,
     /// Of the repairs kept, those whose pins were met only as weighted targets ([`SOFT`]).
     pub soft: usize,
+    /// Patches crossed twice along a j-line ([`j_sheeted`]) after the solve.
+    pub sheets_before: usize,
+    /// Of those, patches whose repair was kept.
+    pub sheets_repaired: usize,
+    /// Patches crossed twice along a j-line after the repairs.
+    pub sheets_after: usize,
+}
+
+/// What one repair mends: a crossed boundary face (tetrahedron, local opposite vertex), or a
+/// patch crossed twice along one of its j-lines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Defect {
+    Face(u32, usize),
+    Sheet(u32),
 }
 
 /// How far a repair reaches from the crossed face.
@@ -52,6 +74,9 @@ pub struct Reach {
     /// Also re-solve the star and edge-middle weights of the points one ring less (with the
     /// jets held): the square star systems then gain the freedom of their edge middles.
     pub stars: bool,
+    /// Also re-solve the Hessians of those points' jets (their number 2 weights, moving as
+    /// one symmetric matrix each; the values and normals held).
+    pub hessians: bool,
 }
 
 /// Lattice steps per edge at which a boundary face is sampled for a sign change ([`crossed`]):
@@ -74,6 +99,11 @@ pub const WIDEN: usize = 2;
 /// and 1e3 leaves two: the weights square the condition of the local group, and at 1e3 its
 /// residual (2.6e-9 of the data) missed the 1e-9 consistency standard.
 const SOFT: f64 = 1e2;
+/// Lattice steps per edge at which [`j_sheeted`] draws j-lines: twice the checker's 5
+/// (`CheckOptions::sheet_resolution`), so its lines are among them.
+const SHEET_RES: usize = 10;
+/// Samples per j-line where Descartes' rule does not decide (the checker's `line_samples`).
+const LINE_SAMPLES: usize = 48;
 /// Rounds of pinning per face (each pins the conditions the previous solution newly misses).
 const ROUNDS: usize = 8;
 /// A repair may not grow any re-solved weight beyond this multiple of the largest before.
@@ -142,6 +172,35 @@ pub fn crossed(weights: &[f64], opp: usize) -> bool {
     false
 }
 
+/// Whether F with the 56 `weights` of a tetrahedron of `role` meets zero more than once along
+/// a j-line: from the apex (local vertex 3) of a face tetrahedron through its base, or from
+/// the edge of T (local 0–1) of an edge tetrahedron to the opposite edge, judged as
+/// `apatch check` judges them ([`SHEET_RES`] lattice). Other roles promise no j-lines.
+#[must_use]
+pub fn j_sheeted(weights: &[f64], role: Role) -> bool {
+    let (from, to) = match role {
+        Role::Face => (
+            simplex_lattice(&[3], SHEET_RES),
+            simplex_lattice(&[0, 1, 2], SHEET_RES),
+        ),
+        Role::Edge => (
+            simplex_lattice(&[0, 1], SHEET_RES),
+            simplex_lattice(&[2, 3], SHEET_RES),
+        ),
+        _ => return false,
+    };
+    if weights.iter().all(|&w| w >= 0.0) || weights.iter().all(|&w| w <= 0.0) {
+        return false;
+    }
+    from.iter().any(|a| {
+        to.iter().any(|b| {
+            let mut c = [0.0; 16];
+            let len = poly::restrict(5, weights, *a, *b, &mut c);
+            roots_beyond_one(c, len, LINE_SAMPLES).is_some()
+        })
+    })
+}
+
 /// Repairs the crossed boundary faces of the solved `value` (slots of `sys`) in place, one at
 /// a time in tetrahedron order (see the module documentation).
 #[must_use]
@@ -155,13 +214,26 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
         .copied()
         .filter(|f| is_crossed(f, value))
         .collect();
+    let is_sheet = |t: u32, value: &[f64]| j_sheeted(&weights(t, value), tets[t as usize].role);
+    let sheets: Vec<u32> = (0..tets.len() as u32)
+        .filter(|&t| is_sheet(t, value))
+        .collect();
     let mut out = HoleRepair {
         crossed_before: holes.len(),
+        sheets_before: sheets.len(),
         ..HoleRepair::default()
     };
-    if holes.is_empty() {
+    if holes.is_empty() && sheets.is_empty() {
         return out;
     }
+    let defects: Vec<Defect> = holes
+        .iter()
+        .map(|&(t, opp)| Defect::Face(t, opp))
+        .chain(sheets.iter().map(|&t| Defect::Sheet(t)))
+        .collect();
+    // Equations are judged relative to the size of F, as the checker does: the largest weight
+    // of the solve (the repairs are small against it).
+    let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
     // Indexes: tetrahedra of each point of T, boundary faces of each tetrahedron, equations
     // of each slot.
     let mut tets_of: HashMap<u32, Vec<u32>> = HashMap::new();
@@ -186,23 +258,27 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
             rings: reach.rings + extra,
             ..reach
         };
-        for &(t, opp) in &holes {
-            if !is_crossed(&(t, opp), value) {
-                // Repaired with an earlier face, or in an earlier pass.
+        for &defect in &defects {
+            let open = match defect {
+                Defect::Face(t, opp) => is_crossed(&(t, opp), value),
+                Defect::Sheet(t) => is_sheet(t, value),
+            };
+            if !open {
+                // Repaired with an earlier defect, or in an earlier pass.
                 continue;
             }
-            if let Some((pinned, soft)) = repair_face(
-                sys,
-                tets,
-                value,
-                (t, opp),
-                &tets_of,
-                &faces_of,
-                &eqs_of,
-                &mi,
-                reach,
-            ) {
-                out.repaired += 1;
+            let index = Index {
+                tets_of: &tets_of,
+                faces_of: &faces_of,
+                eqs_of: &eqs_of,
+                mi: &mi,
+                wmax,
+            };
+            if let Some((pinned, soft)) = repair_defect(sys, tets, value, defect, &index, reach) {
+                match defect {
+                    Defect::Face(..) => out.repaired += 1,
+                    Defect::Sheet(_) => out.sheets_repaired += 1,
+                }
                 out.pinned += pinned;
                 out.widened += usize::from(extra > 0);
                 out.soft += usize::from(soft);
@@ -210,25 +286,50 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
         }
     }
     out.crossed_after = boundary.iter().filter(|f| is_crossed(f, value)).count();
+    out.sheets_after = (0..tets.len() as u32)
+        .filter(|&t| is_sheet(t, value))
+        .count();
     out
 }
 
-/// One face's repair; `Some(pins)` when kept (and `value` updated).
-#[allow(clippy::too_many_arguments)]
-fn repair_face(
+/// The lookups [`repair_defect`] shares across defects.
+struct Index<'a> {
+    /// Tetrahedra at each point of T.
+    tets_of: &'a HashMap<u32, Vec<u32>>,
+    /// Local opposite vertices of each tetrahedron's boundary faces.
+    faces_of: &'a HashMap<u32, Vec<usize>>,
+    /// Equations each slot appears in.
+    eqs_of: &'a [Vec<u32>],
+    /// Multi-indices of degree 5.
+    mi: &'a [[u8; 4]],
+    /// Largest weight of the solve.
+    wmax: f64,
+}
+
+/// One defect's repair; `Some((pins, soft))` when kept (and `value` updated).
+fn repair_defect(
     sys: &System,
     tets: &[HullTet],
     value: &mut [f64],
-    (t, opp): (u32, usize),
-    tets_of: &HashMap<u32, Vec<u32>>,
-    faces_of: &HashMap<u32, Vec<usize>>,
-    eqs_of: &[Vec<u32>],
-    mi: &[[u8; 4]],
+    defect: Defect,
+    index: &Index<'_>,
     reach: Reach,
 ) -> Option<(usize, bool)> {
+    let Index {
+        tets_of,
+        faces_of,
+        eqs_of,
+        mi,
+        wmax,
+    } = *index;
     let np = sys.np;
+    let (t, opp) = match defect {
+        Defect::Face(t, opp) => (t, opp),
+        // The whole patch: no local vertex is left out.
+        Defect::Sheet(t) => (t, 4),
+    };
     let tet = &tets[t as usize];
-    // Points of T within `reach` edges of the face's points.
+    // Points of T within `reach` edges of the defect's points.
     let mut ring: Vec<u32> = (0..4)
         .filter(|&k| k != opp && tet.gid[k] < np)
         .map(|k| tet.gid[k])
@@ -269,6 +370,9 @@ fn repair_face(
             if hull.clone().all(|p| p.1 <= 1) {
                 return true;
             }
+            if reach.hessians && hessian_point(&parts, np, &inner).is_some() {
+                return true;
+            }
             reach.stars
                 && hull.clone().all(|p| p.1 <= 2)
                 && hull.filter(|p| p.1 == 2).all(|p| inner.contains(&p.0))
@@ -280,13 +384,52 @@ fn repair_face(
         return None;
     }
     let col: HashMap<u32, usize> = unk.iter().enumerate().map(|(i, &s)| (s, i)).collect();
+    // With `hessians`, the number 2 weights of each inner point p move together as its jet's
+    // Hessian does: one more unknown per entry of the change δH (target 0), and for each
+    // such weight b at p, a, b' the equation b − (a − p)ᵀ δH (b' − p)/20 = its value now.
+    let mut hess_rows: Vec<(Vec<(usize, f64)>, f64)> = Vec::new();
+    let mut hess_col: HashMap<u32, usize> = HashMap::new();
+    if reach.hessians {
+        let mut pos: HashMap<u32, glam::DVec3> = HashMap::new();
+        for &k in &near {
+            for (g, p) in tets[k as usize].gid.iter().zip(tets[k as usize].pts) {
+                pos.insert(*g, p);
+            }
+        }
+        for (j, &s) in unk.iter().enumerate() {
+            let parts = super::system::unkey(sys.keys[s as usize]);
+            let Some(p) = hessian_point(&parts, np, &inner) else {
+                continue;
+            };
+            let next = unk.len() + 6 * hess_col.len();
+            let base = *hess_col.entry(p).or_insert(next);
+            let at = pos[&p];
+            let others: Vec<glam::DVec3> = parts
+                .iter()
+                .filter(|q| q.0 != p)
+                .flat_map(|q| std::iter::repeat_n(pos[&q.0] - at, usize::from(q.1)))
+                .collect();
+            let (u, v) = (others[0], others[1]);
+            let coef = [
+                u.x * v.x,
+                u.x * v.y + u.y * v.x,
+                u.x * v.z + u.z * v.x,
+                u.y * v.y,
+                u.y * v.z + u.z * v.y,
+                u.z * v.z,
+            ];
+            let mut row = vec![(j, 1.0)];
+            row.extend(coef.iter().enumerate().map(|(e, c)| (base + e, -c / 20.0)));
+            hess_rows.push((row, value[s as usize]));
+        }
+    }
     let mut eqs: Vec<u32> = unk
         .iter()
         .flat_map(|&s| eqs_of[s as usize].iter().copied())
         .collect();
     eqs.sort_unstable();
     eqs.dedup();
-    let n = unk.len();
+    let n = unk.len() + 6 * hess_col.len();
     let mut rows: Vec<Vec<(usize, f64)>> = Vec::with_capacity(eqs.len());
     let mut c: Vec<f64> = Vec::with_capacity(eqs.len());
     for &e in &eqs {
@@ -301,7 +444,12 @@ fn repair_face(
         rows.push(row);
         c.push(rhs);
     }
-    let x0: Vec<f64> = unk.iter().map(|&s| value[s as usize]).collect();
+    for (row, rhs) in hess_rows {
+        rows.push(row);
+        c.push(rhs);
+    }
+    let mut x0: Vec<f64> = unk.iter().map(|&s| value[s as usize]).collect();
+    x0.resize(n, 0.0);
     let scale = c.iter().chain(&x0).fold(1e-300_f64, |a, x| a.max(x.abs()));
     let bound = GROWTH * scale;
     // The boundary faces of the re-solved tetrahedra and whether each is crossed now.
@@ -317,6 +465,14 @@ fn repair_face(
             .collect()
     };
     let before = crossed_now(value);
+    // The j-patches among them crossed twice along a j-line now.
+    let sheets_now = |value: &[f64]| -> HashSet<u32> {
+        near.iter()
+            .copied()
+            .filter(|&k| j_sheeted(&sys.weights(k as usize, value), tets[k as usize].role))
+            .collect()
+    };
+    let sheets_before = sheets_now(value);
     // Sign conditions: every late slot on a boundary face of the re-solved tetrahedra with a
     // sign from Theorem 2.1 (its face's weights), the crossed face's misses pinned first, then
     // whatever a solution newly misses among the ones met before.
@@ -343,6 +499,21 @@ fn repair_face(
             }
         }
     }
+    // The defect's own weights: a crossed face's, or every signed weight of a patch crossed
+    // twice along a j-line (Theorem 2.1's signs make every j-line cross once).
+    let hole_slots: HashSet<u32> = match defect {
+        Defect::Face(..) => face_slots(t, opp).into_iter().collect(),
+        Defect::Sheet(_) => {
+            let own = &sys.slot_of[t as usize];
+            let m = MARGIN * own.iter().fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()));
+            for &s in own {
+                if col.contains_key(&s) && has_sign(s) {
+                    watched.push((s, m));
+                }
+            }
+            own.iter().copied().collect()
+        }
+    };
     watched.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
     watched.dedup_by_key(|w| w.0);
     let tiny = ZERO * scale;
@@ -351,26 +522,108 @@ fn repair_face(
         .filter(|&&(s, _)| sign(s) * value[s as usize] >= -tiny)
         .map(|w| w.0)
         .collect();
-    let hole_slots: HashSet<u32> = face_slots(t, opp).into_iter().collect();
     let mut pins: Vec<(usize, f64)> = Vec::new();
     let mut pinned: HashSet<u32> = HashSet::new();
     let mut x = x0.clone();
     let mut soft = false;
-    for _ in 0..ROUNDS {
+    // The weights lifted to the margin: the defect's, then those of any boundary face or
+    // j-patch a solution turns defective (they join the defect instead of refusing it).
+    let mut lifted = hole_slots;
+    let mut trial = value.to_vec();
+    let mut solves = 0;
+    loop {
         let miss: Vec<(u32, f64)> = watched
             .iter()
             .copied()
             .filter(|&(s, _)| !pinned.contains(&s))
             .filter(|&(s, m)| {
-                // The crossed face's weights are lifted to the margin; the others only kept
-                // from turning.
+                // The lifted weights go to the margin; the others are only kept from turning.
                 let v = sign(s) * x[col[&s]];
-                (hole_slots.contains(&s) && v < m) || (met_before.contains(&s) && v < -tiny)
+                (lifted.contains(&s) && v < m) || (met_before.contains(&s) && v < -tiny)
             })
             .collect();
         if miss.is_empty() {
-            break;
+            if pins.is_empty() {
+                trace(|| format!("{defect:?}: nothing to pin among {n} unknowns"));
+                return None;
+            }
+            // Kept only when the defect is gone and no other boundary face or j-patch of the
+            // re-solved tetrahedra turned defective; those that did join the defect.
+            for (j, &s) in unk.iter().enumerate() {
+                trial[s as usize] = x[j];
+            }
+            let still = match defect {
+                Defect::Face(..) => crossed(&sys.weights(t as usize, &trial), opp),
+                Defect::Sheet(_) => j_sheeted(&sys.weights(t as usize, &trial), tet.role),
+            };
+            if still {
+                trace(|| {
+                    // What the re-solve cannot reach: the defect's weights held (data, or
+                    // beyond the reach) with the wrong sign, and those without a sign.
+                    let held_wrong = lifted
+                        .iter()
+                        .filter(|s| !col.contains_key(s))
+                        .filter(|&&s| has_sign(s) && sign(s) * trial[s as usize] < -tiny)
+                        .count();
+                    let unsigned = lifted.iter().filter(|&&s| !has_sign(s)).count();
+                    format!(
+                        "{defect:?}: {} pins; still there ({held_wrong} held weights with the wrong sign, {unsigned} without a sign)",
+                        pins.len()
+                    )
+                });
+                return None;
+            }
+            let new_faces: Vec<(u32, usize)> = crossed_now(&trial)
+                .into_iter()
+                .filter(|f| !before.contains(f))
+                .collect();
+            let new_sheets: Vec<u32> = sheets_now(&trial)
+                .into_iter()
+                .filter(|k| !sheets_before.contains(k))
+                .collect();
+            if new_faces.is_empty() && new_sheets.is_empty() {
+                break;
+            }
+            let mut grew = false;
+            for &(k, o) in &new_faces {
+                let m = MARGIN * face_scale(k, o, value);
+                for s in face_slots(k, o) {
+                    if col.contains_key(&s) && has_sign(s) {
+                        grew |= lifted.insert(s);
+                        watched.push((s, m));
+                    }
+                }
+            }
+            for &k in &new_sheets {
+                let own = &sys.slot_of[k as usize];
+                let m = MARGIN * own.iter().fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()));
+                for &s in own {
+                    if col.contains_key(&s) && has_sign(s) {
+                        grew |= lifted.insert(s);
+                        watched.push((s, m));
+                    }
+                }
+            }
+            watched.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
+            watched.dedup_by_key(|w| w.0);
+            if !grew || solves == ROUNDS {
+                trace(|| {
+                    format!(
+                        "{defect:?}: {} pins; newly crossed faces {}, new j-sheets {}",
+                        pins.len(),
+                        new_faces.len(),
+                        new_sheets.len()
+                    )
+                });
+                return None;
+            }
+            continue;
         }
+        if solves == ROUNDS {
+            trace(|| format!("{defect:?}: {} pins; rounds used up", pins.len()));
+            return None;
+        }
+        solves += 1;
         for (s, m) in miss {
             pinned.insert(s);
             pins.push((col[&s], sign(s) * m));
@@ -386,7 +639,7 @@ fn repair_face(
             if !ok(&sol) {
                 trace(|| {
                     format!(
-                        "face {t}/{opp}: {n} unknowns, {} equations, {} pins: residual {hard:.2e} of {scale:.2e} (soft {:.2e}), largest {:.2e}",
+                        "{defect:?}: {n} unknowns, {} equations, {} pins: residual {hard:.2e} of {scale:.2e} (soft {:.2e}), largest {:.2e}",
                         rows.len(),
                         pins.len(),
                         sol.residual,
@@ -399,19 +652,10 @@ fn repair_face(
         }
         x = sol.x;
     }
-    if pins.is_empty() {
-        trace(|| format!("face {t}/{opp}: nothing to pin among {n} unknowns"));
-        return None;
-    }
-    let mut trial = value.to_vec();
-    for (j, &s) in unk.iter().enumerate() {
-        trial[s as usize] = x[j];
-    }
     // The checker measures jumps relative to the local size of F: each re-solved equation's
     // residual relative to its own terms may not grow past what it was and the staged solve's
     // standard (on the nut, residuals small against the group's largest datum still gave
     // Hessian jumps of 6.5e-7 where F is small).
-    let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
     let worst = |value: &[f64]| {
         eqs.iter()
             .map(|&e| sys.relative_residual(e as usize, value, wmax))
@@ -420,25 +664,21 @@ fn repair_face(
     let limit = worst(value).max(super::system::NEAR_NULL_RESIDUAL);
     let grown = worst(&trial);
     if grown.is_nan() || grown > limit {
-        trace(|| format!("face {t}/{opp}: relative residual {grown:.2e} > {limit:.2e}"));
-        return None;
-    }
-    let after = crossed_now(&trial);
-    if after.contains(&(t, opp)) || after.iter().any(|f| !before.contains(f)) {
-        trace(|| {
-            format!(
-                "face {t}/{opp}: {} pins; still crossed {}, newly crossed {}",
-                pins.len(),
-                after.contains(&(t, opp)),
-                after.iter().filter(|f| !before.contains(f)).count()
-            )
-        });
+        trace(|| format!("{defect:?}: relative residual {grown:.2e} > {limit:.2e}"));
         return None;
     }
     for (j, &s) in unk.iter().enumerate() {
         value[s as usize] = x[j];
     }
     Some((pins.len(), soft))
+}
+
+/// The point of T whose number 2 weight the slot with key `parts` is (multiplicity 3 there,
+/// the other two indices elsewhere) when that point is in `inner`: the weights whose jet a
+/// repair with [`Reach::hessians`] re-solves.
+fn hessian_point(parts: &[(u32, u8)], np: u32, inner: &HashSet<u32>) -> Option<u32> {
+    let p = parts.iter().find(|q| q.1 == 3)?;
+    (p.0 < np && inner.contains(&p.0)).then_some(p.0)
 }
 
 /// The weights closest to `x0` that meet `rows`·x = `c` and the pins x_j = v.
@@ -512,6 +752,42 @@ fn trace(msg: impl FnOnce() -> String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Weights that depend only on the level (λ_3 for a face tetrahedron, λ_2 + λ_3 for an
+    /// edge tetrahedron) make F a univariate Bernstein polynomial in the level with those
+    /// coefficients, the same on every j-line. Levels 1, −3, 1, 1, 1, 1: F(0) = F(1) = 1 and
+    /// F(0.2) ≈ −0.64, two roots on every line; 1, −3, −1, −1, −1, −1: one sign change, one
+    /// root (Descartes). A tetrahedron of another role promises no j-lines.
+    #[test]
+    fn j_sheets_are_two_roots_along_the_j_lines() {
+        let mi = multi_indices(5);
+        let by_level = |g: [f64; 6], role: Role| -> Vec<f64> {
+            mi.iter()
+                .map(|l| match role {
+                    Role::Edge => g[usize::from(l[2] + l[3])],
+                    _ => g[usize::from(l[3])],
+                })
+                .collect()
+        };
+        let two = [1.0, -3.0, 1.0, 1.0, 1.0, 1.0];
+        let one = [1.0, -3.0, -1.0, -1.0, -1.0, -1.0];
+        for role in [Role::Face, Role::Edge] {
+            assert!(j_sheeted(&by_level(two, role), role), "{role:?}");
+            assert!(!j_sheeted(&by_level(one, role), role), "{role:?}");
+        }
+        assert!(!j_sheeted(&by_level(two, Role::Face), Role::Vertex));
+        // F = g(λ_0) with the first g has roots at λ_0 ≈ 0.066 and 0.409: a j-line of the
+        // face tetrahedron runs from the apex (λ_0 = 0) to a base point with λ_0 up to 0.8
+        // on the lattice, so some j-lines cross twice; so do the edge tetrahedron's, from its
+        // edge of T (local 0–1, λ_0 up to 0.9 on the lattice) to the opposite edge (λ_0 = 0).
+        let across: Vec<f64> = mi.iter().map(|l| two[usize::from(l[0])]).collect();
+        assert!(j_sheeted(&across, Role::Face));
+        assert!(j_sheeted(&across, Role::Edge));
+        // With the one-root levels along λ_0, F has one root in λ_0 ∈ [0, 1]: no line of
+        // the tetrahedron crosses twice.
+        let once: Vec<f64> = mi.iter().map(|l| one[usize::from(l[0])]).collect();
+        assert!(!j_sheeted(&once, Role::Face) && !j_sheeted(&once, Role::Edge));
+    }
 
     /// One equation x0 = x1. Hard pins x0 = 1, x1 = −1 contradict it; as targets of equal
     /// weight they meet halfway, x0 = x1 = 0, and the unpinned x2 keeps its value. With x0
