@@ -32,6 +32,7 @@ use super::system::{HullTet, System};
 use crate::bb::{multi_indices, poly};
 use crate::check::sheets::{roots_beyond_one, simplex_lattice};
 use crate::complex::Role;
+use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 
 /// What [`repair`] did.
@@ -258,24 +259,79 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
             rings: reach.rings + extra,
             ..reach
         };
-        for &defect in &defects {
-            let open = match defect {
+        let index = Index {
+            tets_of: &tets_of,
+            faces_of: &faces_of,
+            eqs_of: &eqs_of,
+            mi: &mi,
+            wmax,
+        };
+        // The defects still open (earlier passes repaired some), with their neighbourhoods.
+        let open: Vec<Local> = defects
+            .par_iter()
+            .filter(|d| match **d {
                 Defect::Face(t, opp) => is_crossed(&(t, opp), value),
                 Defect::Sheet(t) => is_sheet(t, value),
-            };
-            if !open {
-                // Repaired with an earlier defect, or in an earlier pass.
-                continue;
+            })
+            .filter_map(|&d| neighbourhood(sys, tets, d, &index, reach))
+            .collect();
+        let reads: Vec<Vec<u32>> = open.par_iter().map(|l| l.reads(sys)).collect();
+        // Waves: in defect order, a defect joins the wave unless it writes what a defect
+        // before it (in the wave, or left for a later wave) reads, or reads what one writes.
+        // Members of a wave touch nothing of each other's, and every defect still comes after
+        // each earlier one it touches, so the waves give the one-by-one result, bit for bit,
+        // on any number of threads.
+        let mut left: Vec<usize> = (0..open.len()).collect();
+        let mut read_mark = vec![false; sys.keys.len()];
+        let mut write_mark = vec![false; sys.keys.len()];
+        while !left.is_empty() {
+            let mut wave = Vec::new();
+            let mut later = Vec::new();
+            for &i in &left {
+                let l = &open[i];
+                let clash = l.unk.iter().any(|&s| read_mark[s as usize])
+                    || reads[i].iter().any(|&s| write_mark[s as usize]);
+                if !clash {
+                    wave.push(i);
+                } else {
+                    later.push(i);
+                }
+                for &s in &reads[i] {
+                    read_mark[s as usize] = true;
+                }
+                for &s in &l.unk {
+                    write_mark[s as usize] = true;
+                }
             }
-            let index = Index {
-                tets_of: &tets_of,
-                faces_of: &faces_of,
-                eqs_of: &eqs_of,
-                mi: &mi,
-                wmax,
-            };
-            if let Some((pinned, soft)) = repair_defect(sys, tets, value, defect, &index, reach) {
-                match defect {
+            for &i in &left {
+                reads[i].iter().for_each(|&s| read_mark[s as usize] = false);
+                open[i]
+                    .unk
+                    .iter()
+                    .for_each(|&s| write_mark[s as usize] = false);
+            }
+            let snapshot: &[f64] = value;
+            let kept: Vec<Option<(Vec<f64>, usize, bool)>> = wave
+                .par_iter()
+                .map(|&i| {
+                    let still = match open[i].defect {
+                        Defect::Face(t, opp) => is_crossed(&(t, opp), snapshot),
+                        Defect::Sheet(t) => is_sheet(t, snapshot),
+                    };
+                    // Repaired with an earlier defect.
+                    still
+                        .then(|| repair_defect(sys, tets, snapshot, &open[i], &index, reach))
+                        .flatten()
+                })
+                .collect();
+            for (&i, k) in wave.iter().zip(kept) {
+                let Some((x, pinned, soft)) = k else {
+                    continue;
+                };
+                for (&s, v) in open[i].unk.iter().zip(x) {
+                    value[s as usize] = v;
+                }
+                match open[i].defect {
                     Defect::Face(..) => out.repaired += 1,
                     Defect::Sheet(_) => out.sheets_repaired += 1,
                 }
@@ -283,6 +339,7 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
                 out.widened += usize::from(extra > 0);
                 out.soft += usize::from(soft);
             }
+            left = later;
         }
     }
     out.crossed_after = boundary.iter().filter(|f| is_crossed(f, value)).count();
@@ -306,21 +363,52 @@ struct Index<'a> {
     wmax: f64,
 }
 
-/// One defect's repair; `Some((pins, soft))` when kept (and `value` updated).
-fn repair_defect(
+/// The neighbourhood a defect's repair re-solves: which weights it may write and which it
+/// reads, fixed by the hull alone (not by the values), so that repairs whose neighbourhoods
+/// do not touch can run at once and give what they give one after the other.
+struct Local {
+    defect: Defect,
+    /// Points of T one ring less than the reach (their stars, with `Reach::hessians` their
+    /// jets' Hessians, are re-solved).
+    inner: HashSet<u32>,
+    /// The tetrahedra around the points within reach, sorted.
+    near: Vec<u32>,
+    /// The re-solved slots, sorted.
+    unk: Vec<u32>,
+    /// Every equation a re-solved slot appears in, sorted.
+    eqs: Vec<u32>,
+}
+
+impl Local {
+    /// Slots the repair reads: the near tetrahedra's (their faces and j-lines are judged) and
+    /// every term of its equations.
+    fn reads(&self, sys: &System) -> Vec<u32> {
+        let mut r: Vec<u32> = self
+            .near
+            .iter()
+            .flat_map(|&k| sys.slot_of[k as usize].iter().copied())
+            .chain(
+                self.eqs
+                    .iter()
+                    .flat_map(|&e| sys.equations[e as usize].terms.iter().map(|t| t.0)),
+            )
+            .collect();
+        r.sort_unstable();
+        r.dedup();
+        r
+    }
+}
+
+/// The neighbourhood of `defect` at `reach`; `None` when it has no slot to re-solve.
+fn neighbourhood(
     sys: &System,
     tets: &[HullTet],
-    value: &mut [f64],
     defect: Defect,
     index: &Index<'_>,
     reach: Reach,
-) -> Option<(usize, bool)> {
+) -> Option<Local> {
     let Index {
-        tets_of,
-        faces_of,
-        eqs_of,
-        mi,
-        wmax,
+        tets_of, eqs_of, ..
     } = *index;
     let np = sys.np;
     let (t, opp) = match defect {
@@ -383,6 +471,47 @@ fn repair_defect(
     if unk.is_empty() {
         return None;
     }
+    let mut eqs: Vec<u32> = unk
+        .iter()
+        .flat_map(|&s| eqs_of[s as usize].iter().copied())
+        .collect();
+    eqs.sort_unstable();
+    eqs.dedup();
+    Some(Local {
+        defect,
+        inner,
+        near,
+        unk,
+        eqs,
+    })
+}
+
+/// One defect's repair on `value` within `local`: the re-solved values of `local.unk`, the
+/// pins and whether they were weighted, when kept.
+fn repair_defect(
+    sys: &System,
+    tets: &[HullTet],
+    value: &[f64],
+    local: &Local,
+    index: &Index<'_>,
+    reach: Reach,
+) -> Option<(Vec<f64>, usize, bool)> {
+    let Index {
+        faces_of, mi, wmax, ..
+    } = *index;
+    let np = sys.np;
+    let Local {
+        defect,
+        ref inner,
+        ref near,
+        ref unk,
+        ref eqs,
+    } = *local;
+    let (t, opp) = match defect {
+        Defect::Face(t, opp) => (t, opp),
+        Defect::Sheet(t) => (t, 4),
+    };
+    let tet = &tets[t as usize];
     let col: HashMap<u32, usize> = unk.iter().enumerate().map(|(i, &s)| (s, i)).collect();
     // With `hessians`, the number 2 weights of each inner point p move together as its jet's
     // Hessian does: one more unknown per entry of the change δH (target 0), and for each
@@ -391,14 +520,14 @@ fn repair_defect(
     let mut hess_col: HashMap<u32, usize> = HashMap::new();
     if reach.hessians {
         let mut pos: HashMap<u32, glam::DVec3> = HashMap::new();
-        for &k in &near {
+        for &k in near {
             for (g, p) in tets[k as usize].gid.iter().zip(tets[k as usize].pts) {
                 pos.insert(*g, p);
             }
         }
         for (j, &s) in unk.iter().enumerate() {
             let parts = super::system::unkey(sys.keys[s as usize]);
-            let Some(p) = hessian_point(&parts, np, &inner) else {
+            let Some(p) = hessian_point(&parts, np, inner) else {
                 continue;
             };
             let next = unk.len() + 6 * hess_col.len();
@@ -423,16 +552,10 @@ fn repair_defect(
             hess_rows.push((row, value[s as usize]));
         }
     }
-    let mut eqs: Vec<u32> = unk
-        .iter()
-        .flat_map(|&s| eqs_of[s as usize].iter().copied())
-        .collect();
-    eqs.sort_unstable();
-    eqs.dedup();
     let n = unk.len() + 6 * hess_col.len();
     let mut rows: Vec<Vec<(usize, f64)>> = Vec::with_capacity(eqs.len());
     let mut c: Vec<f64> = Vec::with_capacity(eqs.len());
-    for &e in &eqs {
+    for &e in eqs {
         let mut row = Vec::new();
         let mut rhs = 0.0;
         for &(s, k) in &sys.equations[e as usize].terms {
@@ -505,7 +628,10 @@ fn repair_defect(
         Defect::Face(..) => face_slots(t, opp).into_iter().collect(),
         Defect::Sheet(_) => {
             let own = &sys.slot_of[t as usize];
-            let m = MARGIN * own.iter().fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()));
+            let m = MARGIN
+                * own
+                    .iter()
+                    .fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()));
             for &s in own {
                 if col.contains_key(&s) && has_sign(s) {
                     watched.push((s, m));
@@ -565,10 +691,26 @@ fn repair_defect(
                         .filter(|s| !col.contains_key(s))
                         .filter(|&&s| has_sign(s) && sign(s) * trial[s as usize] < -tiny)
                         .count();
-                    let unsigned = lifted.iter().filter(|&&s| !has_sign(s)).count();
+                    let big = lifted
+                        .iter()
+                        .fold(0.0_f64, |a, &s| a.max(trial[s as usize].abs()));
+                    let unsigned: Vec<String> = lifted
+                        .iter()
+                        .filter(|&&s| !has_sign(s))
+                        .map(|&s| {
+                            format!(
+                                "{:?} req {} {:.1e}",
+                                super::system::unkey(sys.keys[s as usize]),
+                                sys.req[s as usize],
+                                trial[s as usize] / big
+                            )
+                        })
+                        .collect();
                     format!(
-                        "{defect:?}: {} pins; still there ({held_wrong} held weights with the wrong sign, {unsigned} without a sign)",
-                        pins.len()
+                        "{defect:?}: {} pins; still there ({held_wrong} held weights with the wrong sign; without a sign: {unsigned:?}), side {:?} role {:?}",
+                        pins.len(),
+                        tet.side,
+                        tet.role
                     )
                 });
                 return None;
@@ -596,7 +738,10 @@ fn repair_defect(
             }
             for &k in &new_sheets {
                 let own = &sys.slot_of[k as usize];
-                let m = MARGIN * own.iter().fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()));
+                let m = MARGIN
+                    * own
+                        .iter()
+                        .fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()));
                 for &s in own {
                     if col.contains_key(&s) && has_sign(s) {
                         grew |= lifted.insert(s);
@@ -667,10 +812,8 @@ fn repair_defect(
         trace(|| format!("{defect:?}: relative residual {grown:.2e} > {limit:.2e}"));
         return None;
     }
-    for (j, &s) in unk.iter().enumerate() {
-        value[s as usize] = x[j];
-    }
-    Some((pins.len(), soft))
+    x.truncate(unk.len());
+    Some((x, pins.len(), soft))
 }
 
 /// The point of T whose number 2 weight the slot with key `parts` is (multiplicity 3 there,
