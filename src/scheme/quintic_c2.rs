@@ -81,10 +81,11 @@ pub struct QuinticOptions {
     /// before the star (edge middles) is imposed, as `consistent_stars` does for exact
     /// dependencies, so the star's weights do not follow their data's noise amplified by 1/σ.
     pub star_tau: f64,
-    /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2) of the
-    /// tetrahedra around every boundary face the surface crosses (a hole), with all their
-    /// C1/C2 equations and the face's weights pinned to Theorem 2.1's signs ([`holes`]): C2
-    /// is kept exactly and nothing changes away from holes. Off by default.
+    /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2, and the
+    /// stars one ring in) of the tetrahedra around every boundary face the surface crosses (a
+    /// hole) and every patch it crosses twice along a j-line (a j-sheet), with all their
+    /// C1/C2 equations and the defect's weights pinned to Theorem 2.1's signs ([`holes`]): C2
+    /// is kept exactly and nothing changes away from the defects. Off by default.
     pub repair_holes: bool,
 }
 
