@@ -86,12 +86,13 @@ fn edge_hole_faces() {
 /// The hole repair on a small model with the knot's hole pattern: the 12×8 quad torus without
 /// `relax_stars` crosses hundreds of outer faces [p q s] of edge tetrahedra (its star weights,
 /// determined by the square star systems, miss their signs there). With `repair_holes` the
-/// late weights around each such face are re-solved with the face's weights pinned: fewer
-/// crossed faces by an independent sampling (not the scheme's own test), and the checker's
-/// C1/C2 measures unchanged in kind (the re-solve keeps every C1/C2 equation), and no more
-/// patches crossed twice along a j-line than before.
+/// late weights around each such face are re-solved with the face's weights pinned: no
+/// crossed face left, by the checker and by an independent sampling (not the scheme's own
+/// test; session 12's repair left 93 of 384, session 10's 196), the checker's C1/C2 measures
+/// within issue 8's bounds (the re-solve keeps every C1/C2 equation), and no more patches
+/// crossed twice along a j-line than before.
 #[test]
-#[ignore = "slow (107 s release): repair_holes is opt-in; only the pending knot scene sets it"]
+#[ignore = "slow (64 s release): repair_holes is opt-in; the knot's scene sets it"]
 fn repair_holes_reduces_the_torus_holes_and_keeps_c2() {
     use apatch::check::{check, CheckOptions};
     use apatch::mesh::{self, NormalMethod};
@@ -136,10 +137,7 @@ fn repair_holes_reduces_the_torus_holes_and_keeps_c2() {
     }
     assert!(crossed[0].0 > 100 && crossed[0].1 > 100, "{crossed:?}");
     assert!(crossed[1].2.repaired > 0, "{crossed:?}");
-    assert!(
-        crossed[1].0 < crossed[0].0 && crossed[1].1 < crossed[0].1,
-        "{crossed:?}"
-    );
+    assert!(crossed[1].0 == 0 && crossed[1].1 == 0, "{crossed:?}");
     // The repair also judges j-sheets: it may not add any (the checker's count).
     assert!(crossed[1].3 <= crossed[0].3, "{crossed:?}");
 }

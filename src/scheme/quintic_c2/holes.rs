@@ -610,19 +610,26 @@ fn repair_defect(
             .map(|(i, _)| sys.slot_of[k as usize][i])
             .collect()
     };
-    let face_scale = |k: u32, o: usize, value: &[f64]| {
-        face_slots(k, o)
+    // The largest weight among `slots` (before the repair), and: watch the signed re-solved
+    // ones of `slots` with margin `m`, returning those.
+    let largest = |slots: &[u32]| {
+        slots
             .iter()
             .fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()))
     };
+    let watch = |watched: &mut Vec<(u32, f64)>, slots: &[u32], m: f64| -> Vec<u32> {
+        let signed: Vec<u32> = slots
+            .iter()
+            .copied()
+            .filter(|s| col.contains_key(s) && has_sign(*s))
+            .collect();
+        watched.extend(signed.iter().map(|&s| (s, m)));
+        signed
+    };
     let mut watched: Vec<(u32, f64)> = Vec::new();
     for &(k, o) in &faces {
-        let m = MARGIN * face_scale(k, o, value);
-        for s in face_slots(k, o) {
-            if col.contains_key(&s) && has_sign(s) {
-                watched.push((s, m));
-            }
-        }
+        let slots = face_slots(k, o);
+        watch(&mut watched, &slots, MARGIN * largest(&slots));
     }
     // The defect's own weights: a crossed face's, or every signed weight of a patch crossed
     // twice along a j-line (Theorem 2.1's signs make every j-line cross once).
@@ -630,15 +637,7 @@ fn repair_defect(
         Defect::Face(..) => face_slots(t, opp).into_iter().collect(),
         Defect::Sheet(_) => {
             let own = &sys.slot_of[t as usize];
-            let m = MARGIN
-                * own
-                    .iter()
-                    .fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()));
-            for &s in own {
-                if col.contains_key(&s) && has_sign(s) {
-                    watched.push((s, m));
-                }
-            }
+            watch(&mut watched, own, MARGIN * largest(own));
             own.iter().copied().collect()
         }
     };
@@ -729,26 +728,13 @@ fn repair_defect(
                 break;
             }
             let mut grew = false;
-            for &(k, o) in &new_faces {
-                let m = MARGIN * face_scale(k, o, value);
-                for s in face_slots(k, o) {
-                    if col.contains_key(&s) && has_sign(s) {
-                        grew |= lifted.insert(s);
-                        watched.push((s, m));
-                    }
-                }
-            }
-            for &k in &new_sheets {
-                let own = &sys.slot_of[k as usize];
-                let m = MARGIN
-                    * own
-                        .iter()
-                        .fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()));
-                for &s in own {
-                    if col.contains_key(&s) && has_sign(s) {
-                        grew |= lifted.insert(s);
-                        watched.push((s, m));
-                    }
+            let turned = new_faces
+                .iter()
+                .map(|&(k, o)| face_slots(k, o))
+                .chain(new_sheets.iter().map(|&k| sys.slot_of[k as usize].to_vec()));
+            for slots in turned {
+                for s in watch(&mut watched, &slots, MARGIN * largest(&slots)) {
+                    grew |= lifted.insert(s);
                 }
             }
             watched.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
