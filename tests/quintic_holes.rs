@@ -143,9 +143,9 @@ fn repair_holes_reduces_the_torus_holes_and_keeps_c2() {
 }
 
 /// The repair's j-sheet half and its parallel waves, on a small model: letter_P_poly's quintic
-/// without `hessian_signs` has patches crossed twice along j-lines (and crossed boundary faces
-/// whose misses are Hessian data the repair does not reach). With `repair_holes` the checker
-/// finds no j-sheet, no more crossed faces than before, and C1/C2 within issue 8's bounds; and
+/// without `hessian_signs` has patches crossed twice along j-lines and crossed base faces
+/// whose weights are jets and stars. With `repair_holes` the checker finds no j-sheet, no more
+/// crossed faces, and everything else within issue 8's bounds; and
 /// the repaired weights are the same, bit for bit, on one thread and on four (the waves run
 /// only repairs that touch nothing of each other's together).
 #[test]
@@ -179,16 +179,14 @@ fn repair_mends_letter_p_j_sheets_on_any_thread_count() {
     let after = check(&one, &CheckOptions::default());
     assert!(before.sheets.j_multi_patches > 0, "{:?}", before.sheets);
     assert_eq!(after.sheets.j_multi_patches, 0, "{:?}", after.sheets);
+    // The base faces' weights are jets and stars, which the default passes do not free (the
+    // opt-in Hessian passes take 28 -> 10): no more crossed faces than before.
     assert!(
         after.holes.crossing <= before.holes.crossing,
         "{:?}",
         after.holes
     );
-    // Issue 8's C2 acceptance on the checker's relative measures.
-    assert!(
-        after.gradient_jump.worst <= 1e-9,
-        "{:?}",
-        after.gradient_jump
-    );
-    assert!(after.hessian_jump.worst <= 1e-7, "{:?}", after.hessian_jump);
+    // Everything else passes: C1/C2 within issue 8's bounds, vertex values and normals still
+    // interpolated.
+    assert_eq!(after.failures(), ["holes"], "{after:?}");
 }
