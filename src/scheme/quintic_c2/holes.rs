@@ -108,7 +108,7 @@ const SOFT: f64 = 1e2;
 const SOFT_MAX: f64 = 1e4;
 
 /// Whether the last two passes free the Hessians (`APATCH_HOLE_HESSIAN_PASSES=1`; off by
-/// default: on letter_P_poly they repair 7 more base faces but take the check from 5 s to
+/// default: on letter_P_poly they repair 7 more base faces but take the check from 2 s to
 /// 5 min in one slow sparse group, not yet understood; the bunny: 1 more face).
 fn hessian_passes() -> bool {
     std::env::var("APATCH_HOLE_HESSIAN_PASSES").is_ok_and(|v| v != "0")
@@ -252,6 +252,10 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
     if holes.is_empty() && sheets.is_empty() {
         return out;
     }
+    let is_open = |d: Defect, value: &[f64]| match d {
+        Defect::Face(t, opp) => is_crossed(&(t, opp), value),
+        Defect::Sheet(t) => is_sheet(t, value),
+    };
     let defects: Vec<Defect> = holes
         .iter()
         .map(|&(t, opp)| Defect::Face(t, opp))
@@ -308,10 +312,7 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
         // The defects still open (earlier passes repaired some), with their neighbourhoods.
         let open: Vec<Local> = defects
             .par_iter()
-            .filter(|d| match **d {
-                Defect::Face(t, opp) => is_crossed(&(t, opp), value),
-                Defect::Sheet(t) => is_sheet(t, value),
-            })
+            .filter(|&&d| is_open(d, value))
             .filter_map(|&d| neighbourhood(sys, tets, d, &index, reach))
             .collect();
         let reads: Vec<Vec<u32>> = open.par_iter().map(|l| l.reads(sys)).collect();
@@ -353,12 +354,8 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
             let kept: Vec<Option<(Vec<f64>, usize, bool)>> = wave
                 .par_iter()
                 .map(|&i| {
-                    let still = match open[i].defect {
-                        Defect::Face(t, opp) => is_crossed(&(t, opp), snapshot),
-                        Defect::Sheet(t) => is_sheet(t, snapshot),
-                    };
                     // Repaired with an earlier defect.
-                    still
+                    is_open(open[i].defect, snapshot)
                         .then(|| repair_defect(sys, tets, snapshot, &open[i], &index, reach))
                         .flatten()
                 })
