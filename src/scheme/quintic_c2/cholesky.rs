@@ -82,52 +82,76 @@ fn sort_by_position(order: &[u32], pattern: &mut [Vec<u32>]) -> Vec<usize> {
 }
 
 /// Elimination order, L's column patterns (sorted by elimination position) and each node's
-/// position, computed once per group and shared by both drop thresholds of [`solve_near`].
-struct Symbolic {
+/// position: the symbolic factorisation of Â Âᵀ, which depends only on which columns each row
+/// touches. Computed once per group ([`Ordering::of`]) and shared by every solve on rows with
+/// the same or fewer entries (both drop thresholds of one solve; the repeated solves of one
+/// hole repair, whose pins only move columns to the right-hand side).
+pub struct Ordering {
     order: Vec<u32>,
     pattern: Vec<Vec<u32>>,
     pos: Vec<usize>,
 }
 
-/// The ordering of the symmetric matrix with `m` nodes and strictly off-diagonal entries `off`.
-fn symbolic(m: usize, off: &[(u32, u32, f64)]) -> Symbolic {
-    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); m];
-    for &(i, k, _) in off {
-        adj[i as usize].push(k);
-        adj[k as usize].push(i);
-    }
-    for a in &mut adj {
-        a.sort_unstable();
-        a.dedup();
-    }
-    let t = std::time::Instant::now();
-    let (order, mut pattern) = super::ordering::quotient_min_degree(adj);
-    let pos = sort_by_position(&order, &mut pattern);
-    if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
-        // Opt-in timing of the ordering on stderr (exploration; results unaffected).
-        let nnz: usize = pattern.iter().map(Vec::len).sum();
-        eprintln!(
-            "quintic-c2 cholesky: {m} nodes, {} off-diagonal, ordering {:.2} s, nnz(L) {nnz}",
-            off.len(),
-            t.elapsed().as_secs_f64()
-        );
-    }
-    Symbolic {
-        order,
-        pattern,
-        pos,
+impl Ordering {
+    /// The ordering for the rows' structure (`n` unknowns): rows sharing a column are
+    /// neighbours, whatever their values (an entry that cancels in one solve may not in the
+    /// next).
+    #[must_use]
+    pub fn of(rows: &[Row], n: usize) -> Ordering {
+        let m = rows.len();
+        let mut by_col: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for (i, r) in rows.iter().enumerate() {
+            for &(j, _) in r {
+                by_col[j].push(i as u32);
+            }
+        }
+        let mut adj: Vec<Vec<u32>> = vec![Vec::new(); m];
+        for list in &mut by_col {
+            list.dedup();
+            for (a, &i) in list.iter().enumerate() {
+                for &k in &list[a + 1..] {
+                    adj[i as usize].push(k);
+                    adj[k as usize].push(i);
+                }
+            }
+        }
+        for a in &mut adj {
+            a.sort_unstable();
+            a.dedup();
+        }
+        let t = std::time::Instant::now();
+        let (order, mut pattern) = super::ordering::quotient_min_degree(adj);
+        let pos = sort_by_position(&order, &mut pattern);
+        if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
+            // Opt-in timing of the ordering on stderr (exploration; results unaffected).
+            let nnz: usize = pattern.iter().map(Vec::len).sum();
+            eprintln!(
+                "quintic-c2 cholesky: {m} nodes, ordering {:.2} s, nnz(L) {nnz}",
+                t.elapsed().as_secs_f64()
+            );
+        }
+        Ordering {
+            order,
+            pattern,
+            pos,
+        }
     }
 }
 
 /// Factors the symmetric matrix given by its diagonal `d` and strictly off-diagonal entries
 /// `off` (each pair once, (i, k, value)) in the order `sym`, dropping pivots below `drop` × the
 /// original diagonal. Returns the factor and the number of dropped nodes.
-fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Symbolic) -> (Factor, usize) {
+///
+/// Left-looking: each column gathers the updates of the columns before it that reach it into
+/// one dense accumulator, so the work is the multiply-adds plus one pass over each column's
+/// pattern (a right-looking update scatters the target's whole pattern for every source column
+/// and cost ~20× the multiply-adds on the repair's groups with freed Hessians).
+fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Ordering) -> (Factor, usize) {
     let m = d.len();
     let order = sym.order.clone();
-    let pattern = sym.pattern.clone();
+    let pattern = &sym.pattern;
     let pos = &sym.pos;
-    // Values of the (partially updated) matrix on each column's pattern.
+    // A's entries below the diagonal, on each column's pattern.
     let mut vals: Vec<Vec<f64>> = pattern.iter().map(|p| vec![0.0; p.len()]).collect();
     for &(i, k, a) in off {
         let (v, u) = if pos[i as usize] < pos[k as usize] {
@@ -143,49 +167,54 @@ fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Symbolic) -> (Fac
     }
     let mut diag: Vec<f64> = d.to_vec();
     let mut dropped = 0;
-    // Scatter: node → index in the current target column's pattern.
-    let mut slot = vec![usize::MAX; m];
+    // Dense accumulator over nodes, zero outside the current column's pattern.
+    let mut acc = vec![0.0; m];
+    // For each node, the finished columns whose next entry below the diagonal is that node,
+    // with the index of that entry: the columns that update it, each met once.
+    let mut links: Vec<Vec<(u32, u32)>> = vec![Vec::new(); m];
     for &v in &order {
         let vi = v as usize;
-        let piv = diag[vi];
+        let pv = &pattern[vi];
+        for (a, &w) in pv.iter().enumerate() {
+            acc[w as usize] = vals[vi][a];
+        }
+        let mut piv = diag[vi];
+        for (j, at) in std::mem::take(&mut links[vi]) {
+            let (pj, lj) = (&pattern[j as usize], &vals[j as usize]);
+            let at = at as usize;
+            let l = lj[at];
+            piv -= l * l;
+            for (&w, &lw) in pj[at + 1..].iter().zip(&lj[at + 1..]) {
+                acc[w as usize] -= l * lw;
+            }
+            if at + 1 < pj.len() {
+                links[pj[at + 1] as usize].push((j, at as u32 + 1));
+            }
+        }
         // NaN pivots count as dependent too.
         if piv.is_nan() || piv <= drop * d[vi].max(f64::MIN_POSITIVE) {
             diag[vi] = 0.0;
+            for &w in pv {
+                acc[w as usize] = 0.0;
+            }
             vals[vi].iter_mut().for_each(|x| *x = 0.0);
             dropped += 1;
             continue;
         }
         let l = piv.sqrt();
         diag[vi] = l;
-        let col: Vec<f64> = vals[vi].iter().map(|x| x / l).collect();
-        let pv = &pattern[vi];
-        for (a, &u) in pv.iter().enumerate() {
-            let lu = col[a];
-            if lu == 0.0 {
-                continue;
-            }
-            let ui = u as usize;
-            diag[ui] -= lu * lu;
-            if a + 1 == pv.len() {
-                continue;
-            }
-            for (b, &w) in pattern[ui].iter().enumerate() {
-                slot[w as usize] = b;
-            }
-            let target = &mut vals[ui];
-            for (bb, &w) in pv.iter().enumerate().skip(a + 1) {
-                target[slot[w as usize]] -= lu * col[bb];
-            }
-            for &w in &pattern[ui] {
-                slot[w as usize] = usize::MAX;
-            }
+        for (a, &w) in pv.iter().enumerate() {
+            vals[vi][a] = acc[w as usize] / l;
+            acc[w as usize] = 0.0;
         }
-        vals[vi] = col;
+        if let Some(&first) = pv.first() {
+            links[first as usize].push((v, 0));
+        }
     }
     let cols = pattern
-        .into_iter()
+        .iter()
         .zip(vals)
-        .map(|(p, v)| p.into_iter().zip(v).collect())
+        .map(|(p, v)| p.iter().copied().zip(v).collect())
         .collect();
     (Factor { order, cols, diag }, dropped)
 }
@@ -195,7 +224,22 @@ fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Symbolic) -> (Fac
 /// [`Solution::rank`] is the number of equations less the dropped dependent ones.
 #[must_use]
 pub fn solve_near(rows: &[Row], n: usize, c: &[f64], target: &[f64], tol: f64) -> Solution {
+    solve_near_ordered(rows, n, c, target, tol, &Ordering::of(rows, n))
+}
+
+/// [`solve_near`] in a given `ordering`, one made for these rows or for rows with more
+/// entries ([`Ordering::of`]).
+#[must_use]
+pub fn solve_near_ordered(
+    rows: &[Row],
+    n: usize,
+    c: &[f64],
+    target: &[f64],
+    tol: f64,
+    ordering: &Ordering,
+) -> Solution {
     let m = rows.len();
+    debug_assert_eq!(ordering.order.len(), m);
     // Unit-norm rows with merged duplicate columns.
     let mut arows: Vec<Vec<(u32, f64)>> = Vec::with_capacity(m);
     let mut cs = Vec::with_capacity(m);
@@ -271,9 +315,8 @@ pub fn solve_near(rows: &[Row], n: usize, c: &[f64], target: &[f64], tol: f64) -
     let mut r = vec![0.0; m];
     let res0 = residual_of(target, &mut r);
     let mut best = (res0, target.to_vec(), 0);
-    let sym = symbolic(m, &off);
     for drop in [DEPENDENT_PIVOT, RETRY_PIVOT] {
-        let (f, dropped) = factor(&d, &off, drop, &sym);
+        let (f, dropped) = factor(&d, &off, drop, ordering);
         let mut x = target.to_vec();
         let mut res = residual_of(&x, &mut r);
         let mut first_step_helped = false;

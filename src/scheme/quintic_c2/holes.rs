@@ -27,13 +27,14 @@
 //! turns defective joins the defect (its weights are lifted too, and the group solved again)
 //! instead of refusing the repair at once.
 
-use super::dense;
+use super::{cholesky, dense};
 use super::system::{HullTet, System};
 use crate::bb::{multi_indices, poly};
 use crate::check::sheets::{roots_beyond_one, simplex_lattice};
 use crate::complex::Role;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
+use std::sync::OnceLock;
 
 /// What [`repair`] did.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -50,8 +51,8 @@ pub struct HoleRepair {
     pub widened: usize,
     /// Of the repairs kept, those whose pins were met only as weighted targets ([`SOFT`]).
     pub soft: usize,
-    /// Of the repairs kept, those of the last pass, with the Hessians of the jets free
-    /// ([`Reach::hessians`]).
+    /// Of the repairs kept, those of the two last (opt-in) passes, with the Hessians of the
+    /// jets free ([`Reach::hessians`]).
     pub hessian: usize,
     /// Patches crossed twice along a j-line ([`j_sheeted`]) after the solve.
     pub sheets_before: usize,
@@ -67,6 +68,25 @@ pub struct HoleRepair {
 enum Defect {
     Face(u32, usize),
     Sheet(u32),
+}
+
+impl Defect {
+    /// The defect's tetrahedron and the local vertex its face leaves out (4 for a j-sheet:
+    /// the whole patch, no vertex left out).
+    fn at(self) -> (u32, usize) {
+        match self {
+            Defect::Face(t, opp) => (t, opp),
+            Defect::Sheet(t) => (t, 4),
+        }
+    }
+
+    /// Whether the defect is there with `weights`, its tetrahedron's, of role `role`.
+    fn open_in(self, weights: &[f64], role: Role) -> bool {
+        match self {
+            Defect::Face(_, opp) => crossed(weights, opp),
+            Defect::Sheet(_) => j_sheeted(weights, role),
+        }
+    }
 }
 
 /// How far a repair reaches from the crossed face.
@@ -252,9 +272,9 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
     if holes.is_empty() && sheets.is_empty() {
         return out;
     }
-    let is_open = |d: Defect, value: &[f64]| match d {
-        Defect::Face(t, opp) => is_crossed(&(t, opp), value),
-        Defect::Sheet(t) => is_sheet(t, value),
+    let is_open = |d: Defect, value: &[f64]| {
+        let t = d.at().0;
+        d.open_in(&weights(t, value), tets[t as usize].role)
     };
     let defects: Vec<Defect> = holes
         .iter()
@@ -448,11 +468,7 @@ fn neighbourhood(
         tets_of, eqs_of, ..
     } = *index;
     let np = sys.np;
-    let (t, opp) = match defect {
-        Defect::Face(t, opp) => (t, opp),
-        // The whole patch: no local vertex is left out.
-        Defect::Sheet(t) => (t, 4),
-    };
+    let (t, opp) = defect.at();
     let tet = &tets[t as usize];
     // Points of T within `reach` edges of the defect's points.
     let mut ring: Vec<u32> = (0..4)
@@ -544,10 +560,7 @@ fn repair_defect(
         ref unk,
         ref eqs,
     } = *local;
-    let (t, opp) = match defect {
-        Defect::Face(t, opp) => (t, opp),
-        Defect::Sheet(t) => (t, 4),
-    };
+    let t = defect.at().0;
     let tet = &tets[t as usize];
     let col: HashMap<u32, usize> = unk.iter().enumerate().map(|(i, &s)| (s, i)).collect();
     // With `hessians`, the number 2 weights of each inner point p move together as its jet's
@@ -669,7 +682,7 @@ fn repair_defect(
     // The defect's own weights: a crossed face's, or every signed weight of a patch crossed
     // twice along a j-line (Theorem 2.1's signs make every j-line cross once).
     let hole_slots: HashSet<u32> = match defect {
-        Defect::Face(..) => face_slots(t, opp).into_iter().collect(),
+        Defect::Face(_, opp) => face_slots(t, opp).into_iter().collect(),
         Defect::Sheet(_) => {
             let own = &sys.slot_of[t as usize];
             watch(&mut watched, own, MARGIN * largest(own));
@@ -691,6 +704,8 @@ fn repair_defect(
     // The weight of pins met only as targets, raised ([`SOFT_MAX`]) while the targets as
     // weighted leave the defect or a turned neighbour.
     let mut weight = SOFT;
+    // The sparse ordering of the group, made at its first sparse solve and kept for the rest.
+    let ordering = OnceLock::new();
     let ok = |sol: &dense::Solution| {
         // NaN-safe: a NaN residual or weight refuses the repair too.
         sol.residual <= CONSISTENT * scale && sol.x.iter().all(|v| v.abs() <= bound)
@@ -709,7 +724,7 @@ fn repair_defect(
         }
         *weight *= 10.0;
         *solves += 1;
-        let sol = solve_soft(&rows, &c, pins, n, &x0, *weight);
+        let sol = solve_soft(&rows, &c, pins, n, &x0, *weight, &ordering);
         ok_soft(&sol).then_some(sol.x)
     };
     // The weights lifted to the margin: the defect's, then those of any boundary face or
@@ -738,10 +753,7 @@ fn repair_defect(
             for (j, &s) in unk.iter().enumerate() {
                 trial[s as usize] = x[j];
             }
-            let still = match defect {
-                Defect::Face(..) => crossed(&sys.weights(t as usize, &trial), opp),
-                Defect::Sheet(_) => j_sheeted(&sys.weights(t as usize, &trial), tet.role),
-            };
+            let still = defect.open_in(&sys.weights(t as usize, &trial), tet.role);
             if still {
                 if soft {
                     if let Some(y) = heavier(&mut weight, &mut solves, &pins) {
@@ -832,10 +844,10 @@ fn repair_defect(
             pinned.insert(s);
             pins.push((col[&s], sign(s) * m));
         }
-        let mut sol = solve(&rows, &c, &pins, n, &x0);
+        let mut sol = solve(&rows, &c, &pins, n, &x0, &ordering);
         if !ok(&sol) {
             let hard = sol.residual;
-            sol = solve_soft(&rows, &c, &pins, n, &x0, weight);
+            sol = solve_soft(&rows, &c, &pins, n, &x0, weight, &ordering);
             if !ok_soft(&sol) {
                 trace(|| {
                     format!(
@@ -880,23 +892,55 @@ fn hessian_point(parts: &[(u32, u8)], np: u32, inner: &HashSet<u32>) -> Option<u
 }
 
 /// The weights closest to `x0` that meet `rows`·x = `c` and the pins x_j = v.
+///
+/// Large groups are solved sparsely in `ordering` (made once per repair from the rows without
+/// pins, [`cholesky::Ordering::of`]): the pinned unknowns leave the rows for the right-hand
+/// side, which keeps the structure within the ordering's and gives the same closest point
+/// (a pinned weight's change is fixed).
 fn solve(
     rows: &[Vec<(usize, f64)>],
     c: &[f64],
     pins: &[(usize, f64)],
     n: usize,
     x0: &[f64],
+    ordering: &OnceLock<cholesky::Ordering>,
 ) -> dense::Solution {
     let m = rows.len() + pins.len();
     if n > super::system::DENSE_LIMIT {
-        let mut all: Vec<super::sparse::Row> = rows.to_vec();
-        let mut rhs = c.to_vec();
+        let mut target = x0.to_vec();
+        let mut pinned = vec![false; n];
         for &(j, v) in pins {
-            all.push(vec![(j, 1.0)]);
-            rhs.push(v);
+            target[j] = v;
+            pinned[j] = true;
         }
-        let scale = rhs.iter().chain(x0).fold(1e-300_f64, |a, x| a.max(x.abs()));
-        return super::cholesky::solve_near(&all, n, &rhs, x0, 1e-13 * scale);
+        let mut rhs = c.to_vec();
+        let reduced: Vec<super::sparse::Row> = rows
+            .iter()
+            .zip(&mut rhs)
+            .map(|(row, r)| {
+                row.iter()
+                    .copied()
+                    .filter(|&(j, k)| {
+                        if pinned[j] {
+                            *r -= k * target[j];
+                        }
+                        !pinned[j]
+                    })
+                    .collect()
+            })
+            .collect();
+        let scale = c.iter().chain(x0).fold(1e-300_f64, |a, x| a.max(x.abs()));
+        let ordering = ordering.get_or_init(|| cholesky::Ordering::of(rows, n));
+        let mut sol =
+            cholesky::solve_near_ordered(&reduced, n, &rhs, &target, 1e-13 * scale, ordering);
+        // The residual of the rows as given (a row whose unknowns are all pinned is dropped
+        // from the reduced solve, but not from what the solution must meet).
+        sol.residual = rows
+            .iter()
+            .zip(c)
+            .map(|(row, &ci)| (row.iter().map(|&(j, k)| k * sol.x[j]).sum::<f64>() - ci).abs())
+            .fold(0.0_f64, |a, r| if r.is_nan() { f64::NAN } else { a.max(r) });
+        return sol;
     }
     let mut a = vec![0.0; m * n];
     let mut rhs = Vec::with_capacity(m);
@@ -915,7 +959,8 @@ fn solve(
 
 /// [`solve`] with the pins as targets weighted by `weight` ([`SOFT`] first) instead of
 /// equations: the weights closest to `x0` (pinned ones: to their pins) in the norm that counts
-/// a pinned weight's change `weight` times, meeting `rows`·x = `c`. Solved as the unweighted problem in y = W x.
+/// a pinned weight's change `weight` times, meeting `rows`·x = `c`. Solved as the unweighted
+/// problem in y = W x (same structure: the same `ordering`).
 fn solve_soft(
     rows: &[Vec<(usize, f64)>],
     c: &[f64],
@@ -923,6 +968,7 @@ fn solve_soft(
     n: usize,
     x0: &[f64],
     weight: f64,
+    ordering: &OnceLock<cholesky::Ordering>,
 ) -> dense::Solution {
     let mut w = vec![1.0; n];
     let mut y0 = x0.to_vec();
@@ -934,7 +980,7 @@ fn solve_soft(
         .iter()
         .map(|r| r.iter().map(|&(j, k)| (j, k / w[j])).collect())
         .collect();
-    let mut sol = solve(&scaled, c, &[], n, &y0);
+    let mut sol = solve(&scaled, c, &[], n, &y0, ordering);
     for (x, wj) in sol.x.iter_mut().zip(&w) {
         *x /= wj;
     }
@@ -996,14 +1042,14 @@ mod tests {
     fn soft_pins_meet_the_equations_and_come_closest() {
         let rows = vec![vec![(0, 1.0), (1, -1.0)]];
         let x0 = [0.0, 0.0, 7.0];
-        let hard = solve(&rows, &[0.0], &[(0, 1.0), (1, -1.0)], 3, &x0);
+        let hard = solve(&rows, &[0.0], &[(0, 1.0), (1, -1.0)], 3, &x0, &OnceLock::new());
         assert!(hard.residual > 0.5, "{hard:?}");
-        let s = solve_soft(&rows, &[0.0], &[(0, 1.0), (1, -1.0)], 3, &x0, SOFT);
+        let s = solve_soft(&rows, &[0.0], &[(0, 1.0), (1, -1.0)], 3, &x0, SOFT, &OnceLock::new());
         // Rounding of a 3-unknown QR (entries O(SOFT)).
         assert!(s.residual < 1e-12, "{s:?}");
         assert!(s.x[0].abs() < 1e-12 && s.x[1].abs() < 1e-12, "{s:?}");
         assert!((s.x[2] - 7.0).abs() < 1e-12, "{s:?}");
-        let s = solve_soft(&rows, &[0.0], &[(0, 1.0)], 3, &x0, SOFT);
+        let s = solve_soft(&rows, &[0.0], &[(0, 1.0)], 3, &x0, SOFT, &OnceLock::new());
         let want = SOFT * SOFT / (SOFT * SOFT + 1.0);
         assert!(
             (s.x[0] - want).abs() < 1e-12 && (s.x[1] - want).abs() < 1e-12,
@@ -1014,7 +1060,7 @@ mod tests {
         let n = super::super::system::DENSE_LIMIT + 1;
         let mut x0 = vec![0.0; n];
         x0[2] = 7.0;
-        let s = solve_soft(&rows, &[0.0], &[(0, 1.0)], n, &x0, SOFT);
+        let s = solve_soft(&rows, &[0.0], &[(0, 1.0)], n, &x0, SOFT, &OnceLock::new());
         assert!(
             (s.x[0] - want).abs() < 1e-12 && (s.x[1] - want).abs() < 1e-12,
             "{s:?}"

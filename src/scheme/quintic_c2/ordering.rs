@@ -103,8 +103,12 @@ pub fn quotient_min_degree(adj: Vec<Vec<u32>>) -> (Vec<u32>, Vec<Vec<u32>>) {
             let external: usize = elems[ii].iter().map(|&e| w[e as usize] as usize).sum();
             let dnew = (vars[ii].len() + lp.len() - 1 + external).min(remaining - 1);
             elems[ii].push(p);
-            deg[ii] = dnew;
-            heap.push(Reverse((dnew, i)));
+            // An unchanged degree keeps its heap entry valid: pushing it again would only
+            // leave a stale twin (the order is the same either way).
+            if dnew != deg[ii] {
+                deg[ii] = dnew;
+                heap.push(Reverse((dnew, i)));
+            }
         }
         for &e in &touched {
             let ei = e as usize;
