@@ -10,7 +10,8 @@ use std::path::Path;
 /// environment overriding the lift, the curvature, the sign pins, the L-U completion and the
 /// joint stars, `RELAX=0` turning off the relaxed stars, `CONSISTENT=1` the consistent
 /// stars, `HSIGNS=1` the Hessian sign fit, `TANGENTS=1` the tangent containment and
-/// `STAR_TAU` the stars' near-null threshold and `REPAIR=1` the hole repair (to explore).
+/// `STAR_TAU` the stars' near-null threshold, `REPAIR=1` the hole repair and
+/// `REPAIR_HESSIANS=0` its Hessian passes off (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -34,6 +35,7 @@ fn options() -> QuinticOptions {
             .and_then(|x| x.parse().ok())
             .unwrap_or(0.0),
         repair_holes: std::env::var("REPAIR").is_ok_and(|s| s == "1"),
+        repair_hessians: std::env::var("REPAIR_HESSIANS").map_or(true, |s| s != "0"),
     }
 }
 

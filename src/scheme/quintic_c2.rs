@@ -87,6 +87,11 @@ pub struct QuinticOptions {
     /// C1/C2 equations and the defect's weights pinned to Theorem 2.1's signs ([`holes`]): C2
     /// is kept exactly and nothing changes away from the defects. Off by default.
     pub repair_holes: bool,
+    /// With `repair_holes`: two last passes that also free the Hessians of the jets within
+    /// reach ([`holes::Reach::hessians`]) for the defects the other passes leave, such as base
+    /// faces of face tetrahedra, whose weights are all jets and stars. On by default
+    /// (letter_P_poly without `hessian_signs`: 28 → 10 crossed faces; bunny: 6 → 3).
+    pub repair_hessians: bool,
 }
 
 impl Default for QuinticOptions {
@@ -104,6 +109,7 @@ impl Default for QuinticOptions {
             contain_tangents: false,
             zero_groups: false,
             repair_holes: false,
+            repair_hessians: true,
         }
     }
 }
@@ -120,6 +126,14 @@ impl QuinticOptions {
     pub fn from_toml(table: &toml::Table, scene: &Path) -> anyhow::Result<QuinticOptions> {
         let mut o = QuinticOptions::default();
         for (k, v) in table {
+            let flag = || -> anyhow::Result<bool> {
+                v.as_bool().ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "{}: `scheme.{k}` must be true or false, got {v}",
+                        scene.display()
+                    )
+                })
+            };
             match k.as_str() {
                 "type" => {}
                 k if crate::hull::inner::InnerOptions::KEYS.contains(&k) => {}
@@ -133,62 +147,15 @@ impl QuinticOptions {
                         ),
                     }
                 }
-                "complete_lu_pairs" => match v.as_bool() {
-                    Some(b) => o.complete_lu_pairs = b,
-                    None => bail!(
-                        "{}: `scheme.complete_lu_pairs` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
-                "joint_stars" => match v.as_bool() {
-                    Some(b) => o.joint_stars = b,
-                    None => bail!(
-                        "{}: `scheme.joint_stars` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
-                "relax_stars" => match v.as_bool() {
-                    Some(b) => o.relax_stars = b,
-                    None => bail!(
-                        "{}: `scheme.relax_stars` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
-                "consistent_stars" => match v.as_bool() {
-                    Some(b) => o.consistent_stars = b,
-                    None => bail!(
-                        "{}: `scheme.consistent_stars` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
-                "hessian_signs" => match v.as_bool() {
-                    Some(b) => o.hessian_signs = b,
-                    None => bail!(
-                        "{}: `scheme.hessian_signs` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
-                "contain_tangents" => match v.as_bool() {
-                    Some(b) => o.contain_tangents = b,
-                    None => bail!(
-                        "{}: `scheme.contain_tangents` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
-                "repair_holes" => match v.as_bool() {
-                    Some(b) => o.repair_holes = b,
-                    None => bail!(
-                        "{}: `scheme.repair_holes` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
-                "zero_groups" => match v.as_bool() {
-                    Some(b) => o.zero_groups = b,
-                    None => bail!(
-                        "{}: `scheme.zero_groups` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
+                "complete_lu_pairs" => o.complete_lu_pairs = flag()?,
+                "joint_stars" => o.joint_stars = flag()?,
+                "relax_stars" => o.relax_stars = flag()?,
+                "consistent_stars" => o.consistent_stars = flag()?,
+                "hessian_signs" => o.hessian_signs = flag()?,
+                "contain_tangents" => o.contain_tangents = flag()?,
+                "repair_holes" => o.repair_holes = flag()?,
+                "repair_hessians" => o.repair_hessians = flag()?,
+                "zero_groups" => o.zero_groups = flag()?,
                 "star_tau" => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
                     Some(t) if (0.0..1.0).contains(&t) => o.star_tau = t,
                     _ => bail!(
@@ -196,13 +163,7 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
-                "signs" => match v.as_bool() {
-                    Some(b) => o.signs = b,
-                    None => bail!(
-                        "{}: `scheme.signs` must be true or false, got {v}",
-                        scene.display()
-                    ),
-                },
+                "signs" => o.signs = flag()?,
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
                     match x {
@@ -214,7 +175,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, `repair_holes`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -299,7 +260,7 @@ pub fn build_with_stats(
             stars: std::env::var("APATCH_HOLE_STARS").map_or(true, |v| v != "0"),
             hessians: std::env::var("APATCH_HOLE_HESSIANS").is_ok_and(|v| v != "0"),
         };
-        stats.hole_repair = holes::repair(&sys, &tets, &mut value, reach);
+        stats.hole_repair = holes::repair(&sys, &tets, &mut value, reach, options.repair_hessians);
         if std::env::var_os("APATCH_SIGN_TRACE").is_some() {
             // Opt-in exploration on stderr (results unaffected).
             eprintln!("quintic-c2 hole repair: {:?}", stats.hole_repair);

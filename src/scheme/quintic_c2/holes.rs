@@ -27,8 +27,8 @@
 //! turns defective joins the defect (its weights are lifted too, and the group solved again)
 //! instead of refusing the repair at once.
 
-use super::{cholesky, dense};
 use super::system::{HullTet, System};
+use super::{cholesky, dense};
 use crate::bb::{multi_indices, poly};
 use crate::check::sheets::{roots_beyond_one, simplex_lattice};
 use crate::complex::Role;
@@ -51,7 +51,7 @@ pub struct HoleRepair {
     pub widened: usize,
     /// Of the repairs kept, those whose pins were met only as weighted targets ([`SOFT`]).
     pub soft: usize,
-    /// Of the repairs kept, those of the two last (opt-in) passes, with the Hessians of the
+    /// Of the repairs kept, those of the two last passes (`repair_hessians`), with the Hessians of the
     /// jets free ([`Reach::hessians`]).
     pub hessian: usize,
     /// Patches crossed twice along a j-line ([`j_sheeted`]) after the solve.
@@ -127,11 +127,10 @@ const SOFT: f64 = 1e2;
 /// defect, the weight grows tenfold up to this (exploration, `APATCH_HOLE_SOFT_MAX=0` off).
 const SOFT_MAX: f64 = 1e4;
 
-/// Whether the last two passes free the Hessians (`APATCH_HOLE_HESSIAN_PASSES=1`; off by
-/// default: on letter_P_poly they repair 7 more base faces but take the check from 2 s to
-/// 5 min in one slow sparse group, not yet understood; the bunny: 1 more face).
-fn hessian_passes() -> bool {
-    std::env::var("APATCH_HOLE_HESSIAN_PASSES").is_ok_and(|v| v != "0")
+/// Whether the last two passes free the Hessians: `asked` (the scene's
+/// `repair_hessians`) unless `APATCH_HOLE_HESSIAN_PASSES=0` (exploration, to compare).
+fn hessian_passes(asked: bool) -> bool {
+    asked && std::env::var("APATCH_HOLE_HESSIAN_PASSES").map_or(true, |v| v != "0")
 }
 
 /// Whether [`SOFT_MAX`] escalation is on (`APATCH_HOLE_SOFT_MAX=0` turns it off, to compare).
@@ -250,7 +249,13 @@ pub fn j_sheeted(weights: &[f64], role: Role) -> bool {
 /// Repairs the crossed boundary faces of the solved `value` (slots of `sys`) in place, one at
 /// a time in tetrahedron order (see the module documentation).
 #[must_use]
-pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -> HoleRepair {
+pub fn repair(
+    sys: &System,
+    tets: &[HullTet],
+    value: &mut [f64],
+    reach: Reach,
+    hessian_passes_asked: bool,
+) -> HoleRepair {
     let np = sys.np;
     let boundary = boundary_faces(tets);
     let weights = |t: u32, value: &[f64]| -> Vec<f64> { sys.weights(t as usize, value) };
@@ -303,7 +308,7 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
         }
     }
     let mi = multi_indices(5);
-    // Passes: the asked reach, [`WIDEN`] wider ones, then (opt-in, [`hessian_passes`]) the
+    // Passes: the asked reach, [`WIDEN`] wider ones, then (the scene's `repair_hessians`, [`hessian_passes`]) the
     // asked reach and one ring more with the Hessians free for what is left (a base face of a
     // face tetrahedron holds no late weight: its weights are jets and stars).
     let asked = reach;
@@ -314,7 +319,7 @@ pub fn repair(sys: &System, tets: &[HullTet], value: &mut [f64], reach: Reach) -
         })
         .chain(
             (0..2)
-                .filter(|_| hessian_passes() && !asked.hessians)
+                .filter(|_| hessian_passes(hessian_passes_asked) && !asked.hessians)
                 .map(|extra| Reach {
                     rings: asked.rings + extra,
                     hessians: true,
@@ -851,10 +856,14 @@ fn repair_defect(
             if !ok_soft(&sol) {
                 trace(|| {
                     format!(
-                        "{defect:?}: {n} unknowns, {} equations, {} pins: residual {hard:.2e} of {scale:.2e} (soft {:.2e}), largest {:.2e}",
+                        "{defect:?}: {n} unknowns, {} equations, {} pins: residual {hard:.2e} of {scale:.2e} (soft {:.2e}; the values before: {:.2e}), largest {:.2e}",
                         rows.len(),
                         pins.len(),
                         sol.residual,
+                        rows.iter()
+                            .zip(&c)
+                            .map(|(r, &ci)| (r.iter().map(|&(j, k)| k * x0[j]).sum::<f64>() - ci).abs())
+                            .fold(0.0_f64, f64::max),
                         sol.x.iter().fold(0.0_f64, |a, v| a.max(v.abs()))
                     )
                 });
@@ -1042,9 +1051,24 @@ mod tests {
     fn soft_pins_meet_the_equations_and_come_closest() {
         let rows = vec![vec![(0, 1.0), (1, -1.0)]];
         let x0 = [0.0, 0.0, 7.0];
-        let hard = solve(&rows, &[0.0], &[(0, 1.0), (1, -1.0)], 3, &x0, &OnceLock::new());
+        let hard = solve(
+            &rows,
+            &[0.0],
+            &[(0, 1.0), (1, -1.0)],
+            3,
+            &x0,
+            &OnceLock::new(),
+        );
         assert!(hard.residual > 0.5, "{hard:?}");
-        let s = solve_soft(&rows, &[0.0], &[(0, 1.0), (1, -1.0)], 3, &x0, SOFT, &OnceLock::new());
+        let s = solve_soft(
+            &rows,
+            &[0.0],
+            &[(0, 1.0), (1, -1.0)],
+            3,
+            &x0,
+            SOFT,
+            &OnceLock::new(),
+        );
         // Rounding of a 3-unknown QR (entries O(SOFT)).
         assert!(s.residual < 1e-12, "{s:?}");
         assert!(s.x[0].abs() < 1e-12 && s.x[1].abs() < 1e-12, "{s:?}");
