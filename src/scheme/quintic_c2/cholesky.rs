@@ -219,6 +219,62 @@ fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Ordering) -> (Fac
     (Factor { order, cols, diag }, dropped)
 }
 
+/// The equations scaled to unit rows (duplicate columns merged), as the factorisation, the
+/// refinement and [`conjugate_gradients`] use them, with each row's own scale to measure the
+/// residual in.
+struct UnitRows {
+    /// Â: each row over its norm.
+    rows: Vec<Vec<(u32, f64)>>,
+    /// ĉ: each right-hand side over its row's norm.
+    c: Vec<f64>,
+    /// Each row's norm as given.
+    scale: Vec<f64>,
+}
+
+impl UnitRows {
+    fn new(rows: &[Row], c: &[f64]) -> UnitRows {
+        debug_assert_eq!(rows.len(), c.len());
+        let mut unit = Vec::with_capacity(rows.len());
+        let mut cs = Vec::with_capacity(rows.len());
+        for (r, &ci) in rows.iter().zip(c) {
+            let mut r: Vec<(u32, f64)> = r.iter().map(|&(j, a)| (j as u32, a)).collect();
+            r.sort_unstable_by_key(|t| t.0);
+            let mut merged: Vec<(u32, f64)> = Vec::with_capacity(r.len());
+            for (j, a) in r {
+                match merged.last_mut() {
+                    Some(last) if last.0 == j => last.1 += a,
+                    _ => merged.push((j, a)),
+                }
+            }
+            let s = merged.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt();
+            let inv = if s > 0.0 { 1.0 / s } else { 0.0 };
+            merged.iter_mut().for_each(|t| t.1 *= inv);
+            unit.push(merged);
+            cs.push(ci * inv);
+        }
+        let scale = rows
+            .iter()
+            .map(|r| r.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt())
+            .collect();
+        UnitRows {
+            rows: unit,
+            c: cs,
+            scale,
+        }
+    }
+
+    /// Sets `r` to ĉ − Â x and returns max |A x − c| in the rows' own scale.
+    fn residual(&self, x: &[f64], r: &mut [f64]) -> f64 {
+        for (i, row) in self.rows.iter().enumerate() {
+            r[i] = self.c[i] - row.iter().map(|&(j, a)| a * x[j as usize]).sum::<f64>();
+        }
+        r.iter()
+            .zip(&self.scale)
+            .map(|(ri, s)| ri.abs() * s)
+            .fold(0.0_f64, f64::max)
+    }
+}
+
 /// Solves A x = c (rows of A as sparse `rows`, `n` unknowns) for the x closest to `target` in
 /// the Euclidean norm, refining until max |A x − c| ≤ `tol` (or [`REFINE`] rounds).
 /// [`Solution::rank`] is the number of equations less the dropped dependent ones.
@@ -240,29 +296,8 @@ pub fn solve_near_ordered(
 ) -> Solution {
     let m = rows.len();
     debug_assert_eq!(ordering.order.len(), m);
-    // Unit-norm rows with merged duplicate columns.
-    let mut arows: Vec<Vec<(u32, f64)>> = Vec::with_capacity(m);
-    let mut cs = Vec::with_capacity(m);
-    for (i, r) in rows.iter().enumerate() {
-        let mut r: Vec<(u32, f64)> = r.iter().map(|&(j, a)| (j as u32, a)).collect();
-        r.sort_unstable_by_key(|t| t.0);
-        let mut merged: Vec<(u32, f64)> = Vec::with_capacity(r.len());
-        for (j, a) in r {
-            match merged.last_mut() {
-                Some(last) if last.0 == j => last.1 += a,
-                _ => merged.push((j, a)),
-            }
-        }
-        let s = merged.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt();
-        let inv = if s > 0.0 { 1.0 / s } else { 0.0 };
-        merged.iter_mut().for_each(|t| t.1 *= inv);
-        arows.push(merged);
-        cs.push(c[i] * inv);
-    }
-    let unscale: Vec<f64> = rows
-        .iter()
-        .map(|r| r.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt())
-        .collect();
+    let unit = UnitRows::new(rows, c);
+    let arows = &unit.rows;
     // Rows of each column.
     let mut by_col: Vec<Vec<(u32, f64)>> = vec![Vec::new(); n];
     for (i, r) in arows.iter().enumerate() {
@@ -303,15 +338,7 @@ pub fn solve_near_ordered(
         }
         touched.clear();
     }
-    let residual_of = |x: &[f64], r: &mut [f64]| {
-        for (i, row) in arows.iter().enumerate() {
-            r[i] = cs[i] - row.iter().map(|&(j, a)| a * x[j as usize]).sum::<f64>();
-        }
-        r.iter()
-            .zip(&unscale)
-            .map(|(ri, s)| ri.abs() * s)
-            .fold(0.0_f64, f64::max)
-    };
+    let residual_of = |x: &[f64], r: &mut [f64]| unit.residual(x, r);
     let mut r = vec![0.0; m];
     let res0 = residual_of(target, &mut r);
     let mut best = (res0, target.to_vec(), 0);
@@ -361,7 +388,7 @@ pub fn solve_near_ordered(
         // still converge there, in the rows the factor keeps.
         for (f, dropped) in &factors {
             let mut x = best.1.clone();
-            let got = conjugate_gradients(&arows, f, &mut x, tol, &residual_of);
+            let got = conjugate_gradients(&unit, f, &mut x, tol);
             if got < best.0 {
                 best = (got, x, *dropped);
             }
@@ -383,16 +410,12 @@ const CG_ITERATIONS: usize = 60;
 
 /// Moves `x` along Âᵀ y, y from preconditioned conjugate gradients on Â Âᵀ y = ĉ − Â x with
 /// the factor `f` as preconditioner (the least-norm correction: x stays as close to where it
-/// started as the equations allow), until `residual_of` (max |A x − c| in the rows' own
+/// started as the equations allow), until [`UnitRows::residual`] (max |A x − c| in the rows' own
 /// scale) is at most `tol` or [`CG_ITERATIONS`] are done. Leaves `x` at the iterate of least
 /// residual and returns that residual.
-fn conjugate_gradients(
-    arows: &[Vec<(u32, f64)>],
-    f: &Factor,
-    x: &mut Vec<f64>,
-    tol: f64,
-    residual_of: &dyn Fn(&[f64], &mut [f64]) -> f64,
-) -> f64 {
+fn conjugate_gradients(unit: &UnitRows, f: &Factor, x: &mut Vec<f64>, tol: f64) -> f64 {
+    let arows = &unit.rows;
+    let residual_of = |x: &[f64], r: &mut [f64]| unit.residual(x, r);
     let m = arows.len();
     let mut r = vec![0.0; m];
     let mut best = residual_of(x, &mut r);
@@ -526,30 +549,12 @@ mod tests {
         let (m, n) = (30, 50);
         let (a, rows, c, target) = system(m, n, 12345);
         let dense = crate::scheme::quintic_c2::dense::solve_near(&a, m, n, &c, &target, 1e-11);
-        let norms: Vec<f64> = rows
-            .iter()
-            .map(|r| r.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt())
-            .collect();
-        let arows: Vec<Vec<(u32, f64)>> = rows
-            .iter()
-            .zip(&norms)
-            .map(|(r, s)| r.iter().map(|&(j, v)| (j as u32, v / s)).collect())
-            .collect();
-        let cs: Vec<f64> = c.iter().zip(&norms).map(|(ci, s)| ci / s).collect();
-        let residual_of = |x: &[f64], r: &mut [f64]| {
-            for (i, row) in arows.iter().enumerate() {
-                r[i] = cs[i] - row.iter().map(|&(j, v)| v * x[j as usize]).sum::<f64>();
-            }
-            r.iter()
-                .zip(&norms)
-                .map(|(ri, s)| ri.abs() * s)
-                .fold(0.0_f64, f64::max)
-        };
+        let unit = UnitRows::new(&rows, &c);
         let ordering = Ordering::of(&rows, n);
         let (f, dropped) = factor(&vec![1.0; m], &[], DEPENDENT_PIVOT, &ordering);
         assert_eq!(dropped, 0);
         let mut x = target.clone();
-        let res = conjugate_gradients(&arows, &f, &mut x, 1e-12, &residual_of);
+        let res = conjugate_gradients(&unit, &f, &mut x, 1e-12);
         // Consistent system, entries O(1): rounding-level residual is reachable.
         assert!(res <= 1e-12, "{res}");
         for (u, v) in x.iter().zip(&dense.x) {
