@@ -18,6 +18,20 @@ const STALL: usize = 10_000;
 /// One sparse row: (column, coefficient) pairs.
 pub type Row = Vec<(usize, f64)>;
 
+/// `terms` sorted by index, with the coefficients of a repeated index summed (in the order
+/// the sort leaves them).
+pub(super) fn merged(mut terms: Vec<(u32, f64)>) -> Vec<(u32, f64)> {
+    terms.sort_unstable_by_key(|t| t.0);
+    let mut out: Vec<(u32, f64)> = Vec::with_capacity(terms.len());
+    for (j, a) in terms {
+        match out.last_mut() {
+            Some(last) if last.0 == j => last.1 += a,
+            _ => out.push((j, a)),
+        }
+    }
+    out
+}
+
 /// Solves A x = c (rows of A as sparse `rows`, `n` unknowns) for the x closest to `target` in
 /// the Euclidean norm, iterating until max |A x − c| ≤ `tol` or `max_iter` iterations.
 /// [`Solution::rank`] is the number of equations (not computed).

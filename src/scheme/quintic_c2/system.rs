@@ -373,14 +373,7 @@ fn face_equations(
                 }
                 terms.push((slot_of[a.0 as usize][index(la)], -coef));
             }
-            terms.sort_unstable_by_key(|t| t.0);
-            let mut merged: Vec<(u32, f64)> = Vec::with_capacity(terms.len());
-            for (s, c) in terms {
-                match merged.last_mut() {
-                    Some(last) if last.0 == s => last.1 += c,
-                    _ => merged.push((s, c)),
-                }
-            }
+            let mut merged = super::sparse::merged(terms);
             merged.retain(|t| t.1 != 0.0);
             if !merged.is_empty() {
                 out.push(Equation { terms: merged });
