@@ -400,10 +400,16 @@ pub fn solve_near_ordered(
 /// Iterations of [`conjugate_gradients`] at most.
 const CG_ITERATIONS: usize = 60;
 
+/// [`conjugate_gradients`] stops after this many iterations in a row that did not halve its
+/// least residual. Measured (a trace of every call on the nut's and the bunny's repairs, ~2900
+/// calls): each solve that reached its tolerance did so by iteration 6, its last halving by
+/// iteration 5; the rest, mostly inconsistent pinned groups, ran all 60 iterations for nothing.
+const CG_STALL: usize = 8;
+
 /// Moves `x` along Âᵀ y, y from preconditioned conjugate gradients on Â Âᵀ y = ĉ − Â x with
 /// the factor `f` as preconditioner (the least-norm correction: x stays as close to where it
 /// started as the equations allow), until [`UnitRows::residual`] (max |A x − c| in the rows' own
-/// scale) is at most `tol` or [`CG_ITERATIONS`] are done. Leaves `x` at the iterate of least
+/// scale) is at most `tol`, [`CG_ITERATIONS`] are done or it stalls ([`CG_STALL`]). Leaves `x` at the iterate of least
 /// residual and returns that residual.
 fn conjugate_gradients(unit: &UnitRows, f: &Factor, x: &mut Vec<f64>, tol: f64) -> f64 {
     let arows = &unit.rows;
@@ -426,9 +432,13 @@ fn conjugate_gradients(unit: &UnitRows, f: &Factor, x: &mut Vec<f64>, tol: f64) 
     let mut dx = vec![0.0; x.len()];
     let mut q = vec![0.0; m];
     let mut true_r = vec![0.0; m];
+    let mut stalled = 0;
     for _ in 0..CG_ITERATIONS {
         // A non-positive (or NaN) curvature ends the iteration.
-        if best <= tol || rz.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        if best <= tol
+            || stalled == CG_STALL
+            || rz.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        {
             break;
         }
         // dx = Âᵀ p, q = Â dx.
@@ -456,6 +466,7 @@ fn conjugate_gradients(unit: &UnitRows, f: &Factor, x: &mut Vec<f64>, tol: f64) 
         }
         // The recurrence's residual drifts from the true one: judge by the true one.
         let res = residual_of(x, &mut true_r);
+        stalled = if res < 0.5 * best { 0 } else { stalled + 1 };
         if res < best {
             best = res;
             best_x.clone_from(x);
