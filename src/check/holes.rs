@@ -252,9 +252,18 @@ fn face_verdict(e: &PatchEval<'_>, opp: u8) -> FaceVerdict {
 
     // Rational terms: no coefficient certificate, sampling only.
     if !p.rational.is_empty() {
-        sample_lattice(&mut ev, |b| e.value(alpha(b)));
+        sample_lattice(&mut ev, &|b| e.value(alpha(b)));
         return finish(&ev, false);
     }
+    let face = face_coefficients(n, &p.weights, usize::from(opp));
+    let all_certified = judge(&face, &mut ev, |b| e.value(alpha(b)));
+    finish(&ev, all_certified)
+}
+
+/// The bivariate coefficients of the face opposite local vertex `opp` of a degree-`n` patch
+/// with BB `weights` (the weights with λ_opp = 0).
+fn face_coefficients(n: usize, weights: &[f64], opp: usize) -> Tri {
+    let verts: Vec<usize> = (0..4).filter(|&k| k != opp).collect();
     let w = n + 1;
     let mut c = vec![0.0; w * w];
     for i in 0..=n {
@@ -263,16 +272,23 @@ fn face_verdict(e: &PatchEval<'_>, opp: u8) -> FaceVerdict {
             l[verts[0]] = i as u8;
             l[verts[1]] = j as u8;
             l[verts[2]] = (n - i - j) as u8;
-            c[i * w + j] = p.weights[index_of(l)];
+            c[i * w + j] = weights[index_of(l)];
         }
     }
-    let face = Tri { n, c };
+    Tri { n, c }
+}
+
+/// Gathers into `ev` the evidence on `face` (F's values by `value`, at face barycentrics):
+/// its coefficients, a lattice, then subdivision. Returns whether every part was certified
+/// one-signed (false: some sub-triangle at [`MAX_DEPTH`] still had coefficients of both signs).
+fn judge(face: &Tri, ev: &mut Evidence, value: impl Fn([f64; 3]) -> f64) -> bool {
+    let zero = ev.zero;
     if face.sign(zero).is_some() {
-        return finish(&ev, true);
+        return true;
     }
-    sample_lattice(&mut ev, |b| e.value(alpha(b)));
+    sample_lattice(ev, &value);
     if ev.crossing() {
-        return finish(&ev, false);
+        return false;
     }
     // Subdivision: certify sub-triangles (coefficients from the face's blossom at their
     // corners), remember their strict signs and where.
@@ -294,7 +310,7 @@ fn face_verdict(e: &PatchEval<'_>, opp: u8) -> FaceVerdict {
                 // F has the strict sign sg inside: record its centroid for that sign even when
                 // |F| there is below the zero threshold.
                 let mid: [f64; 3] = std::array::from_fn(|m| (k[0][m] + k[1][m] + k[2][m]) / 3.0);
-                let f = e.value(alpha(mid)).abs().max(f64::MIN_POSITIVE);
+                let f = value(mid).abs().max(f64::MIN_POSITIVE);
                 ev.force(f64::from(sg) * f, mid);
             }
             None if depth >= MAX_DEPTH => all_certified = false,
@@ -315,7 +331,24 @@ fn face_verdict(e: &PatchEval<'_>, opp: u8) -> FaceVerdict {
             break;
         }
     }
-    finish(&ev, all_certified)
+    all_certified
+}
+
+/// Whether F of a polynomial patch (degree `n`, BB `weights`) takes both strict signs on the
+/// face opposite local vertex `opp`, by the evidence `apatch check` gathers (values within
+/// 1e-12 of the largest weight count as zero): what a scheme's repair must see to agree with
+/// the check's "holes".
+#[must_use]
+pub fn polynomial_face_crossed(n: usize, weights: &[f64], opp: usize) -> bool {
+    let s = weights.iter().fold(0.0_f64, |a, w| a.max(w.abs()));
+    let mut ev = Evidence {
+        zero: ZERO * s.max(f64::MIN_POSITIVE),
+        pos: (0.0, [0.0; 3]),
+        neg: (0.0, [0.0; 3]),
+    };
+    let face = face_coefficients(n, weights, opp);
+    judge(&face, &mut ev, |b| face.blossom(&vec![b; n]));
+    ev.crossing()
 }
 
 /// F at the corners of a triangle: its corner coefficients, in corner order.
@@ -325,7 +358,7 @@ fn corner_values(t: &Tri) -> [f64; 3] {
 }
 
 /// Samples the face's lattice (boundary included) into `ev`.
-fn sample_lattice(ev: &mut Evidence, f: impl Fn([f64; 3]) -> f64) {
+fn sample_lattice(ev: &mut Evidence, f: &impl Fn([f64; 3]) -> f64) {
     for i in 0..=LATTICE {
         for j in 0..=LATTICE - i {
             let b = [
@@ -402,5 +435,58 @@ mod tests {
         assert_eq!(t.sign(1e-12), Some(-1));
         t.c[3] = 0.5;
         assert_eq!(t.sign(1e-12), None);
+    }
+
+    /// The 56 BB weights of the quintic (b₀ − c·S)² S³ − ε S⁵ on a tetrahedron (S = Σ bₘ ≡ 1):
+    /// a weight is the average of the factors' coefficients over the orderings of its indices,
+    /// here (b₀ − c)² − ε averaged over the 20 ordered pairs of index positions.
+    fn band_weights(c: f64, eps: f64) -> Vec<f64> {
+        crate::bb::multi_indices(5)
+            .into_iter()
+            .map(|l| {
+                let seq: Vec<usize> = (0..4).flat_map(|m| vec![m; usize::from(l[m])]).collect();
+                let lin = |m: usize| if m == 0 { 1.0 - c } else { -c };
+                let mut sum = 0.0;
+                for i in 0..5 {
+                    for j in 0..5 {
+                        if i != j {
+                            sum += lin(seq[i]) * lin(seq[j]);
+                        }
+                    }
+                }
+                sum / 20.0 - eps
+            })
+            .collect()
+    }
+
+    /// F = (b₀ − 3/8)² − 1e-5 is negative only in a band 0.0063 wide around b₀ = 3/8, between
+    /// the points of a 30-step lattice (b₀ = 11/30, 12/30), but the subdivision's corners reach
+    /// b₀ = 3/8: the face opposite vertex 3 is crossed, by brute force and by the verdict.
+    /// With +1e-5 it is positive everywhere and not crossed.
+    #[test]
+    fn thin_pocket_between_lattice_points_is_a_crossing() {
+        let n = 5;
+        let w = band_weights(0.375, 1e-5);
+        let value = |b: [f64; 4]| crate::bb::poly::eval(n, &w, b);
+        // Independent truth: a fine lattice on the face sees both signs.
+        let steps = 800;
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for i in 0..=steps {
+            for j in 0..=steps - i {
+                let b = [i as f64, j as f64, (steps - i - j) as f64, 0.0].map(|x| x / steps as f64);
+                lo = lo.min(value(b));
+                hi = hi.max(value(b));
+            }
+        }
+        assert!(lo < 0.0 && hi > 0.0, "{lo} {hi}");
+        // The 30-step lattice alone does not.
+        let coarse = (0..=30).all(|i| {
+            (0..=30 - i).all(|j| value([i, j, 30 - i - j, 0].map(|x| f64::from(x) / 30.0)) > 0.0)
+        });
+        assert!(coarse);
+        assert!(polynomial_face_crossed(n, &w, 3));
+        assert!(!polynomial_face_crossed(n, &band_weights(0.375, -1e-5), 3));
+        // The face opposite vertex 0 has b₀ = 0: F = 0.375² − 1e-5 there, one-signed.
+        assert!(!polynomial_face_crossed(n, &w, 0));
     }
 }

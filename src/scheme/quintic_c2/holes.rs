@@ -103,9 +103,6 @@ pub struct Reach {
     pub hessians: bool,
 }
 
-/// Lattice steps per edge at which a boundary face is sampled for a sign change ([`crossed`]):
-/// finer than the checker's first sampling (12), whose subdivision finds the rest.
-const STEPS: usize = 30;
 /// |F| at or below this share of the patch's largest weight is zero (the checker's threshold).
 const ZERO: f64 = 1e-12;
 /// Pinned weights are set to this share of the largest weight on their face, with their sign:
@@ -187,34 +184,12 @@ pub fn boundary_faces(tets: &[HullTet]) -> Vec<(u32, usize)> {
 }
 
 /// Whether F with the 56 `weights` takes both strict signs on the face opposite local vertex
-/// `opp` (lattice of [`STEPS`] per edge; values within [`ZERO`] of the largest weight are zero).
-/// A face whose own weights are one-signed is not crossed (the Bernstein basis is positive).
+/// `opp`, judged as `apatch check` judges its "holes" (coefficients, lattice, subdivision:
+/// [`crate::check::holes::polynomial_face_crossed`]). A 30-step lattice, used before, missed the
+/// bunny's last crossed face (a pocket 2.4e-6 deep between its points).
 #[must_use]
 pub fn crossed(weights: &[f64], opp: usize) -> bool {
-    let big = weights.iter().fold(0.0_f64, |a, w| a.max(w.abs()));
-    let zero = ZERO * big;
-    let mi = multi_indices(5);
-    let on_face = || mi.iter().zip(weights).filter(|(l, _)| l[opp] == 0);
-    if on_face().all(|(_, w)| *w >= -zero) || on_face().all(|(_, w)| *w <= zero) {
-        return false;
-    }
-    let others: Vec<usize> = (0..4).filter(|&k| k != opp).collect();
-    let (mut pos, mut neg) = (false, false);
-    for i in 0..=STEPS {
-        for j in 0..=STEPS - i {
-            let mut b = [0.0; 4];
-            b[others[0]] = i as f64 / STEPS as f64;
-            b[others[1]] = j as f64 / STEPS as f64;
-            b[others[2]] = (STEPS - i - j) as f64 / STEPS as f64;
-            let f = poly::eval(5, weights, b);
-            pos |= f > zero;
-            neg |= f < -zero;
-            if pos && neg {
-                return true;
-            }
-        }
-    }
-    false
+    crate::check::holes::polynomial_face_crossed(5, weights, opp)
 }
 
 /// Whether F with the 56 `weights` of a tetrahedron of `role` meets zero more than once along
@@ -605,6 +580,26 @@ fn repair_defect(
             let mut row = vec![(j, 1.0)];
             row.extend(coef.iter().enumerate().map(|(e, c)| (base + e, -c / 20.0)));
             hess_rows.push((row, value[s as usize]));
+        }
+        // Each point's δH is solved for in units that make its largest coefficient 1 (the
+        // unknown is s_p·δH): as given, the coefficients are |a − p||b′ − p|/20, about 1e-3 on
+        // the bunny, and the C2 rows among a point's number 2 weights are then nearly
+        // combinations of its Hessian rows (Â Âᵀ nearly singular), which stalled the solves of
+        // its last holes.
+        let mut unit = vec![0.0_f64; 6 * hess_col.len()];
+        for (row, _) in &hess_rows {
+            for &(j, k) in &row[1..] {
+                let u = &mut unit[(j - unk.len()) / 6 * 6];
+                *u = u.max(k.abs());
+            }
+        }
+        for (row, _) in &mut hess_rows {
+            for (j, k) in &mut row[1..] {
+                let u = unit[(*j - unk.len()) / 6 * 6];
+                if u > 0.0 {
+                    *k /= u;
+                }
+            }
         }
     }
     let n = unk.len() + 6 * hess_col.len();
