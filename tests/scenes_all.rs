@@ -26,7 +26,7 @@ fn scenes(dir: &str) -> Vec<PathBuf> {
 /// 1300 singular star systems and the hole repair). CI's time budget cannot hold them, so
 /// they are checked by the ignored [`heavy_scenes_build_and_pass_check`] instead, with the
 /// same checks: `cargo test --release --test scenes_all -- --ignored`.
-const HEAVY: &[&str] = &["knot_quintic.toml"];
+const HEAVY: &[&str] = &["bunny_quintic.toml", "knot_quintic.toml"];
 
 fn is_heavy(path: &Path) -> bool {
     path.file_name()
