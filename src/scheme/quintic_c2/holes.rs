@@ -846,15 +846,16 @@ fn repair_defect(
         }
         let mut sol = solve(&rows, &c, &pins, n, &x0, &ordering);
         if !ok(&sol) {
-            let hard = sol.residual;
+            let (hard, hard_rank) = (sol.residual, sol.rank);
             sol = solve_soft(&rows, &c, &pins, n, &x0, weight, &ordering);
             if !ok_soft(&sol) {
                 trace(|| {
                     format!(
-                        "{defect:?}: {n} unknowns, {} equations, {} pins: residual {hard:.2e} of {scale:.2e} (soft {:.2e}; the values before: {:.2e}), largest {:.2e}",
+                        "{defect:?}: {n} unknowns, {} equations, {} pins: residual {hard:.2e} of {scale:.2e} at rank {hard_rank} (soft {:.2e} at rank {}; the values before: {:.2e}), largest {:.2e}",
                         rows.len(),
                         pins.len(),
                         sol.residual,
+                        sol.rank,
                         rows.iter()
                             .zip(&c)
                             .map(|(r, &ci)| (r.iter().map(|&(j, k)| k * x0[j]).sum::<f64>() - ci).abs())
