@@ -586,16 +586,16 @@ fn repair_defect(
         // the bunny, and the C2 rows among a point's number 2 weights are then nearly
         // combinations of its Hessian rows (Â Âᵀ nearly singular), which stalled the solves of
         // its last holes.
-        let mut unit = vec![0.0_f64; 6 * hess_col.len()];
+        let point = |j: usize| (j - unk.len()) / 6;
+        let mut unit = vec![0.0_f64; hess_col.len()];
         for (row, _) in &hess_rows {
             for &(j, k) in &row[1..] {
-                let u = &mut unit[(j - unk.len()) / 6 * 6];
-                *u = u.max(k.abs());
+                unit[point(j)] = unit[point(j)].max(k.abs());
             }
         }
         for (row, _) in &mut hess_rows {
             for (j, k) in &mut row[1..] {
-                let u = unit[(*j - unk.len()) / 6 * 6];
+                let u = unit[point(*j)];
                 if u > 0.0 {
                     *k /= u;
                 }
