@@ -14,6 +14,7 @@ pub mod flat;
 pub mod holes;
 pub mod jets;
 pub mod ordering;
+mod pinned;
 pub mod signs;
 pub mod sparse;
 pub mod system;

@@ -257,8 +257,13 @@ impl UnitRows {
 
     /// Sets `r` to ĉ − Â x and returns max |A x − c| in the rows' own scale.
     fn residual(&self, x: &[f64], r: &mut [f64]) -> f64 {
+        self.residual_to(&self.c, x, r)
+    }
+
+    /// [`UnitRows::residual`] for the unit right-hand side `c` instead of ĉ.
+    fn residual_to(&self, c: &[f64], x: &[f64], r: &mut [f64]) -> f64 {
         for (i, row) in self.rows.iter().enumerate() {
-            r[i] = self.c[i] - row.iter().map(|&(j, a)| a * x[j as usize]).sum::<f64>();
+            r[i] = c[i] - row.iter().map(|&(j, a)| a * x[j as usize]).sum::<f64>();
         }
         r.iter()
             .zip(&self.scale)
@@ -341,7 +346,7 @@ pub fn solve_near_ordered(
         // still converge there, in the rows the factor keeps.
         for (f, dropped) in &factors {
             let mut x = best.1.clone();
-            let (got, _) = conjugate_gradients(&unit, f, &mut x, tol, CG_STALL);
+            let (got, _) = conjugate_gradients(&unit, &unit.c, f, &mut x, tol, CG_STALL);
             if got < best.0 {
                 best = (got, x, *dropped);
             }
@@ -355,6 +360,95 @@ pub fn solve_near_ordered(
         x,
         rank: m - dropped,
         residual,
+    }
+}
+
+/// One group's equations A x = c factored once (Â Âᵀ, dependent rows dropped at
+/// [`DEPENDENT_PIVOT`]), for many minimum-change moves: onto the equations ([`Projector::meet`])
+/// or onto their null space ([`Projector::project`], Π v = v − Âᵀ (Â Âᵀ)⁺ Â v). The hole
+/// repair's pinned solves are combinations of such projections of the pinned unknowns' unit
+/// vectors, so one factor serves every round and weight of a repair
+/// (`holes`' `PinnedSolves`).
+pub struct Projector {
+    unit: UnitRows,
+    factor: Factor,
+    dropped: usize,
+}
+
+impl Projector {
+    /// Factors the `rows` (over `n` unknowns, right-hand side `c`) in `ordering`, one made
+    /// for them ([`Ordering::of`]).
+    #[must_use]
+    pub fn new(rows: &[Row], n: usize, c: &[f64], ordering: &Ordering) -> Projector {
+        debug_assert_eq!(ordering.order.len(), rows.len());
+        let unit = UnitRows::new(rows, c);
+        let (d, off) = normal_matrix(&unit.rows, n);
+        let (factor, dropped) = factor(&d, &off, DEPENDENT_PIVOT, ordering);
+        Projector {
+            unit,
+            factor,
+            dropped,
+        }
+    }
+
+    /// The rows dropped as dependent (exploration: which rows a move misses).
+    #[must_use]
+    pub fn dropped_rows(&self) -> Vec<usize> {
+        (0..self.factor.diag.len())
+            .filter(|&i| self.factor.diag[i] == 0.0)
+            .collect()
+    }
+
+    /// The number of equations less the dependent ones dropped.
+    #[must_use]
+    pub fn rank(&self) -> usize {
+        self.unit.rows.len() - self.dropped
+    }
+
+    /// Moves `x` to the closest point (Euclidean) with A x = c, refined until max |A x − c| ≤
+    /// `tol`; returns that residual.
+    pub fn meet(&self, x: &mut Vec<f64>, tol: f64) -> f64 {
+        self.refine(x, &self.unit.c, tol)
+    }
+
+    /// Moves `v` to its orthogonal projection onto the null space of A (the closest point with
+    /// A v = 0), refined until max |A v| ≤ `tol`; returns that residual.
+    pub fn project(&self, v: &mut Vec<f64>, tol: f64) -> f64 {
+        self.refine(v, &vec![0.0; self.unit.rows.len()], tol)
+    }
+
+    /// Least-norm corrections along Âᵀ y towards Â x = `c`: iterative refinement with the
+    /// factor while it lowers the residual, then conjugate gradients preconditioned by it
+    /// (as [`solve_near_ordered`] does). Leaves `x` at the best point met.
+    fn refine(&self, x: &mut Vec<f64>, c: &[f64], tol: f64) -> f64 {
+        let arows = &self.unit.rows;
+        let mut r = vec![0.0; arows.len()];
+        let mut res = self.unit.residual_to(c, x, &mut r);
+        for _ in 0..=REFINE {
+            if res <= tol {
+                return res;
+            }
+            let before = (res, x.clone());
+            self.factor.solve(&mut r);
+            for (row, &yi) in arows.iter().zip(&r) {
+                if yi != 0.0 {
+                    for &(j, a) in row {
+                        x[j as usize] += a * yi;
+                    }
+                }
+            }
+            res = self.unit.residual_to(c, x, &mut r);
+            if res.partial_cmp(&before.0) != Some(std::cmp::Ordering::Less) {
+                // Refinement stopped helping (NaN-safe): keep the better point.
+                (res, *x) = before;
+                break;
+            }
+        }
+        if res > tol {
+            let (got, _) = conjugate_gradients(&self.unit, c, &self.factor, x, tol, CG_STALL);
+            res = got.min(res);
+        }
+        res
     }
 }
 
@@ -422,13 +516,14 @@ const CG_STALL: usize = 8;
 /// residual and returns that residual and the iterations done.
 fn conjugate_gradients(
     unit: &UnitRows,
+    c: &[f64],
     f: &Factor,
     x: &mut Vec<f64>,
     tol: f64,
     stall: usize,
 ) -> (f64, usize) {
     let arows = &unit.rows;
-    let residual_of = |x: &[f64], r: &mut [f64]| unit.residual(x, r);
+    let residual_of = |x: &[f64], r: &mut [f64]| unit.residual_to(c, x, r);
     let m = arows.len();
     let mut r = vec![0.0; m];
     let mut best = residual_of(x, &mut r);
@@ -501,10 +596,11 @@ fn conjugate_gradients(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
-    fn lcg(seed: &mut u64) -> f64 {
+    /// A seeded uniform number in [−1, 1) (the random systems of these and `pinned`'s tests).
+    pub(in crate::scheme::quintic_c2) fn lcg(seed: &mut u64) -> f64 {
         *seed = seed
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
@@ -576,7 +672,7 @@ mod tests {
         let mut x = target.clone();
         // No stall stop: with this preconditioner the largest residual need not halve for
         // many steps in a row (CG minimises another norm).
-        let (res, _) = conjugate_gradients(&unit, &f, &mut x, 1e-12, CG_ITERATIONS);
+        let (res, _) = conjugate_gradients(&unit, &unit.c, &f, &mut x, 1e-12, CG_ITERATIONS);
         // Consistent system, entries O(1): rounding-level residual is reachable.
         assert!(res <= 1e-12, "{res}");
         for (u, v) in x.iter().zip(&dense.x) {
@@ -599,7 +695,7 @@ mod tests {
         let mut x = s.x.clone();
         let (d, off) = normal_matrix(&unit.rows, n);
         let (f, _) = factor(&d, &off, DEPENDENT_PIVOT, &ordering);
-        let (res, iterations) = conjugate_gradients(&unit, &f, &mut x, 1e-13, CG_STALL);
+        let (res, iterations) = conjugate_gradients(&unit, &unit.c, &f, &mut x, 1e-13, CG_STALL);
         assert!(iterations <= CG_STALL + 1, "{iterations}");
         // Never worse than where it started; the contradiction (0.5) stays far above rounding.
         assert!(res <= s.residual && res > 1e-3, "{res} vs {}", s.residual);
