@@ -170,9 +170,9 @@ mod tests {
 
     /// Exploration: a group dumped by the repair (`APATCH_HOLE_DUMP`), solved hard and soft
     /// (w = 100), with the rows each solve misses (`CLEAN=t` first drops terms below t of their
-    /// row's largest).
+    /// row's largest; `EQUIL=1` solves for the unknowns over their columns' norms).
     #[test]
-    #[ignore = "exploration: DUMP=/tmp/dump_<defect>_<n>.json [CLEAN=1e-13]"]
+    #[ignore = "exploration: DUMP=/tmp/dump_<defect>_<n>.json [CLEAN=1e-13] [EQUIL=1]"]
     fn explore_dump() {
         let path = std::env::var("DUMP").expect("DUMP=path");
         let j: serde_json::Value =
@@ -193,6 +193,33 @@ mod tests {
         let c: Vec<f64> = serde_json::from_value(j["c"].clone()).unwrap();
         let x0: Vec<f64> = serde_json::from_value(j["x0"].clone()).unwrap();
         let pins: Vec<(usize, f64)> = serde_json::from_value(j["pins"].clone()).unwrap();
+        let (mut x0, mut pins) = (x0, pins);
+        let orig_rows = rows.clone();
+        let mut colscale = vec![1.0; n];
+        if std::env::var("EQUIL").is_ok() {
+            let mut norm = vec![0.0_f64; n];
+            for r in &rows {
+                for &(j, a) in r {
+                    norm[j] += a * a;
+                }
+            }
+            for j in 0..n {
+                if norm[j] > 0.0 {
+                    colscale[j] = 1.0 / norm[j].sqrt();
+                }
+            }
+            for r in &mut rows {
+                for t in r.iter_mut() {
+                    t.1 *= colscale[t.0];
+                }
+            }
+            for (x, d) in x0.iter_mut().zip(&colscale) {
+                *x /= d;
+            }
+            for p in &mut pins {
+                p.1 /= colscale[p.0];
+            }
+        }
         let scale = c.iter().chain(&x0).fold(1e-300_f64, |a, x| a.max(x.abs()));
         eprintln!(
             "n {n} m {} pins {} scale {scale:.3e}",
@@ -204,7 +231,21 @@ mod tests {
         let dropped = solves.proj.dropped_rows();
         eprintln!("rank {} dropped {}", solves.proj.rank(), dropped.len());
         for w in [None, Some(1e2)] {
-            let sol = solves.solve(&rows, &c, &pins, w);
+            let mut sol = solves.solve(&rows, &c, &pins, w);
+            for (x, d) in sol.x.iter_mut().zip(&colscale) {
+                *x *= d;
+            }
+            let rows = &orig_rows;
+            eprintln!(
+                "  original rows: {:.3e}",
+                rows.iter()
+                    .zip(&c)
+                    .map(
+                        |(row, &ci)| (row.iter().map(|&(j, a)| a * sol.x[j]).sum::<f64>() - ci)
+                            .abs()
+                    )
+                    .fold(0.0_f64, f64::max)
+            );
             let miss: Vec<(usize, f64, f64)> = rows
                 .iter()
                 .zip(&c)
