@@ -312,14 +312,7 @@ pub fn solve_near_ordered(
                 break;
             }
             f.solve(&mut r);
-            for (i, row) in arows.iter().enumerate() {
-                let yi = r[i];
-                if yi != 0.0 {
-                    for &(j, a) in row {
-                        x[j as usize] += a * yi;
-                    }
-                }
-            }
+            add_transposed(arows, &r, &mut x);
             let before = res;
             res = residual_of(&x, &mut r);
             if step == 0 {
@@ -392,6 +385,7 @@ impl Projector {
     }
 
     /// The rows dropped as dependent (exploration: which rows a move misses).
+    #[cfg(test)]
     #[must_use]
     pub fn dropped_rows(&self) -> Vec<usize> {
         (0..self.factor.diag.len())
@@ -430,13 +424,7 @@ impl Projector {
             }
             let before = (res, x.clone());
             self.factor.solve(&mut r);
-            for (row, &yi) in arows.iter().zip(&r) {
-                if yi != 0.0 {
-                    for &(j, a) in row {
-                        x[j as usize] += a * yi;
-                    }
-                }
-            }
+            add_transposed(arows, &r, x);
             res = self.unit.residual_to(c, x, &mut r);
             if res.partial_cmp(&before.0) != Some(std::cmp::Ordering::Less) {
                 // Refinement stopped helping (NaN-safe): keep the better point.
@@ -449,6 +437,18 @@ impl Projector {
             res = got.min(res);
         }
         res
+    }
+}
+
+/// x += Âᵀ y for the unit rows `arows` (rows with y_i = 0 skipped): the least-norm move of the
+/// refinement, the projections and conjugate gradients.
+fn add_transposed(arows: &[Vec<(u32, f64)>], y: &[f64], x: &mut [f64]) {
+    for (row, &yi) in arows.iter().zip(y) {
+        if yi != 0.0 {
+            for &(j, a) in row {
+                x[j as usize] += a * yi;
+            }
+        }
     }
 }
 
@@ -554,13 +554,7 @@ fn conjugate_gradients(
         }
         // dx = Âᵀ p, q = Â dx.
         dx.iter_mut().for_each(|v| *v = 0.0);
-        for (row, &pi) in arows.iter().zip(&p) {
-            if pi != 0.0 {
-                for &(j, a) in row {
-                    dx[j as usize] += a * pi;
-                }
-            }
-        }
+        add_transposed(arows, &p, &mut dx);
         for (qi, row) in q.iter_mut().zip(arows) {
             *qi = row.iter().map(|&(j, a)| a * dx[j as usize]).sum();
         }

@@ -117,26 +117,30 @@ impl PinnedSolves {
         let rows_miss = rows
             .iter()
             .zip(c)
-            .map(|(row, &ci)| (row.iter().map(|&(j, a)| a * x[j]).sum::<f64>() - ci).abs())
-            .fold(0.0_f64, |a, r| if r.is_nan() { f64::NAN } else { a.max(r) });
-        let pins_miss = if weight.is_none() {
-            pins.iter()
-                .map(|&(j, v)| (x[j] - v).abs())
-                .fold(0.0_f64, |a, r| if r.is_nan() { f64::NAN } else { a.max(r) })
-        } else {
-            0.0
-        };
-        let residual = if rows_miss.is_nan() || pins_miss.is_nan() {
-            f64::NAN
-        } else {
-            rows_miss.max(pins_miss)
-        };
+            .map(|(row, &ci)| (row.iter().map(|&(j, a)| a * x[j]).sum::<f64>() - ci).abs());
+        let pins_miss = pins
+            .iter()
+            .filter(|_| weight.is_none())
+            .map(|&(j, v)| (x[j] - v).abs());
+        let residual = largest(rows_miss.chain(pins_miss));
         Solution {
             x,
             rank: self.proj.rank(),
             residual,
         }
     }
+}
+
+/// The largest of `misses`, NaN if any is NaN (`f64::max` would pass over a NaN, and a NaN
+/// residual must refuse the solve).
+fn largest(misses: impl Iterator<Item = f64>) -> f64 {
+    misses.fold(0.0_f64, |a, r| {
+        if a.is_nan() || r.is_nan() {
+            f64::NAN
+        } else {
+            a.max(r)
+        }
+    })
 }
 
 #[cfg(test)]
@@ -282,6 +286,15 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A NaN miss anywhere makes the residual NaN (a fold with `f64::max` alone forgets a NaN
+    /// once a later miss is a number).
+    #[test]
+    fn largest_keeps_a_nan() {
+        assert_eq!(largest([1.0, 3.0, 2.0].into_iter()), 3.0);
+        assert!(largest([1.0, f64::NAN, 2.0].into_iter()).is_nan());
+        assert!(largest([f64::NAN, 0.5].into_iter()).is_nan());
     }
 
     /// The dense A (row-major) of sparse rows, duplicates summed.
