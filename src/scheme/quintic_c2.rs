@@ -9,6 +9,7 @@
 //! and interpolates T's points with ∇F ∥ their normals.
 
 pub mod cholesky;
+mod dd;
 pub mod dense;
 pub mod flat;
 pub mod holes;

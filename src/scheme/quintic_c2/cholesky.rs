@@ -14,6 +14,7 @@
 //! runs on one thread in a fixed order (ties broken by index), so the bits do not depend on the
 //! thread count.
 
+use super::dd::{Dd, Real};
 use super::dense::Solution;
 use super::sparse::Row;
 
@@ -30,44 +31,52 @@ pub const RETRY_PIVOT: f64 = 1e-9;
 /// Rounds of iterative refinement after the first solve.
 const REFINE: usize = 4;
 
-/// The Cholesky factor of a sparse symmetric matrix in elimination order.
-struct Factor {
+/// The Cholesky factor of a sparse symmetric matrix in elimination order, in f64 or, where
+/// the normal equations need more digits, in double-double ([`Precise`]).
+struct Factor<T: Real = f64> {
     /// Elimination position → node.
     order: Vec<u32>,
     /// Node → columns of L below the diagonal: (row node, value), in elimination order.
-    cols: Vec<Vec<(u32, f64)>>,
+    cols: Vec<Vec<(u32, T)>>,
     /// Node → diagonal of L (0 for a dropped, dependent node).
-    diag: Vec<f64>,
+    diag: Vec<T>,
 }
 
-impl Factor {
-    /// Solves L Lᵀ y = r in place (dependent nodes get y = 0).
+impl<T: Real> Factor<T> {
+    /// Solves L Lᵀ y = r in place (dependent nodes get y = 0), in the factor's precision.
     fn solve(&self, r: &mut [f64]) {
+        let mut w: Vec<T> = r.iter().map(|&x| T::of(x)).collect();
         for &v in &self.order {
             let v = v as usize;
-            if self.diag[v] == 0.0 {
-                r[v] = 0.0;
+            if self.diag[v].f64() == 0.0 {
+                w[v] = T::default();
                 continue;
             }
-            let z = r[v] / self.diag[v];
-            r[v] = z;
+            let z = w[v] / self.diag[v];
+            w[v] = z;
             for &(u, l) in &self.cols[v] {
-                r[u as usize] -= l * z;
+                w[u as usize] -= l * z;
             }
         }
         for &v in self.order.iter().rev() {
             let v = v as usize;
-            if self.diag[v] == 0.0 {
+            if self.diag[v].f64() == 0.0 {
                 continue;
             }
-            let mut s = r[v];
+            let mut s = w[v];
             for &(u, l) in &self.cols[v] {
-                s -= l * r[u as usize];
+                s -= l * w[u as usize];
             }
-            r[v] = s / self.diag[v];
+            w[v] = s / self.diag[v];
+        }
+        for (x, y) in r.iter_mut().zip(w) {
+            *x = y.f64();
         }
     }
 }
+
+/// The factor in double-double, for groups whose f64 factor does not meet their rows.
+type Precise = Factor<Dd>;
 
 /// Each node's position in the elimination `order`; sorts every column pattern by it.
 fn sort_by_position(order: &[u32], pattern: &mut [Vec<u32>]) -> Vec<usize> {
@@ -146,13 +155,21 @@ impl Ordering {
 /// one dense accumulator, so the work is the multiply-adds plus one pass over each column's
 /// pattern (the right-looking update it replaced scattered the target's whole pattern for every
 /// source column: letter P's repair with freed Hessians, 5 min → 101 s).
-fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Ordering) -> (Factor, usize) {
+fn factor<T: Real>(
+    d: &[T],
+    off: &[(u32, u32, T)],
+    drop: f64,
+    sym: &Ordering,
+) -> (Factor<T>, usize) {
     let m = d.len();
     let order = sym.order.clone();
     let pattern = &sym.pattern;
     let pos = &sym.pos;
     // A's entries below the diagonal, on each column's pattern.
-    let mut vals: Vec<Vec<f64>> = pattern.iter().map(|p| vec![0.0; p.len()]).collect();
+    let mut vals: Vec<Vec<T>> = pattern
+        .iter()
+        .map(|p| vec![T::default(); p.len()])
+        .collect();
     for &(i, k, a) in off {
         let (v, u) = if pos[i as usize] < pos[k as usize] {
             (i, k)
@@ -165,10 +182,10 @@ fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Ordering) -> (Fac
             .expect("edge in pattern");
         vals[v as usize][idx] += a;
     }
-    let mut diag: Vec<f64> = d.to_vec();
+    let mut diag: Vec<T> = d.to_vec();
     let mut dropped = 0;
     // Dense accumulator over nodes, zero outside the current column's pattern.
-    let mut acc = vec![0.0; m];
+    let mut acc = vec![T::default(); m];
     // For each node, the finished columns whose next entry below the diagonal is that node,
     // with the index of that entry: the columns that update it, each met once.
     let mut links: Vec<Vec<(u32, u32)>> = vec![Vec::new(); m];
@@ -192,20 +209,20 @@ fn factor(d: &[f64], off: &[(u32, u32, f64)], drop: f64, sym: &Ordering) -> (Fac
             }
         }
         // NaN pivots count as dependent too.
-        if piv.is_nan() || piv <= drop * d[vi].max(f64::MIN_POSITIVE) {
-            diag[vi] = 0.0;
+        if piv.f64().is_nan() || piv.f64() <= drop * d[vi].f64().max(f64::MIN_POSITIVE) {
+            diag[vi] = T::default();
             for &w in pv {
-                acc[w as usize] = 0.0;
+                acc[w as usize] = T::default();
             }
-            vals[vi].iter_mut().for_each(|x| *x = 0.0);
+            vals[vi].iter_mut().for_each(|x| *x = T::default());
             dropped += 1;
             continue;
         }
-        let l = piv.sqrt();
+        let l = piv.root();
         diag[vi] = l;
         for (a, &w) in pv.iter().enumerate() {
             vals[vi][a] = acc[w as usize] / l;
-            acc[w as usize] = 0.0;
+            acc[w as usize] = T::default();
         }
         if let Some(&first) = pv.first() {
             links[first as usize].push((v, 0));
@@ -295,7 +312,7 @@ pub fn solve_near_ordered(
     debug_assert_eq!(ordering.order.len(), m);
     let unit = UnitRows::new(rows, c);
     let arows = &unit.rows;
-    let (d, off) = normal_matrix(arows, n);
+    let (d, off) = normal_matrix::<f64>(arows, n);
     let residual_of = |x: &[f64], r: &mut [f64]| unit.residual(x, r);
     let mut r = vec![0.0; m];
     let res0 = residual_of(target, &mut r);
@@ -339,13 +356,24 @@ pub fn solve_near_ordered(
         // still converge there, in the rows the factor keeps.
         for (f, dropped) in &factors {
             let mut x = best.1.clone();
-            let (got, _) = conjugate_gradients(&unit, &unit.c, f, &mut x, tol, CG_STALL);
+            let (got, _) =
+                conjugate_gradients(&unit, &unit.c, &|z| f.solve(z), &mut x, tol, CG_STALL);
             if got < best.0 {
                 best = (got, x, *dropped);
             }
             if best.0 <= tol {
                 break;
             }
+        }
+    }
+    if best.0 > tol {
+        // Still short: the f64 factor's pivots of nearly dependent rows are rounding. The
+        // normal equations in double-double tell dependent rows from independent ones.
+        let precise = Projector::precise(rows, n, c, ordering, PRECISE_PIVOT);
+        let mut x = target.to_vec();
+        let got = precise.meet(&mut x, tol);
+        if got < best.0 {
+            best = (got, x, precise.dropped);
         }
     }
     let (residual, x, dropped) = best;
@@ -364,8 +392,31 @@ pub fn solve_near_ordered(
 /// (`holes`' `PinnedSolves`).
 pub struct Projector {
     unit: UnitRows,
-    factor: Factor,
+    factor: EitherFactor,
     dropped: usize,
+}
+
+/// A [`Projector`]'s factor, in f64 or double-double.
+enum EitherFactor {
+    Double(Factor),
+    Precise(Precise),
+}
+
+impl EitherFactor {
+    fn solve(&self, r: &mut [f64]) {
+        match self {
+            EitherFactor::Double(f) => f.solve(r),
+            EitherFactor::Precise(f) => f.solve(r),
+        }
+    }
+
+    #[cfg(test)]
+    fn is_dropped(&self, i: usize) -> bool {
+        match self {
+            EitherFactor::Double(f) => f.diag[i] == 0.0,
+            EitherFactor::Precise(f) => f.diag[i].to_f64() == 0.0,
+        }
+    }
 }
 
 impl Projector {
@@ -375,11 +426,28 @@ impl Projector {
     pub fn new(rows: &[Row], n: usize, c: &[f64], ordering: &Ordering) -> Projector {
         debug_assert_eq!(ordering.order.len(), rows.len());
         let unit = UnitRows::new(rows, c);
-        let (d, off) = normal_matrix(&unit.rows, n);
+        let (d, off) = normal_matrix::<f64>(&unit.rows, n);
         let (factor, dropped) = factor(&d, &off, DEPENDENT_PIVOT, ordering);
         Projector {
             unit,
-            factor,
+            factor: EitherFactor::Double(factor),
+            dropped,
+        }
+    }
+
+    /// [`Projector::new`] with Â Âᵀ formed and factored in double-double, dropping rows whose
+    /// squared distance from the span of the rows before them is below `drop`
+    /// ([`PRECISE_PIVOT`] in the repair): for groups whose f64 factor misses their rows
+    /// (pivots of nearly dependent rows lost in f64's rounding).
+    #[must_use]
+    pub fn precise(rows: &[Row], n: usize, c: &[f64], ordering: &Ordering, drop: f64) -> Projector {
+        debug_assert_eq!(ordering.order.len(), rows.len());
+        let unit = UnitRows::new(rows, c);
+        let (d, off) = normal_matrix::<Dd>(&unit.rows, n);
+        let (factor, dropped) = factor(&d, &off, drop, ordering);
+        Projector {
+            unit,
+            factor: EitherFactor::Precise(factor),
             dropped,
         }
     }
@@ -388,8 +456,8 @@ impl Projector {
     #[cfg(test)]
     #[must_use]
     pub fn dropped_rows(&self) -> Vec<usize> {
-        (0..self.factor.diag.len())
-            .filter(|&i| self.factor.diag[i] == 0.0)
+        (0..self.unit.rows.len())
+            .filter(|&i| self.factor.is_dropped(i))
             .collect()
     }
 
@@ -433,12 +501,22 @@ impl Projector {
             }
         }
         if res > tol {
-            let (got, _) = conjugate_gradients(&self.unit, c, &self.factor, x, tol, CG_STALL);
+            let solve = |z: &mut [f64]| self.factor.solve(z);
+            let (got, _) = conjugate_gradients(&self.unit, c, &solve, x, tol, CG_STALL);
             res = got.min(res);
         }
         res
     }
 }
+
+/// Drop threshold of [`Projector::precise`]: rows within √1e-15 ≈ 3e-8 of the span of the
+/// rows before them are dependent. Measured on spot's Hessian-pass group of 18506 unknowns
+/// (15375 rows): in double-double every pivot lies above 1e-12 or below 1e-18 (478 dropped at
+/// any threshold between), and the moves meet every row to 3e-14 of the data; at 1e-22 two
+/// rows of pivots ~1e-20 (rows dependent in exact geometry, off the span by their
+/// coefficients' rounding) are kept and the moves miss by 2e-3, as the f64 factor's did
+/// (its pivots below ~1e-13 are rounding).
+pub const PRECISE_PIVOT: f64 = 1e-15;
 
 /// x += Âᵀ y for the unit rows `arows` (rows with y_i = 0 skipped): the least-norm move of the
 /// refinement, the projections and conjugate gradients.
@@ -453,8 +531,9 @@ fn add_transposed(arows: &[Vec<(u32, f64)>], y: &[f64], x: &mut [f64]) {
 }
 
 /// Â Âᵀ of the unit rows `arows` over `n` unknowns: its diagonal and its strictly upper
-/// entries (row, column, value), the input of [`factor`].
-fn normal_matrix(arows: &[Vec<(u32, f64)>], n: usize) -> (Vec<f64>, Vec<(u32, u32, f64)>) {
+/// entries (row, column, value), the input of [`factor`], summed in `T` (exact products in
+/// double-double).
+fn normal_matrix<T: Real>(arows: &[Vec<(u32, f64)>], n: usize) -> (Vec<T>, Vec<(u32, u32, T)>) {
     let m = arows.len();
     // Rows of each column.
     let mut by_col: Vec<Vec<(u32, f64)>> = vec![Vec::new(); n];
@@ -463,10 +542,12 @@ fn normal_matrix(arows: &[Vec<(u32, f64)>], n: usize) -> (Vec<f64>, Vec<(u32, u3
             by_col[j as usize].push((i as u32, a));
         }
     }
-    // Â Âᵀ: diagonal and the strictly upper entries.
-    let mut d = vec![0.0; m];
-    let mut off: Vec<(u32, u32, f64)> = Vec::new();
-    let mut acc = vec![0.0; m];
+    // Â Âᵀ: diagonal and the strictly upper entries (an entry that cancels exactly is kept
+    // out).
+    let mut d = vec![T::default(); m];
+    let mut off: Vec<(u32, u32, T)> = Vec::new();
+    let mut acc = vec![T::default(); m];
+    let mut seen = vec![false; m];
     let mut touched: Vec<u32> = Vec::new();
     for (i, r) in arows.iter().enumerate() {
         for &(j, a) in r {
@@ -474,23 +555,20 @@ fn normal_matrix(arows: &[Vec<(u32, f64)>], n: usize) -> (Vec<f64>, Vec<(u32, u3
                 if (k as usize) < i {
                     continue;
                 }
-                if acc[k as usize] == 0.0 {
+                if !seen[k as usize] {
+                    seen[k as usize] = true;
                     touched.push(k);
                 }
-                acc[k as usize] += a * b;
-                if acc[k as usize] == 0.0 {
-                    // Keep it marked as touched (exact cancellation).
-                    acc[k as usize] = f64::MIN_POSITIVE;
-                }
+                acc[k as usize] += T::product(a, b);
             }
         }
         touched.sort_unstable();
         for &k in &touched {
-            let v = acc[k as usize];
-            acc[k as usize] = 0.0;
+            let v = std::mem::take(&mut acc[k as usize]);
+            seen[k as usize] = false;
             if k as usize == i {
                 d[i] = v;
-            } else if v != f64::MIN_POSITIVE {
+            } else if v.f64() != 0.0 {
                 off.push((i as u32, k, v));
             }
         }
@@ -517,7 +595,7 @@ const CG_STALL: usize = 8;
 fn conjugate_gradients(
     unit: &UnitRows,
     c: &[f64],
-    f: &Factor,
+    f: &dyn Fn(&mut [f64]),
     x: &mut Vec<f64>,
     tol: f64,
     stall: usize,
@@ -533,7 +611,7 @@ fn conjugate_gradients(
     let precondition = |r: &[f64], z: &mut Vec<f64>| {
         z.clear();
         z.extend_from_slice(r);
-        f.solve(z);
+        f(z);
     };
     let mut z = Vec::new();
     precondition(&r, &mut z);
@@ -666,7 +744,14 @@ pub(super) mod tests {
         let mut x = target.clone();
         // No stall stop: with this preconditioner the largest residual need not halve for
         // many steps in a row (CG minimises another norm).
-        let (res, _) = conjugate_gradients(&unit, &unit.c, &f, &mut x, 1e-12, CG_ITERATIONS);
+        let (res, _) = conjugate_gradients(
+            &unit,
+            &unit.c,
+            &|z| f.solve(z),
+            &mut x,
+            1e-12,
+            CG_ITERATIONS,
+        );
         // Consistent system, entries O(1): rounding-level residual is reachable.
         assert!(res <= 1e-12, "{res}");
         for (u, v) in x.iter().zip(&dense.x) {
@@ -687,12 +772,87 @@ pub(super) mod tests {
         let ordering = Ordering::of(&rows, n);
         let s = solve_near(&rows, n, &c, &target, 1e-13);
         let mut x = s.x.clone();
-        let (d, off) = normal_matrix(&unit.rows, n);
+        let (d, off) = normal_matrix::<f64>(&unit.rows, n);
         let (f, _) = factor(&d, &off, DEPENDENT_PIVOT, &ordering);
-        let (res, iterations) = conjugate_gradients(&unit, &unit.c, &f, &mut x, 1e-13, CG_STALL);
+        let (res, iterations) =
+            conjugate_gradients(&unit, &unit.c, &|z| f.solve(z), &mut x, 1e-13, CG_STALL);
         assert!(iterations <= CG_STALL + 1, "{iterations}");
         // Never worse than where it started; the contradiction (0.5) stays far above rounding.
         assert!(res <= s.residual && res > 1e-3, "{res} vs {}", s.residual);
+    }
+
+    /// The double-double factor resolves a squared distance far below f64's rounding: row b
+    /// = (cos t, sin t) at angle t = 1e-9 from row a = (1, 0) is sin² t ≈ 1e-18 from a's span
+    /// (exactly b₁² for the rows as stored, since |b|² − (a·b)² = b₀² + b₁² − b₀²). f64 forms
+    /// Â Âᵀ's entries and the pivot 1 − cos² t at its rounding (1e-16), so its pivot is
+    /// noise, and the drop decision with it.
+    #[test]
+    fn precise_pivots_resolve_distances_below_f64_rounding() {
+        let t = 1e-9_f64;
+        let rows: Vec<Vec<(u32, f64)>> = vec![vec![(0, 1.0)], vec![(0, t.cos()), (1, t.sin())]];
+        let ordering = Ordering {
+            order: vec![0, 1],
+            pattern: vec![vec![1], vec![]],
+            pos: vec![0, 1],
+        };
+        let true_pivot = t.sin() * t.sin();
+        let (d, off) = normal_matrix::<Dd>(&rows, 2);
+        let (f, dropped) = factor(&d, &off, 0.0, &ordering);
+        assert_eq!(dropped, 0);
+        let piv = f.diag[1] * f.diag[1];
+        // Double-double carries ~32 digits: the pivot's error is ~1e-32 against 1e-18.
+        assert!(
+            (piv.to_f64() - true_pivot).abs() <= 1e-9 * true_pivot,
+            "{piv:?} vs {true_pivot:e}"
+        );
+        let (d, off) = normal_matrix::<f64>(&rows, 2);
+        let (f, _) = factor(&d, &off, 0.0, &ordering);
+        let piv = f.diag[1] * f.diag[1];
+        // What the precise factor is for: f64's pivot is off by orders of magnitude (it is
+        // 1 − cos² t with cos t = 1 − 5e-19 rounded to 1).
+        assert!((piv - true_pivot).abs() > 0.5 * true_pivot, "{piv:e}");
+    }
+
+    /// [`Projector::precise`] agrees with the dense pivoted QR on random rank-deficient
+    /// systems as the f64 solve does (same rank, same closest solution), and meets a row
+    /// pair 1e-6 apart in angle, whose f64 pivot (1e-12) sits 10× above f64's drop threshold
+    /// and within its rounding's reach of it.
+    #[test]
+    fn precise_projector_matches_dense() {
+        for (m, n, seed) in [(30, 50, 12345), (120, 200, 7)] {
+            let (mut a, mut rows, mut c, target) = system(m, n, seed);
+            // Row 4 turned 1e-6 off row 5 (both independent of the rest), consistent data.
+            let t = 1e-6_f64;
+            let b: Row = rows[5]
+                .iter()
+                .map(|&(j, v)| (j, v * t.cos()))
+                .chain([(n - 1, t.sin())])
+                .collect();
+            for j in 0..n {
+                a[4 * n + j] = 0.0;
+            }
+            for &(j, v) in &b {
+                a[4 * n + j] += v;
+            }
+            rows[4] = (0..n)
+                .filter(|&j| a[4 * n + j] != 0.0)
+                .map(|j| (j, a[4 * n + j]))
+                .collect();
+            c[4] = c[5] * t.cos() + t.sin() * 0.25;
+            let d = crate::scheme::quintic_c2::dense::solve_near(&a, m, n, &c, &target, 1e-11);
+            let ordering = Ordering::of(&rows, n);
+            let p = Projector::precise(&rows, n, &c, &ordering, PRECISE_PIVOT);
+            let mut x = target.clone();
+            let res = p.meet(&mut x, 1e-13);
+            assert_eq!(p.rank(), d.rank, "rank ({m}×{n})");
+            // Consistent system: rounding-level residual, as asked.
+            assert!(res <= 1e-13, "{res}");
+            for (u, v) in x.iter().zip(&d.x) {
+                // Both the unique closest solution; the 1e-6 pair conditions it to ~1e6, so
+                // rounding of 1e-16 grows to ~1e-10 in x.
+                assert!((u - v).abs() < 1e-8, "{u} vs {v}");
+            }
+        }
     }
 
     /// An inconsistent dependent row shows in the residual (not hidden by the drop).
