@@ -234,7 +234,7 @@ mod tests {
     /// (w = 100), with the rows each solve misses (`CLEAN=t` first drops terms below t of their
     /// row's largest; `EQUIL=1` solves for the unknowns over their columns' norms).
     #[test]
-    #[ignore = "exploration: DUMP=/tmp/dump_<defect>_<n>.json [CLEAN=1e-13] [EQUIL=1]"]
+    #[ignore = "exploration: DUMP=/tmp/dump_<defect>_<n>.json [CLEAN=1e-13] [EQUIL=1] [PRECISE=drop] [SWEEP=1]"]
     fn explore_dump() {
         let path = std::env::var("DUMP").expect("DUMP=path");
         let j: serde_json::Value =
@@ -289,6 +289,14 @@ mod tests {
             pins.len()
         );
         let ordering = Ordering::of(&rows, n);
+        if std::env::var("SWEEP").is_ok() {
+            // Dropped rows of the precise factor per threshold: a gap shows as a plateau.
+            for e in 9..=24 {
+                let drop = 10f64.powi(-e);
+                let p = Projector::precise(&rows, n, &c, &ordering, drop);
+                eprintln!("  drop 1e-{e}: dropped {}", rows.len() - p.rank());
+            }
+        }
         let solves = match std::env::var("PRECISE") {
             Ok(d) => PinnedSolves::with(
                 Projector::precise(&rows, n, &c, &ordering, d.parse().unwrap()),
@@ -400,31 +408,41 @@ mod tests {
     }
 
     /// Hard pins give what the dense pivoted QR (independent) gives for the rows with the pins
-    /// appended as equations: the same closest solution, pins and rows met.
+    /// appended as equations: the same closest solution, pins and rows met, with the f64
+    /// factor and with the double-double one.
     #[test]
     fn hard_pins_match_the_dense_solve() {
         let (m, n) = (60, 90);
         let (rows, c, x0) = group(m, n, 41);
         let ordering = Ordering::of(&rows, n);
-        let solves = match std::env::var("PRECISE") {
-            Ok(d) => PinnedSolves::with(
-                Projector::precise(&rows, n, &c, &ordering, d.parse().unwrap()),
-                &c,
-                &x0,
-            ),
-            Err(_) => PinnedSolves::new(&rows, &c, n, &x0, &ordering),
-        };
+        let precise = Projector::precise(&rows, n, &c, &ordering, PRECISE_PIVOT);
+        for solves in [
+            PinnedSolves::new(&rows, &c, n, &x0, &ordering),
+            PinnedSolves::with(precise, &c, &x0),
+        ] {
+            hard_pins_check(&solves, &rows, &c, &x0, m, n);
+        }
+    }
+
+    fn hard_pins_check(
+        solves: &PinnedSolves,
+        rows: &[Row],
+        c: &[f64],
+        x0: &[f64],
+        m: usize,
+        n: usize,
+    ) {
         let pins = [(3, 0.7), (17, -0.2), (50, 1.5)];
-        let got = solves.solve(&rows, &c, &pins, None);
-        let mut a = dense_of(&rows, n);
-        let mut rhs = c.clone();
+        let got = solves.solve(rows, c, &pins, None);
+        let mut a = dense_of(rows, n);
+        let mut rhs = c.to_vec();
         for &(j, v) in &pins {
             let mut e = vec![0.0; n];
             e[j] = 1.0;
             a.extend(e);
             rhs.push(v);
         }
-        let want = dense::solve_near(&a, m + pins.len(), n, &rhs, &x0, 1e-11);
+        let want = dense::solve_near(&a, m + pins.len(), n, &rhs, x0, 1e-11);
         // Consistent, modestly conditioned, entries O(1): rounding-level agreement.
         assert!(got.residual < 1e-12, "{}", got.residual);
         assert_eq!(got.rank, m - 1, "one dependent row");
@@ -441,14 +459,7 @@ mod tests {
         let (m, n) = (60, 90);
         let (rows, c, x0) = group(m, n, 7);
         let ordering = Ordering::of(&rows, n);
-        let solves = match std::env::var("PRECISE") {
-            Ok(d) => PinnedSolves::with(
-                Projector::precise(&rows, n, &c, &ordering, d.parse().unwrap()),
-                &c,
-                &x0,
-            ),
-            Err(_) => PinnedSolves::new(&rows, &c, n, &x0, &ordering),
-        };
+        let solves = PinnedSolves::new(&rows, &c, n, &x0, &ordering);
         let pins = [(5, 2.0), (40, -1.0)];
         let w = 30.0;
         let got = solves.solve(&rows, &c, &pins, Some(w));
@@ -489,14 +500,7 @@ mod tests {
             .map(|i| if i <= 10 { i as f64 } else { 0.0 })
             .collect();
         let ordering = Ordering::of(&rows, n);
-        let solves = match std::env::var("PRECISE") {
-            Ok(d) => PinnedSolves::with(
-                Projector::precise(&rows, n, &c, &ordering, d.parse().unwrap()),
-                &c,
-                &x0,
-            ),
-            Err(_) => PinnedSolves::new(&rows, &c, n, &x0, &ordering),
-        };
+        let solves = PinnedSolves::new(&rows, &c, n, &x0, &ordering);
         let pins = [(0, 0.5), (10, 10.0)];
         let hard = solves.solve(&rows, &c, &pins, None);
         // The pins contradict the chain by 0.5: far above rounding.
