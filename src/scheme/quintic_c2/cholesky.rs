@@ -10,9 +10,11 @@
 //!
 //! Dependent equations (a pivot below [`DEPENDENT_PIVOT`] of its row's unit norm, i.e. the row
 //! lies within √1e-13 of the span of the rows eliminated before it) are dropped, as the dense
-//! QR's rank test drops them; whether they are met shows in [`Solution::residual`]. Everything
-//! runs on one thread in a fixed order (ties broken by index), so the bits do not depend on the
-//! thread count.
+//! QR's rank test drops them; whether they are met shows in [`Solution::residual`]. Where the
+//! f64 factor cannot tell nearly dependent rows from dependent ones (their pivots, squared
+//! distances, sink into f64's rounding), the same factorisation runs in double-double
+//! ([`Projector::precise`], [`PRECISE_PIVOT`]). Everything runs on one thread in a fixed order
+//! (ties broken by index), so the bits do not depend on the thread count.
 
 use super::dd::{Dd, Real};
 use super::dense::Solution;

@@ -157,12 +157,12 @@ const ROUNDS: usize = 24;
 const GROWTH: f64 = 2.0;
 /// A re-solved group is consistent when its residual is at most this share of its data (the
 /// staged solve's standard, `system::consistent`).
-const CONSISTENT: f64 = 1e-9;
+pub(super) const CONSISTENT: f64 = 1e-9;
 /// The same for a solve with weighted pins ([`solve_soft`]), whose group is consistent by
 /// construction: looser, as the per-equation residual guard after the solve still holds every
 /// re-solved equation to the staged solve's standard (on the bunny a weighted group missed
 /// 1e-9 of its data by rounding: 2.9e-9 of 0.42).
-const SOFT_CONSISTENT: f64 = 1e-7;
+pub(super) const SOFT_CONSISTENT: f64 = 1e-7;
 
 /// The boundary faces of the hull: (tetrahedron, local opposite vertex) of every face that
 /// belongs to one tetrahedron only, in tetrahedron order.

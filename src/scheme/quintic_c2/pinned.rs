@@ -48,12 +48,6 @@ pub(super) struct PinnedSolves {
     precise: Cell<bool>,
 }
 
-/// The miss of the rows (relative to the group's largest datum) above which a solve is done
-/// again with the double-double factor: the repair's standard for a hard solve
-/// (`holes::CONSISTENT`, 1e-9), a hundred times lower, so that a solve f64 gets nearly right
-/// does not pay for the precise factor.
-const PRECISE_WHEN: f64 = 1e-11;
-
 impl PinnedSolves {
     /// Factors the group `rows`·x = `c` (`n` unknowns) in `ordering` and moves `x0` onto it.
     pub(super) fn new(
@@ -88,10 +82,11 @@ impl PinnedSolves {
     /// miss of the equations as given (`rows`, `c`) and, for hard pins, of the pins;
     /// [`Solution::rank`] is the group's (equations less dependent ones).
     ///
-    /// A solve whose f64 factor misses the rows by more than [`PRECISE_WHEN`] is done again
-    /// with the group factored in double-double (kept for the repair's later solves): the
-    /// nearly dependent rows of spot's Hessian-pass groups were missed by 3e-7 and 1.8e-3 of
-    /// their data in f64.
+    /// A solve whose f64 factor misses the rows by more than the repair accepts (`holes`'
+    /// `CONSISTENT` hard, `SOFT_CONSISTENT` weighted, of the group's largest datum) is done
+    /// again with the group factored in double-double, kept for the repair's later solves:
+    /// the nearly dependent rows of spot's Hessian-pass groups were missed by 3e-7 and 1.8e-3
+    /// of their data in f64.
     pub(super) fn solve(
         &self,
         rows: &[Row],
@@ -102,10 +97,15 @@ impl PinnedSolves {
         let (sol, rows_miss) = self.solve_once(rows, c, pins, weight);
         // Inconsistent hard pins are the caller's to judge: only the rows' miss is the
         // factor's.
-        if self.precise.get() || rows_miss <= PRECISE_WHEN * self.scale {
+        let standard = match weight {
+            None => super::holes::CONSISTENT,
+            Some(_) => super::holes::SOFT_CONSISTENT,
+        };
+        if self.precise.get() || rows_miss <= standard * self.scale {
             return sol;
         }
         let n = self.base.borrow().len();
+        let t = std::time::Instant::now();
         let ordering = Ordering::of(rows, n);
         let proj = Projector::precise(rows, n, c, &ordering, PRECISE_PIVOT);
         let mut base = self.x0.clone();
@@ -114,7 +114,18 @@ impl PinnedSolves {
         *self.base.borrow_mut() = base;
         self.columns.borrow_mut().clear();
         self.precise.set(true);
-        let (again, _) = self.solve_once(rows, c, pins, weight);
+        let (again, again_miss) = self.solve_once(rows, c, pins, weight);
+        if std::env::var_os("APATCH_HOLE_TRACE").is_some() {
+            // Opt-in exploration on stderr (results unaffected).
+            eprintln!(
+                "quintic-c2 hole repair: double-double factor ({n} unknowns, {} rows, {} pins, {}): rows missed {rows_miss:.2e} → {again_miss:.2e} of {:.2e}, {:.2} s",
+                rows.len(),
+                pins.len(),
+                if weight.is_some() { "weighted" } else { "hard" },
+                self.scale,
+                t.elapsed().as_secs_f64()
+            );
+        }
         // The better of the two (NaN-safe: a number beats a NaN).
         if again.residual.partial_cmp(&sol.residual) == Some(std::cmp::Ordering::Greater) {
             sol
