@@ -398,6 +398,22 @@ pub struct Projector {
     dropped: usize,
 }
 
+/// The unit rows of A x = c and the factor of their Â Âᵀ in `T`, formed and factored in
+/// `ordering`, rows below `drop` dropped; with the number dropped.
+fn factored<T: Real>(
+    rows: &[Row],
+    n: usize,
+    c: &[f64],
+    ordering: &Ordering,
+    drop: f64,
+) -> (UnitRows, Factor<T>, usize) {
+    debug_assert_eq!(ordering.order.len(), rows.len());
+    let unit = UnitRows::new(rows, c);
+    let (d, off) = normal_matrix::<T>(&unit.rows, n);
+    let (factor, dropped) = factor(&d, &off, drop, ordering);
+    (unit, factor, dropped)
+}
+
 /// A [`Projector`]'s factor, in f64 or double-double.
 enum EitherFactor {
     Double(Factor),
@@ -415,8 +431,8 @@ impl EitherFactor {
     #[cfg(test)]
     fn is_dropped(&self, i: usize) -> bool {
         match self {
-            EitherFactor::Double(f) => f.diag[i] == 0.0,
-            EitherFactor::Precise(f) => f.diag[i].to_f64() == 0.0,
+            EitherFactor::Double(f) => f.diag[i].f64() == 0.0,
+            EitherFactor::Precise(f) => f.diag[i].f64() == 0.0,
         }
     }
 }
@@ -426,10 +442,7 @@ impl Projector {
     /// for them ([`Ordering::of`]).
     #[must_use]
     pub fn new(rows: &[Row], n: usize, c: &[f64], ordering: &Ordering) -> Projector {
-        debug_assert_eq!(ordering.order.len(), rows.len());
-        let unit = UnitRows::new(rows, c);
-        let (d, off) = normal_matrix::<f64>(&unit.rows, n);
-        let (factor, dropped) = factor(&d, &off, DEPENDENT_PIVOT, ordering);
+        let (unit, factor, dropped) = factored::<f64>(rows, n, c, ordering, DEPENDENT_PIVOT);
         Projector {
             unit,
             factor: EitherFactor::Double(factor),
@@ -443,10 +456,7 @@ impl Projector {
     /// (pivots of nearly dependent rows lost in f64's rounding).
     #[must_use]
     pub fn precise(rows: &[Row], n: usize, c: &[f64], ordering: &Ordering, drop: f64) -> Projector {
-        debug_assert_eq!(ordering.order.len(), rows.len());
-        let unit = UnitRows::new(rows, c);
-        let (d, off) = normal_matrix::<Dd>(&unit.rows, n);
-        let (factor, dropped) = factor(&d, &off, drop, ordering);
+        let (unit, factor, dropped) = factored::<Dd>(rows, n, c, ordering, drop);
         Projector {
             unit,
             factor: EitherFactor::Precise(factor),
@@ -804,7 +814,7 @@ pub(super) mod tests {
         let piv = f.diag[1] * f.diag[1];
         // Double-double carries ~32 digits: the pivot's error is ~1e-32 against 1e-18.
         assert!(
-            (piv.to_f64() - true_pivot).abs() <= 1e-9 * true_pivot,
+            (piv.f64() - true_pivot).abs() <= 1e-9 * true_pivot,
             "{piv:?} vs {true_pivot:e}"
         );
         let (d, off) = normal_matrix::<f64>(&rows, 2);

@@ -37,41 +37,6 @@ fn two_prod(a: f64, b: f64) -> (f64, f64) {
     (p, a.mul_add(b, -p))
 }
 
-impl Dd {
-    #[inline]
-    #[must_use]
-    pub fn from_f64(x: f64) -> Dd {
-        Dd { hi: x, lo: 0.0 }
-    }
-
-    /// a · b of two f64, exactly.
-    #[inline]
-    #[must_use]
-    pub fn product(a: f64, b: f64) -> Dd {
-        let (hi, lo) = two_prod(a, b);
-        Dd { hi, lo }
-    }
-
-    /// The nearest f64.
-    #[inline]
-    #[must_use]
-    pub fn to_f64(self) -> f64 {
-        self.hi + self.lo
-    }
-
-    #[must_use]
-    pub fn sqrt(self) -> Dd {
-        if self.hi <= 0.0 {
-            return Dd::from_f64(self.hi.sqrt());
-        }
-        // One Newton step from the f64 root: √a ≈ s + (a − s²) / (2s).
-        let s = self.hi.sqrt();
-        let e = self - Dd::product(s, s);
-        let (hi, lo) = quick_two_sum(s, e.hi / (2.0 * s));
-        Dd { hi, lo }
-    }
-}
-
 impl Add for Dd {
     type Output = Dd;
     #[inline]
@@ -134,12 +99,12 @@ impl Div for Dd {
     fn div(self, b: Dd) -> Dd {
         // Long division: q1 = a/b in f64, then the remainder's quotient.
         let q1 = self.hi / b.hi;
-        let r = self - b * Dd::from_f64(q1);
+        let r = self - b * Dd::of(q1);
         let q2 = r.hi / b.hi;
-        let r = r - b * Dd::from_f64(q2);
+        let r = r - b * Dd::of(q2);
         let q3 = r.hi / b.hi;
         let (hi, lo) = quick_two_sum(q1, q2);
-        Dd { hi, lo } + Dd::from_f64(q3)
+        Dd { hi, lo } + Dd::of(q3)
     }
 }
 
@@ -184,19 +149,26 @@ impl Real for f64 {
 impl Real for Dd {
     #[inline]
     fn product(a: f64, b: f64) -> Dd {
-        Dd::product(a, b)
+        let (hi, lo) = two_prod(a, b);
+        Dd { hi, lo }
     }
     #[inline]
     fn of(x: f64) -> Dd {
-        Dd::from_f64(x)
+        Dd { hi: x, lo: 0.0 }
     }
     #[inline]
     fn f64(self) -> f64 {
-        self.to_f64()
+        self.hi + self.lo
     }
-    #[inline]
     fn root(self) -> Dd {
-        self.sqrt()
+        if self.hi <= 0.0 {
+            return Dd::of(self.hi.sqrt());
+        }
+        // One Newton step from the f64 root: √a ≈ s + (a − s²) / (2s).
+        let s = self.hi.sqrt();
+        let e = self - Dd::product(s, s);
+        let (hi, lo) = quick_two_sum(s, e.hi / (2.0 * s));
+        Dd { hi, lo }
     }
 }
 
@@ -210,8 +182,8 @@ mod tests {
     fn products_keep_what_f64_rounds_away() {
         let a = 1.0 + 2f64.powi(-30);
         let small = 2f64.powi(-60);
-        let sq = Dd::product(a, a) - Dd::from_f64(1.0) - Dd::from_f64(2f64.powi(-29));
-        assert_eq!(sq.to_f64(), small);
+        let sq = Dd::product(a, a) - Dd::of(1.0) - Dd::of(2f64.powi(-29));
+        assert_eq!(sq.f64(), small);
         assert_eq!(a * a - 1.0 - 2f64.powi(-29), 0.0);
     }
 
@@ -219,13 +191,13 @@ mod tests {
     /// precision, 2⁻¹⁰⁴ ≈ 5e-32, with a few roundings).
     #[test]
     fn division_and_root_invert_products() {
-        let third = Dd::from_f64(1.0) / Dd::from_f64(3.0);
-        let back = third * Dd::from_f64(3.0) - Dd::from_f64(1.0);
-        assert!(back.to_f64().abs() < 1e-31, "{back:?}");
-        let two = Dd::from_f64(2.0);
-        let r = two.sqrt();
+        let third = Dd::of(1.0) / Dd::of(3.0);
+        let back = third * Dd::of(3.0) - Dd::of(1.0);
+        assert!(back.f64().abs() < 1e-31, "{back:?}");
+        let two = Dd::of(2.0);
+        let r = two.root();
         let back = r * r - two;
-        assert!(back.to_f64().abs() < 1e-31, "{back:?}");
+        assert!(back.f64().abs() < 1e-31, "{back:?}");
         // Not just the f64 root.
         assert!(r.lo != 0.0);
     }
