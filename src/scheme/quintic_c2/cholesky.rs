@@ -19,6 +19,7 @@
 use super::dd::{Dd, Real};
 use super::dense::Solution;
 use super::sparse::Row;
+use rayon::prelude::*;
 
 /// Squared distance of a unit row from the span of the rows before it below which it is taken
 /// as dependent: exact dependencies leave pivots at the rounding of the elimination (≲ 1e-15
@@ -80,6 +81,63 @@ impl<T: Real> Factor<T> {
             w[v] = s / self.diag[v];
         }
         w
+    }
+}
+
+/// Right-hand sides of [`Factor::solve_wide_many`]'s one pass over L.
+const BATCH: usize = 8;
+
+impl<T: Real> Factor<T> {
+    /// [`Factor::solve_wide`] for up to [`BATCH`] right-hand sides in one pass over L (the
+    /// solve reads L once from memory for all of them); each gets the same arithmetic, in the
+    /// same order, as alone.
+    fn solve_wide_many(&self, rs: &[&[f64]]) -> Vec<Vec<T>> {
+        let b = rs.len();
+        assert!(b <= BATCH, "{b} right-hand sides, at most {BATCH}");
+        let m = self.diag.len();
+        let mut w = vec![[T::default(); BATCH]; m];
+        for (k, r) in rs.iter().enumerate() {
+            for (wi, &ri) in w.iter_mut().zip(r.iter()) {
+                wi[k] = T::of(ri);
+            }
+        }
+        for &v in &self.order {
+            let v = v as usize;
+            if self.diag[v].f64() == 0.0 {
+                w[v] = [T::default(); BATCH];
+                continue;
+            }
+            let d = self.diag[v];
+            let mut z = w[v];
+            for zk in &mut z[..b] {
+                *zk = *zk / d;
+            }
+            w[v] = z;
+            for &(u, l) in &self.cols[v] {
+                let wu = &mut w[u as usize];
+                for k in 0..b {
+                    wu[k] -= l * z[k];
+                }
+            }
+        }
+        for &v in self.order.iter().rev() {
+            let v = v as usize;
+            if self.diag[v].f64() == 0.0 {
+                continue;
+            }
+            let mut s = w[v];
+            for &(u, l) in &self.cols[v] {
+                let wu = &w[u as usize];
+                for k in 0..b {
+                    s[k] -= l * wu[k];
+                }
+            }
+            let d = self.diag[v];
+            for k in 0..b {
+                w[v][k] = s[k] / d;
+            }
+        }
+        (0..b).map(|k| w.iter().map(|wi| wi[k]).collect()).collect()
     }
 }
 
@@ -445,18 +503,27 @@ impl EitherFactor {
                 f.solve(r);
                 add_transposed(arows, r, x);
             }
-            EitherFactor::Precise(f) => {
-                let y = f.solve_wide(r);
-                let mut acc: Vec<Dd> = x.iter().map(|&v| Dd::of(v)).collect();
-                for (row, &yi) in arows.iter().zip(&y) {
-                    if yi.f64() != 0.0 {
-                        for &(j, a) in row {
-                            acc[j as usize] += Dd::of(a) * yi;
-                        }
+            EitherFactor::Precise(f) => add_transposed_precise(arows, &f.solve_wide(r), x),
+        }
+    }
+
+    /// [`EitherFactor::correct`] of several (x, r) pairs (at most [`BATCH`]) with one pass
+    /// over the factor, each with the same arithmetic as alone.
+    fn correct_many(&self, arows: &[Vec<(u32, f64)>], rs: &mut [Vec<f64>], xs: &mut [Vec<f64>]) {
+        let views: Vec<&[f64]> = rs.iter().map(Vec::as_slice).collect();
+        match self {
+            EitherFactor::Double(f) => {
+                let ys = f.solve_wide_many(&views);
+                for ((r, y), x) in rs.iter_mut().zip(ys).zip(xs) {
+                    for (ri, yi) in r.iter_mut().zip(y) {
+                        *ri = yi;
                     }
+                    add_transposed(arows, r, x);
                 }
-                for (v, s) in x.iter_mut().zip(acc) {
-                    *v = s.f64();
+            }
+            EitherFactor::Precise(f) => {
+                for (y, x) in f.solve_wide_many(&views).iter().zip(xs) {
+                    add_transposed_precise(arows, y, x);
                 }
             }
         }
@@ -525,26 +592,93 @@ impl Projector {
         self.refine(v, &vec![0.0; self.unit.rows.len()], tol)
     }
 
+    /// The projections Π e_j of the unit vectors of unknowns `js` (of `n`), as
+    /// [`Projector::project`] makes them one by one (the same values), with their residuals:
+    /// the first solve of each [`BATCH`] of them shares one pass over the factor, and the
+    /// batches run in parallel. The repair's pinned solves spent most of their time in these
+    /// projections (a profile of the nut's repair: 66% in the factor's solves).
+    #[must_use]
+    pub fn project_units(&self, js: &[usize], n: usize, tol: f64) -> Vec<(Vec<f64>, f64)> {
+        let m = self.unit.rows.len();
+        let zero = vec![0.0; m];
+        js.par_chunks(BATCH)
+            .flat_map_iter(|chunk| {
+                let mut xs: Vec<Vec<f64>> = chunk
+                    .iter()
+                    .map(|&j| {
+                        let mut v = vec![0.0; n];
+                        v[j] = 1.0;
+                        v
+                    })
+                    .collect();
+                let mut rs = vec![vec![0.0; m]; chunk.len()];
+                let mut res: Vec<f64> = xs
+                    .iter()
+                    .zip(&mut rs)
+                    .map(|(x, r)| self.unit.residual_to(&zero, x, r))
+                    .collect();
+                // Step 0 of the refinement, batched for those above `tol`.
+                let active: Vec<usize> = (0..chunk.len()).filter(|&k| res[k] > tol).collect();
+                let before: Vec<Vec<f64>> = active.iter().map(|&k| xs[k].clone()).collect();
+                let mut ax: Vec<Vec<f64>> =
+                    active.iter().map(|&k| std::mem::take(&mut xs[k])).collect();
+                let mut ar: Vec<Vec<f64>> =
+                    active.iter().map(|&k| std::mem::take(&mut rs[k])).collect();
+                self.factor.correct_many(&self.unit.rows, &mut ar, &mut ax);
+                for (((&k, x), mut r), old) in active.iter().zip(ax).zip(ar).zip(before) {
+                    let mut x = x;
+                    let now = self.unit.residual_to(&zero, &x, &mut r);
+                    res[k] = if now.partial_cmp(&res[k]) == Some(std::cmp::Ordering::Less) {
+                        self.refine_from(&mut x, &zero, tol, &mut r, now, 1)
+                    } else {
+                        x = old;
+                        self.finish(&mut x, &zero, tol, res[k])
+                    };
+                    xs[k] = x;
+                }
+                xs.into_iter().zip(res).collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
     /// Least-norm corrections along Âᵀ y towards Â x = `c`: iterative refinement with the
     /// factor while it lowers the residual, then conjugate gradients preconditioned by it
     /// (as [`solve_near_ordered`] does). Leaves `x` at the best point met.
     fn refine(&self, x: &mut Vec<f64>, c: &[f64], tol: f64) -> f64 {
-        let arows = &self.unit.rows;
-        let mut r = vec![0.0; arows.len()];
-        let mut res = self.unit.residual_to(c, x, &mut r);
-        for _ in 0..=REFINE {
+        let mut r = vec![0.0; self.unit.rows.len()];
+        let res = self.unit.residual_to(c, x, &mut r);
+        self.refine_from(x, c, tol, &mut r, res, 0)
+    }
+
+    /// [`Projector::refine`] from refinement step `from` on, `r` and `res` the residual at `x`.
+    fn refine_from(
+        &self,
+        x: &mut Vec<f64>,
+        c: &[f64],
+        tol: f64,
+        r: &mut [f64],
+        mut res: f64,
+        from: usize,
+    ) -> f64 {
+        for _ in from..=REFINE {
             if res <= tol {
                 return res;
             }
             let before = (res, x.clone());
-            self.factor.correct(arows, &mut r, x);
-            res = self.unit.residual_to(c, x, &mut r);
+            self.factor.correct(&self.unit.rows, r, x);
+            res = self.unit.residual_to(c, x, r);
             if res.partial_cmp(&before.0) != Some(std::cmp::Ordering::Less) {
                 // Refinement stopped helping (NaN-safe): keep the better point.
                 (res, *x) = before;
-                break;
+                return self.finish(x, c, tol, res);
             }
         }
+        self.finish(x, c, tol, res)
+    }
+
+    /// The end of [`Projector::refine`]: conjugate gradients where refinement left `x` (its
+    /// residual `res`) short of `tol`.
+    fn finish(&self, x: &mut Vec<f64>, c: &[f64], tol: f64, mut res: f64) -> f64 {
         if res > tol {
             let solve = |z: &mut [f64]| self.factor.solve(z);
             let (got, _) = conjugate_gradients(&self.unit, c, &solve, x, tol, CG_STALL);
@@ -562,6 +696,22 @@ impl Projector {
 /// coefficients' rounding) are kept and the moves miss by 2e-3, as the f64 factor's did
 /// (its pivots below ~1e-13 are rounding).
 pub const PRECISE_PIVOT: f64 = 1e-15;
+
+/// x += Âᵀ y with y and the sum in double-double, x rounded once at the end
+/// ([`EitherFactor::correct`] says why).
+fn add_transposed_precise(arows: &[Vec<(u32, f64)>], y: &[Dd], x: &mut [f64]) {
+    let mut acc: Vec<Dd> = x.iter().map(|&v| Dd::of(v)).collect();
+    for (row, &yi) in arows.iter().zip(y) {
+        if yi.f64() != 0.0 {
+            for &(j, a) in row {
+                acc[j as usize] += Dd::of(a) * yi;
+            }
+        }
+    }
+    for (v, s) in x.iter_mut().zip(acc) {
+        *v = s.f64();
+    }
+}
 
 /// x += Âᵀ y for the unit rows `arows` (rows with y_i = 0 skipped): the least-norm move of the
 /// refinement, the projections and conjugate gradients.
@@ -856,6 +1006,34 @@ pub(super) mod tests {
         // What the precise factor is for: f64's pivot is off by orders of magnitude (it is
         // 1 − cos² t with cos t = 1 − 5e-19 rounded to 1).
         assert!((piv - true_pivot).abs() > 0.5 * true_pivot, "{piv:e}");
+    }
+
+    /// [`Projector::project_units`] (batched, parallel) gives the projections
+    /// [`Projector::project`] gives one by one, bit for bit, in both precisions: 19 unknowns,
+    /// so the last batch is partial; a rank-deficient system, so some rows are dropped.
+    #[test]
+    fn batched_projections_are_the_single_ones() {
+        let (m, n) = (60, 90);
+        let (_, rows, c, _) = system(m, n, 4242);
+        let ordering = Ordering::of(&rows, n);
+        let js: Vec<usize> = (0..19).map(|k| (k * 7 + 3) % n).collect();
+        for p in [
+            Projector::new(&rows, n, &c, &ordering),
+            Projector::precise(&rows, n, &c, &ordering, PRECISE_PIVOT),
+        ] {
+            for (&j, (v, res)) in js.iter().zip(p.project_units(&js, n, 1e-13)) {
+                let mut e = vec![0.0; n];
+                e[j] = 1.0;
+                let one = p.project(&mut e, 1e-13);
+                assert_eq!(res.to_bits(), one.to_bits(), "column {j}");
+                assert!(
+                    v.iter().zip(&e).all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "column {j}"
+                );
+                // A real projection: unit vector moved into the null space.
+                assert!(res <= 1e-13 && v[j] < 1.0, "column {j}: {res:e}, {}", v[j]);
+            }
+        }
     }
 
     /// [`Projector::precise`] agrees with the dense pivoted QR on random rank-deficient

@@ -147,14 +147,16 @@ impl PinnedSolves {
         let k = pins.len();
         let n = base.len();
         let mut columns = self.columns.borrow_mut();
-        for &(j, _) in pins {
-            columns.entry(j).or_insert_with(|| {
-                let mut v = vec![0.0; n];
-                v[j] = 1.0;
-                // A unit vector: the staged solves' standard, 1e-13 of its size.
-                proj.project(&mut v, 1e-13);
-                v
-            });
+        let mut new: Vec<usize> = pins
+            .iter()
+            .map(|p| p.0)
+            .filter(|j| !columns.contains_key(j))
+            .collect();
+        new.sort_unstable();
+        new.dedup();
+        // Unit vectors: the staged solves' standard, 1e-13 of their size.
+        for (j, (v, _)) in new.iter().zip(proj.project_units(&new, n, 1e-13)) {
+            columns.insert(*j, v);
         }
         let cols: Vec<&Vec<f64>> = pins.iter().map(|(j, _)| &columns[j]).collect();
         // G, symmetrised (its two halves differ by the projections' rounding).
@@ -335,6 +337,25 @@ mod tests {
             eprintln!(
                 "  column {j}: projection residual {got:.3e}, |Π e_j|² {:.3e}",
                 v[j]
+            );
+        }
+        if std::env::var("TIMEPROJ").is_ok() {
+            // One by one against batched (the same values), in one run.
+            let js: Vec<usize> = pins.iter().map(|p| p.0).collect();
+            let proj = solves.proj.borrow();
+            let t = std::time::Instant::now();
+            for &j in &js {
+                let mut v = vec![0.0; n];
+                v[j] = 1.0;
+                proj.project(&mut v, 1e-13);
+            }
+            let single = t.elapsed().as_secs_f64();
+            let t = std::time::Instant::now();
+            let _ = proj.project_units(&js, n, 1e-13);
+            let batched = t.elapsed().as_secs_f64();
+            eprintln!(
+                "{} projections: one by one {single:.3} s, batched {batched:.3} s",
+                js.len()
             );
         }
         let dropped = solves.proj.borrow().dropped_rows();
