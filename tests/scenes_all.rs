@@ -26,7 +26,11 @@ fn scenes(dir: &str) -> Vec<PathBuf> {
 /// 1300 singular star systems and the hole repair). CI's time budget cannot hold them, so
 /// they are checked by the ignored [`heavy_scenes_build_and_pass_check`] instead, with the
 /// same checks: `cargo test --release --test scenes_all -- --ignored`.
-const HEAVY: &[&str] = &["bunny_quintic.toml", "knot_quintic.toml"];
+const HEAVY: &[&str] = &[
+    "bunny_quintic.toml",
+    "knot_quintic.toml",
+    "spot_quintic.toml",
+];
 
 fn is_heavy(path: &Path) -> bool {
     path.file_name()
@@ -110,7 +114,7 @@ fn shipped_scenes_build_and_pass_check() {
 
 /// The [`HEAVY`] scenes, each shipped and held to the same checks.
 #[test]
-#[ignore = "slow (~5 CPU-min per scene): the heavy shipped scenes, run by hand"]
+#[ignore = "slow (5-20 CPU-min per scene): the heavy shipped scenes, run by hand"]
 fn heavy_scenes_build_and_pass_check() {
     let heavy: Vec<_> = shipped().into_iter().filter(|p| is_heavy(p)).collect();
     assert_eq!(
