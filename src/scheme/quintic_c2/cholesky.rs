@@ -56,31 +56,8 @@ impl<T: Real> Factor<T> {
 
     /// L Lᵀ y = r solved and returned in the factor's precision (dependent nodes get y = 0).
     fn solve_wide(&self, r: &[f64]) -> Vec<T> {
-        let mut w: Vec<T> = r.iter().map(|&x| T::of(x)).collect();
-        for &v in &self.order {
-            let v = v as usize;
-            if self.diag[v].f64() == 0.0 {
-                w[v] = T::default();
-                continue;
-            }
-            let z = w[v] / self.diag[v];
-            w[v] = z;
-            for &(u, l) in &self.cols[v] {
-                w[u as usize] -= l * z;
-            }
-        }
-        for &v in self.order.iter().rev() {
-            let v = v as usize;
-            if self.diag[v].f64() == 0.0 {
-                continue;
-            }
-            let mut s = w[v];
-            for &(u, l) in &self.cols[v] {
-                s -= l * w[u as usize];
-            }
-            w[v] = s / self.diag[v];
-        }
-        w
+        let mut y = self.solve_batch::<1>(&[r]);
+        y.pop().unwrap_or_default()
     }
 }
 
@@ -92,10 +69,15 @@ impl<T: Real> Factor<T> {
     /// solve reads L once from memory for all of them); each gets the same arithmetic, in the
     /// same order, as alone.
     fn solve_wide_many(&self, rs: &[&[f64]]) -> Vec<Vec<T>> {
+        self.solve_batch::<BATCH>(rs)
+    }
+
+    /// L Lᵀ y = r for up to `B` right-hand sides `rs`, kept side by side per node.
+    fn solve_batch<const B: usize>(&self, rs: &[&[f64]]) -> Vec<Vec<T>> {
         let b = rs.len();
-        assert!(b <= BATCH, "{b} right-hand sides, at most {BATCH}");
+        assert!(b <= B, "{b} right-hand sides, at most {B}");
         let m = self.diag.len();
-        let mut w = vec![[T::default(); BATCH]; m];
+        let mut w = vec![[T::default(); B]; m];
         for (k, r) in rs.iter().enumerate() {
             for (wi, &ri) in w.iter_mut().zip(r.iter()) {
                 wi[k] = T::of(ri);
@@ -104,7 +86,7 @@ impl<T: Real> Factor<T> {
         for &v in &self.order {
             let v = v as usize;
             if self.diag[v].f64() == 0.0 {
-                w[v] = [T::default(); BATCH];
+                w[v] = [T::default(); B];
                 continue;
             }
             let d = self.diag[v];
