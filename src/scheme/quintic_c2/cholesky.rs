@@ -13,8 +13,9 @@
 //! QR's rank test drops them; whether they are met shows in [`Solution::residual`]. Where the
 //! f64 factor cannot tell nearly dependent rows from dependent ones (their pivots, squared
 //! distances, sink into f64's rounding), the same factorisation runs in double-double
-//! ([`Projector::precise`], [`PRECISE_PIVOT`]). Everything runs on one thread in a fixed order
-//! (ties broken by index), so the bits do not depend on the thread count.
+//! ([`Projector::precise`], [`PRECISE_PIVOT`]). Every solve runs on one thread in a fixed order
+//! (ties broken by index); [`Projector::project_units`] runs its projections in parallel, each
+//! with the arithmetic it has alone, so the bits do not depend on the thread count.
 
 use super::dd::{Dd, Real};
 use super::dense::Solution;
@@ -490,21 +491,16 @@ impl EitherFactor {
     }
 
     /// [`EitherFactor::correct`] of several (x, r) pairs (at most [`BATCH`]) with one pass
-    /// over the factor, each with the same arithmetic as alone.
-    fn correct_many(&self, arows: &[Vec<(u32, f64)>], rs: &mut [Vec<f64>], xs: &mut [Vec<f64>]) {
-        let views: Vec<&[f64]> = rs.iter().map(Vec::as_slice).collect();
+    /// over the factor, each x with the same arithmetic as alone (the rs are left as they are).
+    fn correct_many(&self, arows: &[Vec<(u32, f64)>], rs: &[&[f64]], xs: &mut [Vec<f64>]) {
         match self {
             EitherFactor::Double(f) => {
-                let ys = f.solve_wide_many(&views);
-                for ((r, y), x) in rs.iter_mut().zip(ys).zip(xs) {
-                    for (ri, yi) in r.iter_mut().zip(y) {
-                        *ri = yi;
-                    }
-                    add_transposed(arows, r, x);
+                for (y, x) in f.solve_wide_many(rs).iter().zip(xs) {
+                    add_transposed(arows, y, x);
                 }
             }
             EitherFactor::Precise(f) => {
-                for (y, x) in f.solve_wide_many(&views).iter().zip(xs) {
+                for (y, x) in f.solve_wide_many(rs).iter().zip(xs) {
                     add_transposed_precise(arows, y, x);
                 }
             }
@@ -604,11 +600,11 @@ impl Projector {
                 let before: Vec<Vec<f64>> = active.iter().map(|&k| xs[k].clone()).collect();
                 let mut ax: Vec<Vec<f64>> =
                     active.iter().map(|&k| std::mem::take(&mut xs[k])).collect();
-                let mut ar: Vec<Vec<f64>> =
+                let ar: Vec<Vec<f64>> =
                     active.iter().map(|&k| std::mem::take(&mut rs[k])).collect();
-                self.factor.correct_many(&self.unit.rows, &mut ar, &mut ax);
-                for (((&k, x), mut r), old) in active.iter().zip(ax).zip(ar).zip(before) {
-                    let mut x = x;
+                let views: Vec<&[f64]> = ar.iter().map(Vec::as_slice).collect();
+                self.factor.correct_many(&self.unit.rows, &views, &mut ax);
+                for (((&k, mut x), mut r), old) in active.iter().zip(ax).zip(ar).zip(before) {
                     let now = self.unit.residual_to(&zero, &x, &mut r);
                     res[k] = if now.partial_cmp(&res[k]) == Some(std::cmp::Ordering::Less) {
                         self.refine_from(&mut x, &zero, tol, &mut r, now, 1)
