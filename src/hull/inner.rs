@@ -89,6 +89,7 @@ pub mod nearguard;
 pub mod normals;
 pub mod overlapnet;
 pub mod planar;
+pub mod reapex;
 pub mod recut;
 pub mod remesh;
 pub mod retriangulate;
@@ -148,6 +149,11 @@ pub struct InnerOptions {
     /// rebuilding and verifying ([`recut`]; default false: opt-in, up to
     /// [`recut::MAX_TRIALS`] rebuilds). For strongly folded control cages (spot_control_cage).
     pub corner_search: bool,
+    /// Where the hull (after the searches above, if on) still has overlapping tetrahedra,
+    /// move the apexes they depend on: lower, towards the centroid or sideways, chosen by the
+    /// overlap test itself ([`reapex`]; default false: opt-in). For strongly folded control
+    /// cages (spot_control_cage).
+    pub apex_search: bool,
 }
 
 impl Default for InnerOptions {
@@ -162,13 +168,14 @@ impl Default for InnerOptions {
             min_volume: verify::DEGENERATE_VOLUME,
             split_search: false,
             corner_search: false,
+            apex_search: false,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 8] = [
+    pub const KEYS: [&'static str; 9] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
@@ -177,12 +184,13 @@ impl InnerOptions {
         "merge_close",
         "split_search",
         "corner_search",
+        "apex_search",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
-    /// (number in [0, 1]), `merge_close` (number in [0, 0.05]), `split_search` and `corner_search`
-    /// (booleans) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
+    /// (number in [0, 1]), `merge_close` (number in [0, 0.05]), `split_search`, `corner_search`
+    /// and `apex_search` (booleans) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -276,6 +284,7 @@ impl InnerOptions {
         for (key, slot) in [
             ("split_search", &mut o.split_search),
             ("corner_search", &mut o.corner_search),
+            ("apex_search", &mut o.apex_search),
         ] {
             match table.get(key) {
                 None => {}
@@ -336,6 +345,8 @@ pub struct InnerReport {
     /// Corners whose normal or α the verification search changed ([`recut`],
     /// `corner_search`), with the violations before and after.
     pub recut: recut::Search,
+    /// The apex search's log ([`reapex`]; empty unless `apex_search`).
+    pub reapex: reapex::Search,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
     /// Input faces of the merged polygons that could take a flat net but have none
@@ -372,6 +383,58 @@ pub fn build(mesh: &Mesh, normals: &[DVec3], options: &InnerOptions) -> Result<S
 /// 2-manifold (naming the vertex and its line), zero-area faces, and corners where no normal is
 /// above all faces (or where one is not and `fix_normals` is off).
 pub fn build_with_report(
+    mesh: &Mesh,
+    normals: &[DVec3],
+    options: &InnerOptions,
+) -> Result<(SimplicialHull, InnerReport)> {
+    let (hull, report) = build_searched(mesh, normals, options)?;
+    if !options.apex_search {
+        return Ok((hull, report));
+    }
+    Ok(apex_search(hull, report))
+}
+
+/// [`reapex::improve`] on `hull`, kept when `verify` agrees that it helped: fewer violations
+/// and none of another kind than overlaps more than before (the search counts overlaps only).
+fn apex_search(hull: SimplicialHull, mut report: InnerReport) -> (SimplicialHull, InnerReport) {
+    let before = verify(&hull);
+    if before.is_empty() {
+        return (hull, report);
+    }
+    let mut moved = hull.clone();
+    let log = reapex::improve(&mut moved);
+    if log.moved.is_empty() {
+        return (hull, report);
+    }
+    let after = verify(&moved);
+    if std::env::var("APATCH_REAPEX_TRACE").is_ok() {
+        eprintln!(
+            "reapex: violations {} -> {}; overlaps {} -> {}, {} moved, {} removed, {} trials",
+            before.len(),
+            after.len(),
+            log.before,
+            log.after,
+            log.moved.len(),
+            log.removed.len(),
+            log.trials
+        );
+    }
+    let others = |v: &[HullViolation]| {
+        v.iter()
+            .filter(|x| x.kind != ViolationKind::Intersecting)
+            .count()
+    };
+    if after.len() < before.len() && others(&after) <= others(&before) {
+        report.reapex = log;
+        (moved, report)
+    } else {
+        (hull, report)
+    }
+}
+
+/// [`build_with_report`] up to the apex search: the build with the flat nets the overlaps
+/// force, then the split and corner searches.
+fn build_searched(
     mesh: &Mesh,
     normals: &[DVec3],
     options: &InnerOptions,

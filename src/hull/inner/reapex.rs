@@ -1,0 +1,479 @@
+//! Apexes moved by the hull's own overlap test (beyond the paper; the last overlaps of
+//! spot_control_cage's folded corners).
+//!
+//! Where to put the apex q of a face tetrahedron over a triangle [p0 p1 p2] of T is a free
+//! choice within the conditions of Definition 3.6: the tetrahedron must lie on its side of the
+//! triangle, stay tangent-containing (Definition 3.5) and not overlap any other tetrahedron of
+//! the hull (Lemma 4.3). The construction (§4, Algorithm 1 and its steps) places q by rules
+//! that do not look at the neighbours, and where T folds tightly (a valley between two fan
+//! triangles of a folded corner, a narrow gap between two corners' fans) the face tetrahedra,
+//! or the edge tetrahedra [p_i p_j q s] glued to them, reach into each other.
+//!
+//! [`improve`] tries, for every apex that an overlapping pair depends on (the face
+//! tetrahedron's own, or either apex of an edge tetrahedron, whose shared point s is their
+//! midpoint), a fixed set of positions: lower over its base, pulled towards the triangle's
+//! centroid, or shifted towards a base vertex or an edge midpoint ([`candidates`]). A move is
+//! kept when it lowers the number of overlapping pairs the moved tetrahedra take part in (or
+//! keeps the number and halves their summed depth) and keeps everything `verify` checks of the
+//! triangle itself: its side, a volume well above [`DEGENERATE_VOLUME`] (the edge tetrahedra's
+//! too), tangent containment at every base vertex where it held, and the clearance over the
+//! base vertices' tangent planes that [`super::clearance`] gives (an apex does not sink further
+//! below a tangent plane than it was, nor below [`CLEARANCE`]: the holes next to such apexes
+//! are what that module prevents). The count is exact: pairs among tetrahedra that do not move
+//! are unchanged, and the moved ones are tested against every tetrahedron near them. Greedy,
+//! most-named apex first, at most [`MAX_ROUNDS`] passes. A hull without overlaps is returned
+//! untouched.
+
+use super::clearance::CLEARANCE;
+use super::degenerate::relative_volume;
+use super::verify::{overlapping_pairs, sat_depth_above, DEGENERATE_VOLUME, OVERLAP_DEPTH};
+use super::sides::edge_sides;
+use crate::hull::simplicial::{HullEdge, Side, SimplicialHull};
+use glam::DVec3;
+use std::collections::HashMap;
+
+/// Passes over the apexes the remaining overlaps name.
+pub const MAX_ROUNDS: usize = 4;
+
+/// Smallest relative volume 6V / L³ of a moved face tetrahedron, as a multiple of
+/// [`DEGENERATE_VOLUME`]: a moved apex is never the hull's flattest by accident (the quintic's
+/// own bound, `C2_MIN_VOLUME` = 1e-3, is checked the same way through `min_volume`).
+const VOLUME_MARGIN: f64 = 100.0;
+
+/// What [`improve`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Search {
+    /// Overlapping pairs before.
+    pub before: usize,
+    /// Overlapping pairs after.
+    pub after: usize,
+    /// The moved apexes: triangle of T and side, in the order moved (an apex moved twice is
+    /// listed twice).
+    pub moved: Vec<(u32, Side)>,
+    /// The removed apexes of L-U pairs: triangle of T and side.
+    pub removed: Vec<(u32, Side)>,
+    /// Positions tried.
+    pub trials: usize,
+}
+
+fn side_of(slot: usize) -> Side {
+    if slot == 0 {
+        Side::Outer
+    } else {
+        Side::Inner
+    }
+}
+
+/// True when triangle `t` may lose its apex on side slot `s`: it has one on the other side,
+/// none of its edges asks for side `s` ([`edge_sides`], Definition 3.1: the scheme's signs on
+/// the edge need a tetrahedron there), every neighbour across its edges has an apex on the other
+/// side (so edge tetrahedra still join them), and the remaining tetrahedron is
+/// tangent-containing wherever the pair was.
+fn removable(hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: usize, s: usize) -> bool {
+    let Some(keep) = hull.apexes[t][1 - s] else {
+        return false;
+    };
+    let asks = edges_of.iter().any(|&e| {
+        let [a, b] = edges[e].v.map(|i| i as usize);
+        edge_sides(hull.points[a], hull.normals[a], hull.points[b], hull.normals[b])[s]
+    });
+    let joined = edges_of.iter().all(|&e| {
+        edges[e]
+            .faces
+            .iter()
+            .all(|&f| f == u32::MAX || hull.apexes[f as usize][1 - s].is_some())
+    });
+    if asks || !joined {
+        return false;
+    }
+    let tri = hull.triangles[t];
+    let p = tri.map(|i| hull.points[i as usize]);
+    let n = tri.map(|i| hull.normals[i as usize]);
+    let both: Vec<[DVec3; 4]> = hull.apexes[t]
+        .iter()
+        .flatten()
+        .map(|&a| [p[0], p[1], p[2], a])
+        .collect();
+    (0..3).all(|k| !contains(&both, p[k], n[k]) || contains(&[[p[0], p[1], p[2], keep]], p[k], n[k]))
+}
+
+/// Tangent containment (Definition 3.5) as `verify` tests it: the plane through `pk` with
+/// normal `nk` leaves the other vertices of one of `tets` on both sides (within
+/// [`super::verify::PLANE_TOL`] of the tetrahedron's size).
+fn contains(tets: &[[DVec3; 4]], pk: DVec3, nk: DVec3) -> bool {
+    tets.iter().any(|tet| {
+        let tol = super::verify::PLANE_TOL * longest_edge(tet);
+        let (lo, hi) = tet
+            .iter()
+            .filter(|&&x| x != pk)
+            .map(|&x| nk.dot(x - pk))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        lo <= tol && hi >= -tol
+    })
+}
+
+/// Who a tetrahedron of the hull depends on: the apexes (triangle, side slot) it is built from.
+#[derive(Clone, Copy, Debug)]
+enum Owner {
+    /// A face tetrahedron over the triangle, on the side.
+    Face(usize, usize),
+    /// An edge tetrahedron at an edge of T: the triangle it is glued to, the other triangle
+    /// (whose apex gives the shared point s), the side, the edge's two points.
+    Edge(usize, usize, usize, [u32; 2]),
+}
+
+impl Owner {
+    fn apexes(self) -> ([(usize, usize); 2], usize) {
+        match self {
+            Owner::Face(t, s) => ([(t, s), (t, s)], 1),
+            Owner::Edge(t, u, s, _) => ([(t, s), (u, s)], 2),
+        }
+    }
+}
+
+/// The hull's tetrahedra with what each depends on.
+struct Tets {
+    tets: Vec<[DVec3; 4]>,
+    boxes: Vec<(DVec3, DVec3)>,
+    longest: Vec<f64>,
+    owners: Vec<Owner>,
+    /// For each apex (triangle, side slot): the tetrahedra built from it.
+    by_apex: HashMap<(usize, usize), Vec<usize>>,
+}
+
+fn bounds(t: &[DVec3; 4]) -> (DVec3, DVec3) {
+    let lo = t.iter().fold(DVec3::splat(f64::INFINITY), |a, &b| a.min(b));
+    let hi = t
+        .iter()
+        .fold(DVec3::splat(f64::NEG_INFINITY), |a, &b| a.max(b));
+    (lo, hi)
+}
+
+fn longest_edge(t: &[DVec3; 4]) -> f64 {
+    let mut l: f64 = 0.0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            l = l.max((t[i] - t[j]).length());
+        }
+    }
+    l
+}
+
+impl Tets {
+    /// Face tetrahedra first, then edge tetrahedra in [`SimplicialHull::edge_tets`]'s order.
+    fn new(hull: &SimplicialHull, edges: &[HullEdge]) -> Tets {
+        let mut owners = Vec::new();
+        for (t, slots) in hull.apexes.iter().enumerate() {
+            for s in Side::BOTH {
+                if slots[s as usize].is_some() {
+                    owners.push(Owner::Face(t, s as usize));
+                }
+            }
+        }
+        for e in edges {
+            let [f0, f1] = e.faces.map(|f| f as usize);
+            if e.faces[1] == u32::MAX {
+                continue;
+            }
+            for s in Side::BOTH {
+                let s = s as usize;
+                if hull.apexes[f0][s].is_some() && hull.apexes[f1][s].is_some() {
+                    owners.push(Owner::Edge(f0, f1, s, e.v));
+                    owners.push(Owner::Edge(f1, f0, s, e.v));
+                }
+            }
+        }
+        let mut by_apex: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+        for (i, o) in owners.iter().enumerate() {
+            let (a, n) = o.apexes();
+            for &key in &a[..n] {
+                by_apex.entry(key).or_default().push(i);
+            }
+        }
+        let tets: Vec<[DVec3; 4]> = owners.iter().map(|&o| build(hull, o, None)).collect();
+        Tets {
+            boxes: tets.iter().map(bounds).collect(),
+            longest: tets.iter().map(longest_edge).collect(),
+            tets,
+            owners,
+            by_apex,
+        }
+    }
+}
+
+/// The tetrahedron `o` with the apex `moved` = (triangle, side, position) in place.
+fn build(hull: &SimplicialHull, o: Owner, moved: Option<(usize, usize, DVec3)>) -> [DVec3; 4] {
+    let apex = |t: usize, s: usize| match moved {
+        Some((mt, ms, q)) if mt == t && ms == s => q,
+        _ => hull.apexes[t][s].expect("owner's apex exists"),
+    };
+    match o {
+        Owner::Face(t, s) => {
+            let [a, b, c] = hull.triangles[t].map(|i| hull.points[i as usize]);
+            [a, b, c, apex(t, s)]
+        }
+        Owner::Edge(t, u, s, v) => {
+            let (q, q1) = (apex(t, s), apex(u, s));
+            let [pi, pj] = v.map(|i| hull.points[i as usize]);
+            [pi, pj, q, 0.5 * (q + q1)]
+        }
+    }
+}
+
+/// Overlapping pairs (count, summed relative depth) in which any of the tetrahedra `moved`
+/// (indices, with their geometry `geom`) take part, against the tetrahedra in `near`.
+fn local_score(tets: &Tets, moved: &[usize], geom: &[[DVec3; 4]], near: &[usize]) -> (usize, f64) {
+    let (mut count, mut depth) = (0, 0.0);
+    for (k, ti) in geom.iter().enumerate() {
+        let (lo, hi) = bounds(ti);
+        let li = longest_edge(ti);
+        for &j in near {
+            if let Some(m) = moved.iter().position(|&x| x == j) {
+                // Pairs of two moved tetrahedra: once, with the moved geometry of both.
+                if m <= k {
+                    continue;
+                }
+                if let Some(d) = pair_depth(ti, li, &geom[m], longest_edge(&geom[m])) {
+                    count += 1;
+                    depth += d;
+                }
+                continue;
+            }
+            let (blo, bhi) = tets.boxes[j];
+            if lo.x > bhi.x || blo.x > hi.x || lo.y > bhi.y || blo.y > hi.y || lo.z > bhi.z {
+                continue;
+            }
+            if blo.z > hi.z {
+                continue;
+            }
+            if let Some(d) = pair_depth(ti, li, &tets.tets[j], tets.longest[j]) {
+                count += 1;
+                depth += d;
+            }
+        }
+    }
+    (count, depth)
+}
+
+/// Relative overlap depth of two tetrahedra as `verify` measures it, when above
+/// [`OVERLAP_DEPTH`].
+fn pair_depth(a: &[DVec3; 4], la: f64, b: &[DVec3; 4], lb: f64) -> Option<f64> {
+    let scale = la.min(lb);
+    let d = sat_depth_above(a, b, OVERLAP_DEPTH * scale)? / scale;
+    (d > OVERLAP_DEPTH).then_some(d)
+}
+
+/// The positions tried for the apex `q` over the triangle `p` (module docs): its height over
+/// the base scaled, its foot pulled towards the centroid, or shifted towards a base vertex or
+/// an edge midpoint.
+fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
+    let Some(nn) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
+        return Vec::new();
+    };
+    let g = (p[0] + p[1] + p[2]) / 3.0;
+    let h = nn.dot(q - g);
+    let foot = q - h * nn;
+    let mut out = Vec::new();
+    for f in [1.0, 0.7, 0.5, 0.35, 0.2, 1.4] {
+        for pull in [0.0, 0.5, 1.0] {
+            if f == 1.0 && pull == 0.0 {
+                continue;
+            }
+            out.push(foot + pull * (g - foot) + f * h * nn);
+        }
+    }
+    let mids = [
+        0.5 * (p[0] + p[1]),
+        0.5 * (p[1] + p[2]),
+        0.5 * (p[2] + p[0]),
+    ];
+    for target in p.iter().chain(&mids) {
+        for f in [1.0, 0.6] {
+            out.push(foot + 0.4 * (*target - foot) + f * h * nn);
+        }
+    }
+    out
+}
+
+/// True when the apex `q` of triangle `t` on side slot `s` keeps what `verify` checks of the
+/// triangle and what [`super::clearance`] gave it, compared with the apex `old` (module docs).
+fn admissible(hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
+    let tri = hull.triangles[t];
+    let p = tri.map(|i| hull.points[i as usize]);
+    let n = tri.map(|i| hull.normals[i as usize]);
+    let Some(nn) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
+        return false;
+    };
+    let sign = if s == Side::Outer as usize { 1.0 } else { -1.0 };
+    // Side and volume.
+    let vol = relative_volume(p[0], p[1], p[2], q);
+    if sign * nn.dot(q - p[0]) <= 0.0 || vol.abs() < VOLUME_MARGIN * DEGENERATE_VOLUME {
+        return false;
+    }
+    let len = (p[1] - p[0])
+        .length()
+        .max((p[2] - p[1]).length())
+        .max((p[0] - p[2]).length());
+    // Clearance over the base vertices' tangent planes, on the side the normals agree with
+    // (as `clearance` measures it).
+    let up = sign * nn;
+    let side = up.dot(n[0] + n[1] + n[2]).signum();
+    for k in 0..3 {
+        let h = |x: DVec3| side * n[k].dot(x - p[k]);
+        if h(q) < h(old).min(CLEARANCE * len) {
+            return false;
+        }
+    }
+    // Tangent containment where it held (the pair's other apex unchanged).
+    let other = hull.apexes[t][1 - s];
+    let pair = |apex: DVec3| -> Vec<[DVec3; 4]> {
+        [Some(apex), other]
+            .into_iter()
+            .flatten()
+            .map(|a| [p[0], p[1], p[2], a])
+            .collect()
+    };
+    let (was, now) = (pair(old), pair(q));
+    if (0..3).any(|k| contains(&was, p[k], n[k]) && !contains(&now, p[k], n[k])) {
+        return false;
+    }
+    // The edge tetrahedra glued at the triangle's edges keep their volume.
+    edges_of.iter().all(|&e| {
+        let edge = &edges[e];
+        let u = if edge.faces[0] as usize == t {
+            edge.faces[1]
+        } else {
+            edge.faces[0]
+        };
+        if u == u32::MAX {
+            return true;
+        }
+        let Some(q1) = hull.apexes[u as usize][s] else {
+            return true;
+        };
+        let m = 0.5 * (q + q1);
+        let [pi, pj] = edge.v.map(|i| hull.points[i as usize]);
+        [q, q1]
+            .iter()
+            .all(|&x| relative_volume(pi, pj, x, m).abs() >= VOLUME_MARGIN * DEGENERATE_VOLUME)
+    })
+}
+
+/// Moves apexes of `hull` while that lowers its overlaps (module docs). Returns what it did;
+/// `hull` is unchanged when nothing helped or T is not a manifold.
+pub fn improve(hull: &mut SimplicialHull) -> Search {
+    let Ok(edges) = hull.edges() else {
+        return Search::default();
+    };
+    let mut edges_of: Vec<Vec<usize>> = vec![Vec::new(); hull.triangles.len()];
+    for (e, edge) in edges.iter().enumerate() {
+        for f in edge.faces {
+            if f != u32::MAX {
+                edges_of[f as usize].push(e);
+            }
+        }
+    }
+    let mut tets = Tets::new(hull, &edges);
+    let pairs = overlapping_pairs(&tets.tets);
+    let mut search = Search {
+        before: pairs.len(),
+        after: pairs.len(),
+        ..Search::default()
+    };
+    let mut pairs = pairs;
+    for _ in 0..MAX_ROUNDS {
+        if pairs.is_empty() {
+            break;
+        }
+        // The apexes the overlapping pairs depend on, most named first.
+        let mut named: HashMap<(usize, usize), usize> = HashMap::new();
+        for &(i, j, _) in &pairs {
+            for k in [i, j] {
+                let (a, n) = tets.owners[k].apexes();
+                for &key in &a[..n] {
+                    *named.entry(key).or_default() += 1;
+                }
+            }
+        }
+        let mut order: Vec<((usize, usize), usize)> = named.into_iter().collect();
+        order.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        let mut improved = false;
+        for ((t, s), _) in order {
+            let old = hull.apexes[t][s].expect("named apexes exist");
+            let moved = tets.by_apex[&(t, s)].clone();
+            let p = hull.triangles[t].map(|i| hull.points[i as usize]);
+            let cands: Vec<DVec3> = candidates(old, p)
+                .into_iter()
+                .filter(|&q| admissible(hull, &edges_of[t], &edges, t, s, old, q))
+                .collect();
+            // Tetrahedra near any position the moved ones may take.
+            let geoms: Vec<Vec<[DVec3; 4]>> = std::iter::once(old)
+                .chain(cands.iter().copied())
+                .map(|q| {
+                    moved
+                        .iter()
+                        .map(|&i| build(hull, tets.owners[i], Some((t, s, q))))
+                        .collect()
+                })
+                .collect();
+            let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for g in geoms.iter().flatten() {
+                let (a, b) = bounds(g);
+                lo = lo.min(a);
+                hi = hi.max(b);
+            }
+            let near: Vec<usize> = (0..tets.tets.len())
+                .filter(|&j| {
+                    let (a, b) = tets.boxes[j];
+                    !(a.x > hi.x || lo.x > b.x || a.y > hi.y || lo.y > b.y || a.z > hi.z || lo.z > b.z)
+                })
+                .collect();
+            let current = local_score(&tets, &moved, &geoms[0], &near);
+            if current.0 == 0 {
+                continue;
+            }
+            let mut best: Option<(usize, f64, usize)> = None;
+            for (c, g) in geoms.iter().enumerate().skip(1) {
+                search.trials += 1;
+                let score = local_score(&tets, &moved, g, &near);
+                let better_than_now =
+                    score.0 < current.0 || (score.0 == current.0 && score.1 < 0.5 * current.1);
+                let better_than_best = best.map_or(true, |(bc, bd, _)| {
+                    score.0 < bc || (score.0 == bc && score.1 < bd)
+                });
+                if better_than_now && better_than_best {
+                    best = Some((score.0, score.1, c));
+                }
+            }
+            // No position clears them all: an L-U pair's apex on a side none of the
+            // triangle's edges asks for may go instead.
+            if best.is_none_or(|(count, _, _)| count > 0)
+                && removable(hull, &edges_of[t], &edges, t, s)
+            {
+                hull.apexes[t][s] = None;
+                tets = Tets::new(hull, &edges);
+                search.removed.push((t as u32, side_of(s)));
+                improved = true;
+                continue;
+            }
+            if let Some((_, _, c)) = best {
+                hull.apexes[t][s] = Some(cands[c - 1]);
+                for (&i, g) in moved.iter().zip(&geoms[c]) {
+                    tets.tets[i] = *g;
+                    tets.boxes[i] = bounds(g);
+                    tets.longest[i] = longest_edge(g);
+                }
+                search.moved.push((t as u32, side_of(s)));
+                improved = true;
+            }
+        }
+        pairs = overlapping_pairs(&tets.tets);
+        search.after = pairs.len();
+        if !improved {
+            break;
+        }
+    }
+    search
+}
