@@ -33,7 +33,7 @@ use glam::DVec3;
 use std::collections::HashMap;
 
 /// Passes over the apexes the remaining overlaps name.
-pub const MAX_ROUNDS: usize = 4;
+pub const MAX_ROUNDS: usize = 12;
 
 /// Smallest relative volume 6V / L³ of a moved face tetrahedron, as a multiple of
 /// [`DEGENERATE_VOLUME`]: a moved apex is never the hull's flattest by accident (the quintic's
@@ -276,7 +276,7 @@ fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
     let h = nn.dot(q - g);
     let foot = q - h * nn;
     let mut out = Vec::new();
-    for f in [1.0, 0.7, 0.5, 0.35, 0.2, 1.4] {
+    for f in [1.0, 0.7, 0.5, 0.35, 0.2, 0.1, 1.4, 2.0] {
         for pull in [0.0, 0.5, 1.0] {
             if f == 1.0 && pull == 0.0 {
                 continue;
@@ -284,14 +284,27 @@ fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
             out.push(foot + pull * (g - foot) + f * h * nn);
         }
     }
+    // Standard heights over the base (as `sides` builds apexes: 0.08 of the longest edge),
+    // for apexes far too flat or too tall.
+    let len = (p[1] - p[0])
+        .length()
+        .max((p[2] - p[1]).length())
+        .max((p[0] - p[2]).length());
+    for rel in [0.03, 0.08] {
+        let up = h.signum() * rel * len * nn;
+        out.push(g + up);
+        out.push(foot + up);
+    }
     let mids = [
         0.5 * (p[0] + p[1]),
         0.5 * (p[1] + p[2]),
         0.5 * (p[2] + p[0]),
     ];
     for target in p.iter().chain(&mids) {
-        for f in [1.0, 0.6] {
-            out.push(foot + 0.4 * (*target - foot) + f * h * nn);
+        for f in [1.0, 0.6, 0.3] {
+            for shift in [0.4, 0.8] {
+                out.push(foot + shift * (*target - foot) + f * h * nn);
+            }
         }
     }
     out
@@ -308,8 +321,10 @@ fn admissible(hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: 
     };
     let sign = if s == Side::Outer as usize { 1.0 } else { -1.0 };
     // Side and volume.
+    // Not flatter than the margin, or than the apex was.
+    let floor = |was: f64| (VOLUME_MARGIN * DEGENERATE_VOLUME).min(was.abs());
     let vol = relative_volume(p[0], p[1], p[2], q);
-    if sign * nn.dot(q - p[0]) <= 0.0 || vol.abs() < VOLUME_MARGIN * DEGENERATE_VOLUME {
+    if sign * nn.dot(q - p[0]) <= 0.0 || vol.abs() < floor(relative_volume(p[0], p[1], p[2], old)) {
         return false;
     }
     let len = (p[1] - p[0])
@@ -353,11 +368,11 @@ fn admissible(hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: 
         let Some(q1) = hull.apexes[u as usize][s] else {
             return true;
         };
-        let m = 0.5 * (q + q1);
         let [pi, pj] = edge.v.map(|i| hull.points[i as usize]);
-        [q, q1]
-            .iter()
-            .all(|&x| relative_volume(pi, pj, x, m).abs() >= VOLUME_MARGIN * DEGENERATE_VOLUME)
+        let (m, was) = (0.5 * (q + q1), 0.5 * (old + q1));
+        [(q, old), (q1, q1)].iter().all(|&(x, y)| {
+            relative_volume(pi, pj, x, m).abs() >= floor(relative_volume(pi, pj, y, was))
+        })
     })
 }
 
