@@ -394,17 +394,28 @@ pub fn build_with_report(
     Ok(apex_search(hull, report))
 }
 
-/// [`reapex::improve`] on `hull`, kept when `verify` agrees that it helped: fewer violations
-/// and none of another kind than overlaps more than before (the search counts overlaps only).
+/// [`search_apexes`] on the built hull, its log in the report.
 fn apex_search(hull: SimplicialHull, mut report: InnerReport) -> (SimplicialHull, InnerReport) {
+    let (hull, log) = search_apexes(hull, false);
+    report.reapex = log;
+    (hull, report)
+}
+
+/// [`reapex::improve`] on `hull`, kept when `verify` agrees that it helped: fewer violations
+/// and no more of other kinds than overlaps (the search counts overlaps only). Returns the
+/// hull (moved or as it was) and the search's log (empty when the moves were not kept). For
+/// hulls that a scheme changes after the build (the cubic's `prepare_hull`: `keep_slopes`,
+/// see [`reapex::improve`]) as well as for [`build_with_report`]'s.
+#[must_use]
+pub fn search_apexes(hull: SimplicialHull, keep_slopes: bool) -> (SimplicialHull, reapex::Search) {
     let before = verify(&hull);
     if before.is_empty() {
-        return (hull, report);
+        return (hull, reapex::Search::default());
     }
     let mut moved = hull.clone();
-    let log = reapex::improve(&mut moved);
-    if log.moved.is_empty() {
-        return (hull, report);
+    let log = reapex::improve(&mut moved, keep_slopes);
+    if log.moved.is_empty() && log.removed.is_empty() {
+        return (hull, reapex::Search::default());
     }
     let after = verify(&moved);
     if std::env::var("APATCH_REAPEX_TRACE").is_ok() {
@@ -425,10 +436,9 @@ fn apex_search(hull: SimplicialHull, mut report: InnerReport) -> (SimplicialHull
             .count()
     };
     if after.len() < before.len() && others(&after) <= others(&before) {
-        report.reapex = log;
-        (moved, report)
+        (moved, log)
     } else {
-        (hull, report)
+        (hull, reapex::Search::default())
     }
 }
 

@@ -28,6 +28,7 @@ use super::clearance::CLEARANCE;
 use super::degenerate::relative_volume;
 use super::verify::{overlapping_pairs, sat_depth_above, DEGENERATE_VOLUME, OVERLAP_DEPTH};
 use super::sides::edge_sides;
+use crate::scheme::cubic_c1::tangent::TANGENT_MARGIN;
 use crate::hull::simplicial::{HullEdge, Side, SimplicialHull};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -312,7 +313,7 @@ fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
 
 /// True when the apex `q` of triangle `t` on side slot `s` keeps what `verify` checks of the
 /// triangle and what [`super::clearance`] gave it, compared with the apex `old` (module docs).
-fn admissible(hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
+fn admissible(keep_slopes: bool, hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
     let tri = hull.triangles[t];
     let p = tri.map(|i| hull.points[i as usize]);
     let n = tri.map(|i| hull.normals[i as usize]);
@@ -338,6 +339,17 @@ fn admissible(hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: 
     for k in 0..3 {
         let h = |x: DVec3| side * n[k].dot(x - p[k]);
         if h(q) < h(old).min(CLEARANCE * len) {
+            return false;
+        }
+    }
+    // The cubic scheme's slopes toward the apex (`scheme::cubic_c1::tangent`), on a hull that
+    // scheme has prepared: not below the margin it gives moved apexes, or below what they were.
+    for k in (0..3).filter(|_| keep_slopes) {
+        let slope = |x: DVec3| {
+            let d = x - p[k];
+            sign * n[k].dot(d) / d.length().max(f64::MIN_POSITIVE)
+        };
+        if slope(q) < slope(old).min(TANGENT_MARGIN) {
             return false;
         }
     }
@@ -376,9 +388,11 @@ fn admissible(hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: 
     })
 }
 
-/// Moves apexes of `hull` while that lowers its overlaps (module docs). Returns what it did;
-/// `hull` is unchanged when nothing helped or T is not a manifold.
-pub fn improve(hull: &mut SimplicialHull) -> Search {
+/// Moves apexes of `hull` while that lowers its overlaps (module docs). With `keep_slopes`
+/// (a hull the cubic scheme has prepared) no move lowers a slope σ(q − p_k)·n_k / |q − p_k|
+/// below the scheme's [`TANGENT_MARGIN`] or below what it was. Returns what it did; `hull` is
+/// unchanged when nothing helped or T is not a manifold.
+pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
     let Ok(edges) = hull.edges() else {
         return Search::default();
     };
@@ -421,7 +435,7 @@ pub fn improve(hull: &mut SimplicialHull) -> Search {
             let p = hull.triangles[t].map(|i| hull.points[i as usize]);
             let cands: Vec<DVec3> = candidates(old, p)
                 .into_iter()
-                .filter(|&q| admissible(hull, &edges_of[t], &edges, t, s, old, q))
+                .filter(|&q| admissible(keep_slopes, hull, &edges_of[t], &edges, t, s, old, q))
                 .collect();
             // Tetrahedra near any position the moved ones may take.
             let geoms: Vec<Vec<[DVec3; 4]>> = std::iter::once(old)
