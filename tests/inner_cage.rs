@@ -531,9 +531,24 @@ fn spot_control_cage_corner_search_lowers_violations() {
         assert!((0.0..=1.0).contains(&cut.turn));
         assert!(cut.alpha.is_none_or(|a| a > 0.0 && a < 1.0));
     }
+    // The apex search (`apex_search`, `hull::inner::reapex`) on that hull, as the build runs
+    // it: `verify` recounts what it reports (measured 54 -> 18, all overlaps; the bound guards
+    // against a regression), and only apexes moved: T, its points and normals are the same.
+    let (moved, log) = inner::search_apexes(hull.clone(), false);
+    let w = inner::verify(&moved);
+    assert_eq!(log.before, v.len());
+    assert_eq!(log.after, w.len());
+    assert!(w.len() <= 18, "{} -> {}", v.len(), w.len());
+    assert!(w.iter().all(|x| x.kind == ViolationKind::Intersecting));
+    assert!(!log.moved.is_empty());
+    assert_eq!(moved.triangles, hull.triangles);
+    assert_eq!(moved.points, hull.points);
+    assert_eq!(moved.normals, hull.normals);
+    assert_ne!(moved.apexes, hull.apexes);
 }
 
-/// The `corner_search` key: a boolean, off by default; any other type is an error naming it.
+/// The `corner_search` and `apex_search` keys: booleans, off by default; any other type is an
+/// error naming the key.
 #[test]
 fn corner_search_key_is_parsed_and_checked() {
     let read = |s: &str| {
@@ -542,9 +557,13 @@ fn corner_search_key_is_parsed_and_checked() {
     };
     assert!(read("corner_search = true").unwrap().corner_search);
     assert!(!read("").unwrap().corner_search);
-    for bad in ["corner_search = 1", "corner_search = \"yes\""] {
-        let e = read(bad).unwrap_err().to_string();
-        assert!(e.contains("corner_search"), "{bad}: {e}");
+    assert!(read("apex_search = true").unwrap().apex_search);
+    assert!(!read("").unwrap().apex_search);
+    for key in ["corner_search", "apex_search"] {
+        for bad in [format!("{key} = 1"), format!("{key} = \"yes\"")] {
+            let e = read(&bad).unwrap_err().to_string();
+            assert!(e.contains(key), "{bad}: {e}");
+        }
     }
 }
 

@@ -414,19 +414,18 @@ pub fn search_apexes(hull: SimplicialHull, keep_slopes: bool) -> (SimplicialHull
     }
     let mut moved = hull.clone();
     let log = reapex::improve(&mut moved, keep_slopes);
-    if log.moved.is_empty() && log.removed.is_empty() {
+    if log.moved.is_empty() {
         return (hull, reapex::Search::default());
     }
     let after = verify(&moved);
     if std::env::var("APATCH_REAPEX_TRACE").is_ok() {
         eprintln!(
-            "reapex: violations {} -> {}; overlaps {} -> {}, {} moved, {} removed, {} trials",
+            "reapex: violations {} -> {}; overlaps {} -> {}, {} moved, {} trials",
             before.len(),
             after.len(),
             log.before,
             log.after,
             log.moved.len(),
-            log.removed.len(),
             log.trials
         );
     }

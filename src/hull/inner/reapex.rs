@@ -1,35 +1,39 @@
-//! Apexes moved by the hull's own overlap test (beyond the paper; the last overlaps of
-//! spot_control_cage's folded corners).
+//! Apexes moved by the hull's own overlap test (beyond the paper; the overlaps left at the
+//! folded corners of spot_control_cage, mpi_poly and fandisk).
 //!
-//! Where to put the apex q of a face tetrahedron over a triangle [p0 p1 p2] of T is a free
-//! choice within the conditions of Definition 3.6: the tetrahedron must lie on its side of the
-//! triangle, stay tangent-containing (Definition 3.5) and not overlap any other tetrahedron of
-//! the hull (Lemma 4.3). The construction (§4, Algorithm 1 and its steps) places q by rules
-//! that do not look at the neighbours, and where T folds tightly (a valley between two fan
-//! triangles of a folded corner, a narrow gap between two corners' fans) the face tetrahedra,
+//! Where the apex q of a face tetrahedron over a triangle [p0 p1 p2] of T goes is a free choice
+//! within Definition 3.6: the tetrahedron must lie on its side of the triangle, stay
+//! tangent-containing (Definition 3.5) and overlap no other tetrahedron of the hull (Lemma
+//! 4.3). The construction (Algorithm 1's steps, then [`super::sides`], [`super::wedge`],
+//! [`super::clearance`]) places q by rules that look at the triangle alone, and where T folds
+//! tightly (a valley between two fan triangles of a folded corner, a narrow gap between two
+//! corners' fans, a flat-net triangle whose apex leans off its thin base) the face tetrahedra,
 //! or the edge tetrahedra [p_i p_j q s] glued to them, reach into each other.
 //!
-//! [`improve`] tries, for every apex that an overlapping pair depends on (the face
-//! tetrahedron's own, or either apex of an edge tetrahedron, whose shared point s is their
-//! midpoint), a fixed set of positions: lower over its base, pulled towards the triangle's
-//! centroid, or shifted towards a base vertex or an edge midpoint ([`candidates`]). A move is
-//! kept when it lowers the number of overlapping pairs the moved tetrahedra take part in (or
-//! keeps the number and halves their summed depth) and keeps everything `verify` checks of the
-//! triangle itself: its side, a volume well above [`DEGENERATE_VOLUME`] (the edge tetrahedra's
-//! too), tangent containment at every base vertex where it held, and the clearance over the
-//! base vertices' tangent planes that [`super::clearance`] gives (an apex does not sink further
-//! below a tangent plane than it was, nor below [`CLEARANCE`]: the holes next to such apexes
-//! are what that module prevents). The count is exact: pairs among tetrahedra that do not move
-//! are unchanged, and the moved ones are tested against every tetrahedron near them. Greedy,
-//! most-named apex first, at most [`MAX_ROUNDS`] passes. A hull without overlaps is returned
-//! untouched.
+//! [`improve`] tries, for every apex an overlapping pair depends on (a face tetrahedron's own,
+//! or either apex of an edge tetrahedron, whose shared point s is their midpoint), a fixed set
+//! of positions ([`candidates`]): its height over the base scaled, its foot pulled towards the
+//! centroid or shifted towards a base vertex or an edge midpoint, or a standard height over
+//! the centroid. A position is admissible when the triangle keeps what `verify` checks of it
+//! and what the earlier steps gave it ([`admissible`]): the apex's side; a volume not below
+//! [`VOLUME_MARGIN`] × [`DEGENERATE_VOLUME`] or what it was (the edge tetrahedra's too);
+//! tangent containment at every base vertex where it held; the height over each base vertex's
+//! tangent plane not below [`CLEARANCE`] × the longest edge or what it was (the holes next to
+//! apexes below those planes are what [`super::clearance`] prevents); and, on a hull the cubic
+//! scheme has prepared, its slopes ([`improve`]'s `keep_slopes`). Of the admissible positions
+//! the one with the fewest overlapping pairs among the moved tetrahedra (then the least summed
+//! depth) is taken if it has fewer than now, or as many with half the depth. The count is
+//! exact: pairs among tetrahedra that do not move are unchanged, and the moved ones are tested
+//! against every tetrahedron whose box meets theirs. Greedy, most-named apex first, at most
+//! [`MAX_ROUNDS`] passes; sequential, so the result does not depend on the thread count. The
+//! caller keeps the moves only when `verify` agrees ([`super::search_apexes`]). A hull without
+//! overlaps is returned untouched.
 
 use super::clearance::CLEARANCE;
 use super::degenerate::relative_volume;
 use super::verify::{overlapping_pairs, sat_depth_above, DEGENERATE_VOLUME, OVERLAP_DEPTH};
-use super::sides::edge_sides;
-use crate::scheme::cubic_c1::tangent::TANGENT_MARGIN;
 use crate::hull::simplicial::{HullEdge, Side, SimplicialHull};
+use crate::scheme::cubic_c1::tangent::TANGENT_MARGIN;
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -51,8 +55,6 @@ pub struct Search {
     /// The moved apexes: triangle of T and side, in the order moved (an apex moved twice is
     /// listed twice).
     pub moved: Vec<(u32, Side)>,
-    /// The removed apexes of L-U pairs: triangle of T and side.
-    pub removed: Vec<(u32, Side)>,
     /// Positions tried.
     pub trials: usize,
 }
@@ -63,39 +65,6 @@ fn side_of(slot: usize) -> Side {
     } else {
         Side::Inner
     }
-}
-
-/// True when triangle `t` may lose its apex on side slot `s`: it has one on the other side,
-/// none of its edges asks for side `s` ([`edge_sides`], Definition 3.1: the scheme's signs on
-/// the edge need a tetrahedron there), every neighbour across its edges has an apex on the other
-/// side (so edge tetrahedra still join them), and the remaining tetrahedron is
-/// tangent-containing wherever the pair was.
-fn removable(hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: usize, s: usize) -> bool {
-    let Some(keep) = hull.apexes[t][1 - s] else {
-        return false;
-    };
-    let asks = edges_of.iter().any(|&e| {
-        let [a, b] = edges[e].v.map(|i| i as usize);
-        edge_sides(hull.points[a], hull.normals[a], hull.points[b], hull.normals[b])[s]
-    });
-    let joined = edges_of.iter().all(|&e| {
-        edges[e]
-            .faces
-            .iter()
-            .all(|&f| f == u32::MAX || hull.apexes[f as usize][1 - s].is_some())
-    });
-    if asks || !joined {
-        return false;
-    }
-    let tri = hull.triangles[t];
-    let p = tri.map(|i| hull.points[i as usize]);
-    let n = tri.map(|i| hull.normals[i as usize]);
-    let both: Vec<[DVec3; 4]> = hull.apexes[t]
-        .iter()
-        .flatten()
-        .map(|&a| [p[0], p[1], p[2], a])
-        .collect();
-    (0..3).all(|k| !contains(&both, p[k], n[k]) || contains(&[[p[0], p[1], p[2], keep]], p[k], n[k]))
 }
 
 /// Tangent containment (Definition 3.5) as `verify` tests it: the plane through `pk` with
@@ -311,9 +280,20 @@ fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
     out
 }
 
+/// The hull with its edges, and which conditions a move keeps.
+struct Site<'a> {
+    hull: &'a SimplicialHull,
+    edges: &'a [HullEdge],
+    /// The edges of each triangle (indices into `edges`).
+    edges_of: &'a [Vec<usize>],
+    /// Keep the cubic scheme's slopes ([`improve`]).
+    keep_slopes: bool,
+}
+
 /// True when the apex `q` of triangle `t` on side slot `s` keeps what `verify` checks of the
 /// triangle and what [`super::clearance`] gave it, compared with the apex `old` (module docs).
-fn admissible(keep_slopes: bool, hull: &SimplicialHull, edges_of: &[usize], edges: &[HullEdge], t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
+fn admissible(site: &Site, t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
+    let (hull, edges, keep_slopes) = (site.hull, site.edges, site.keep_slopes);
     let tri = hull.triangles[t];
     let p = tri.map(|i| hull.points[i as usize]);
     let n = tri.map(|i| hull.normals[i as usize]);
@@ -367,7 +347,7 @@ fn admissible(keep_slopes: bool, hull: &SimplicialHull, edges_of: &[usize], edge
         return false;
     }
     // The edge tetrahedra glued at the triangle's edges keep their volume.
-    edges_of.iter().all(|&e| {
+    site.edges_of[t].iter().all(|&e| {
         let edge = &edges[e];
         let u = if edge.faces[0] as usize == t {
             edge.faces[1]
@@ -433,10 +413,19 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
             let old = hull.apexes[t][s].expect("named apexes exist");
             let moved = tets.by_apex[&(t, s)].clone();
             let p = hull.triangles[t].map(|i| hull.points[i as usize]);
+            let site = Site {
+                hull,
+                edges: &edges,
+                edges_of: &edges_of,
+                keep_slopes,
+            };
             let cands: Vec<DVec3> = candidates(old, p)
                 .into_iter()
-                .filter(|&q| admissible(keep_slopes, hull, &edges_of[t], &edges, t, s, old, q))
+                .filter(|&q| admissible(&site, t, s, old, q))
                 .collect();
+            if cands.is_empty() {
+                continue;
+            }
             // Tetrahedra near any position the moved ones may take.
             let geoms: Vec<Vec<[DVec3; 4]>> = std::iter::once(old)
                 .chain(cands.iter().copied())
@@ -456,7 +445,12 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
             let near: Vec<usize> = (0..tets.tets.len())
                 .filter(|&j| {
                     let (a, b) = tets.boxes[j];
-                    !(a.x > hi.x || lo.x > b.x || a.y > hi.y || lo.y > b.y || a.z > hi.z || lo.z > b.z)
+                    !(a.x > hi.x
+                        || lo.x > b.x
+                        || a.y > hi.y
+                        || lo.y > b.y
+                        || a.z > hi.z
+                        || lo.z > b.z)
                 })
                 .collect();
             let current = local_score(&tets, &moved, &geoms[0], &near);
@@ -469,23 +463,11 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
                 let score = local_score(&tets, &moved, g, &near);
                 let better_than_now =
                     score.0 < current.0 || (score.0 == current.0 && score.1 < 0.5 * current.1);
-                let better_than_best = best.map_or(true, |(bc, bd, _)| {
-                    score.0 < bc || (score.0 == bc && score.1 < bd)
-                });
+                let better_than_best =
+                    best.is_none_or(|(bc, bd, _)| score.0 < bc || (score.0 == bc && score.1 < bd));
                 if better_than_now && better_than_best {
                     best = Some((score.0, score.1, c));
                 }
-            }
-            // No position clears them all: an L-U pair's apex on a side none of the
-            // triangle's edges asks for may go instead.
-            if best.is_none_or(|(count, _, _)| count > 0)
-                && removable(hull, &edges_of[t], &edges, t, s)
-            {
-                hull.apexes[t][s] = None;
-                tets = Tets::new(hull, &edges);
-                search.removed.push((t as u32, side_of(s)));
-                improved = true;
-                continue;
             }
             if let Some((_, _, c)) = best {
                 hull.apexes[t][s] = Some(cands[c - 1]);
@@ -505,4 +487,117 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
         }
     }
     search
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hull::inner::verify::{verify, ViolationKind};
+    use crate::hull::simplicial::PointOrigin;
+
+    /// Two triangles of T folded into a 60° valley, both with tall outer apexes leaning into
+    /// it (as at spot_control_cage's folded corner 50), and a third closing the fold's far
+    /// side so the hull has edge tetrahedra at two edges.
+    fn valley(height: f64) -> SimplicialHull {
+        let c = 60f64.to_radians().cos();
+        let s = 60f64.to_radians().sin();
+        let points = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.5, 1.0, 0.0),
+            DVec3::new(0.5, c, s),
+            DVec3::new(1.5, 0.5, 0.3),
+        ];
+        let tri_normal = |t: [usize; 3]| {
+            (points[t[1]] - points[t[0]])
+                .cross(points[t[2]] - points[t[0]])
+                .normalize()
+        };
+        let triangles = [[0usize, 1, 2], [1, 0, 3], [1, 4, 2]];
+        // Vertex normals: the valley's bisector on the fold, the faces' elsewhere; every apex
+        // starts over all three tangent planes.
+        let a = tri_normal(triangles[0]);
+        let b = tri_normal(triangles[1]);
+        let normals = vec![
+            (a + b).normalize(),
+            (a + b).normalize(),
+            a,
+            b,
+            tri_normal(triangles[2]),
+        ];
+        let apexes = triangles
+            .iter()
+            .map(|&t| {
+                let g = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0;
+                [Some(g + height * tri_normal(t)), None]
+            })
+            .collect();
+        SimplicialHull {
+            points,
+            normals,
+            origins: vec![PointOrigin::Other; 5],
+            triangles: triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
+            apexes,
+            element: vec![0, 1, 2],
+        }
+    }
+
+    fn overlaps(hull: &SimplicialHull) -> usize {
+        verify(hull)
+            .iter()
+            .filter(|v| v.kind == ViolationKind::Intersecting)
+            .count()
+    }
+
+    /// The valley's tall apexes overlap; the search lowers them until nothing overlaps, as
+    /// `verify` (an independent count over the whole hull) confirms, and every moved apex keeps
+    /// its side, a volume, and its height over the base vertices' tangent planes.
+    #[test]
+    fn folded_valley_apexes_are_lowered_until_nothing_overlaps() {
+        let before = valley(0.8);
+        let n0 = overlaps(&before);
+        assert!(n0 > 0, "premise: the tall apexes overlap");
+        let mut hull = before.clone();
+        let log = improve(&mut hull, false);
+        assert_eq!(log.before, n0, "the search counts what verify counts");
+        assert_eq!(overlaps(&hull), 0);
+        assert_eq!(log.after, 0);
+        assert!(!log.moved.is_empty());
+        // No other violation comes (T is open here, so verify also names its boundary edges:
+        // the same ones before and after).
+        let others = |h: &SimplicialHull| {
+            verify(h)
+                .into_iter()
+                .filter(|v| v.kind != ViolationKind::Intersecting)
+                .map(|v| v.message)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(others(&hull), others(&before));
+        for (t, tri) in hull.triangles.iter().enumerate() {
+            let (old, new) = (before.apexes[t][0].unwrap(), hull.apexes[t][0].unwrap());
+            let p = tri.map(|i| hull.points[i as usize]);
+            let len = (p[1] - p[0])
+                .length()
+                .max((p[2] - p[1]).length())
+                .max((p[0] - p[2]).length());
+            for &k in tri {
+                let (pk, nk) = (hull.points[k as usize], hull.normals[k as usize]);
+                // Exact comparison with the admissibility bound; 1e-12 absorbs the rounding
+                // of the recomputed dot products.
+                assert!(nk.dot(new - pk) >= nk.dot(old - pk).min(CLEARANCE * len) - 1e-12);
+            }
+        }
+    }
+
+    /// Low apexes that do not overlap: nothing moves.
+    #[test]
+    fn a_hull_without_overlaps_is_untouched() {
+        let before = valley(0.05);
+        assert_eq!(overlaps(&before), 0, "premise");
+        let mut hull = before.clone();
+        let log = improve(&mut hull, false);
+        assert!(log.moved.is_empty());
+        assert_eq!(log.trials, 0);
+        assert_eq!(hull.apexes, before.apexes);
+    }
 }
