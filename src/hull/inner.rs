@@ -409,7 +409,8 @@ fn apex_search(hull: SimplicialHull, mut report: InnerReport) -> (SimplicialHull
 #[must_use]
 pub fn search_apexes(hull: SimplicialHull, keep_slopes: bool) -> (SimplicialHull, reapex::Search) {
     let before = verify(&hull);
-    if before.is_empty() {
+    let unsigned_before = reapex::unsigned_count(&hull);
+    if before.is_empty() && unsigned_before == 0 {
         return (hull, reapex::Search::default());
     }
     let mut moved = hull.clone();
@@ -418,13 +419,16 @@ pub fn search_apexes(hull: SimplicialHull, keep_slopes: bool) -> (SimplicialHull
         return (hull, reapex::Search::default());
     }
     let after = verify(&moved);
+    let unsigned_after = reapex::unsigned_count(&moved);
     if std::env::var("APATCH_REAPEX_TRACE").is_ok() {
         eprintln!(
-            "reapex: violations {} -> {}; overlaps {} -> {}, {} moved, {} trials",
+            "reapex: violations {} -> {}; overlaps {} -> {}; unsigned {} -> {}; {} moved, {} trials",
             before.len(),
             after.len(),
             log.before,
             log.after,
+            unsigned_before,
+            unsigned_after,
             log.moved.len(),
             log.trials
         );
@@ -434,7 +438,9 @@ pub fn search_apexes(hull: SimplicialHull, keep_slopes: bool) -> (SimplicialHull
             .filter(|x| x.kind != ViolationKind::Intersecting)
             .count()
     };
-    if after.len() < before.len() && others(&after) <= others(&before) {
+    if (after.len(), unsigned_after) < (before.len(), unsigned_before)
+        && others(&after) <= others(&before)
+    {
         (moved, log)
     } else {
         (hull, reapex::Search::default())

@@ -52,6 +52,10 @@ pub struct Search {
     pub before: usize,
     /// Overlapping pairs after.
     pub after: usize,
+    /// Unsigned edge tetrahedra ([`unsigned_count`]) before.
+    pub unsigned_before: usize,
+    /// Unsigned edge tetrahedra after.
+    pub unsigned_after: usize,
     /// The moved apexes: triangle of T and side, in the order moved (an apex moved twice is
     /// listed twice).
     pub moved: Vec<(u32, Side)>,
@@ -192,9 +196,46 @@ fn build(hull: &SimplicialHull, o: Owner, moved: Option<(usize, usize, DVec3)>) 
     }
 }
 
-/// Overlapping pairs (count, summed relative depth) in which any of the tetrahedra `moved`
-/// (indices, with their geometry `geom`) take part, against the tetrahedra in `near`.
-fn local_score(tets: &Tets, moved: &[usize], geom: &[[DVec3; 4]], near: &[usize]) -> (usize, f64) {
+/// What a move is judged by, compared in this order: overlapping pairs, then unsigned edge
+/// tetrahedra ([`unsigned`]), then the overlaps' summed relative depth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Score {
+    overlaps: usize,
+    unsigned: usize,
+    depth: f64,
+}
+
+impl Score {
+    /// Fewer overlaps, or as many and fewer unsigned edge tetrahedra, or both as many and the
+    /// depth halved (a smaller step would let the search creep).
+    fn improves_on(self, now: Score) -> bool {
+        (self.overlaps, self.unsigned) < (now.overlaps, now.unsigned)
+            || ((self.overlaps, self.unsigned) == (now.overlaps, now.unsigned)
+                && self.depth < 0.5 * now.depth)
+    }
+
+    /// The better of two candidates.
+    fn beats(self, other: Score) -> bool {
+        (self.overlaps, self.unsigned) < (other.overlaps, other.unsigned)
+            || ((self.overlaps, self.unsigned) == (other.overlaps, other.unsigned)
+                && self.depth < other.depth)
+    }
+
+    fn is_clean(self) -> bool {
+        self.overlaps == 0 && self.unsigned == 0
+    }
+}
+
+/// The score of the tetrahedra `moved` (indices, with their geometry `geom`): the overlapping
+/// pairs they take part in against the tetrahedra in `near`, and how many of them are unsigned
+/// edge tetrahedra.
+fn local_score(
+    hull: &SimplicialHull,
+    tets: &Tets,
+    moved: &[usize],
+    geom: &[[DVec3; 4]],
+    near: &[usize],
+) -> Score {
     let (mut count, mut depth) = (0, 0.0);
     for (k, ti) in geom.iter().enumerate() {
         let (lo, hi) = bounds(ti);
@@ -212,10 +253,13 @@ fn local_score(tets: &Tets, moved: &[usize], geom: &[[DVec3; 4]], near: &[usize]
                 continue;
             }
             let (blo, bhi) = tets.boxes[j];
-            if lo.x > bhi.x || blo.x > hi.x || lo.y > bhi.y || blo.y > hi.y || lo.z > bhi.z {
-                continue;
-            }
-            if blo.z > hi.z {
+            if lo.x > bhi.x
+                || blo.x > hi.x
+                || lo.y > bhi.y
+                || blo.y > hi.y
+                || lo.z > bhi.z
+                || blo.z > hi.z
+            {
                 continue;
             }
             if let Some(d) = pair_depth(ti, li, &tets.tets[j], tets.longest[j]) {
@@ -224,7 +268,56 @@ fn local_score(tets: &Tets, moved: &[usize], geom: &[[DVec3; 4]], near: &[usize]
             }
         }
     }
-    (count, depth)
+    let unsigned_here = moved
+        .iter()
+        .zip(geom)
+        .filter(|(&i, g)| unsigned(hull, tets.owners[i], g))
+        .count();
+    Score {
+        overlaps: count,
+        unsigned: unsigned_here,
+        depth,
+    }
+}
+
+/// Relative height (of the triangle's longest edge) below which the shared point s of an edge
+/// tetrahedron counts as not on its apex's side: the cubic scheme's sign conditions need s's
+/// barycentric coordinate towards the apex positive, beyond rounding.
+const UNSIGNED_TOL: f64 = 1e-9;
+
+/// True when `o` is an edge tetrahedron (geometry `tet` = [p_i p_j q s]) whose shared point s
+/// does not lie on the apex q's side of q's triangle: the cubic scheme cannot make its weights
+/// towards s of the side's sign there (`CubicBuild::unsigned`), and every edge of fandisk's
+/// hull whose boundary faces the surface crossed had such a tetrahedron (16 of 16; 183 edges
+/// had one).
+fn unsigned(hull: &SimplicialHull, o: Owner, tet: &[DVec3; 4]) -> bool {
+    let Owner::Edge(t, ..) = o else {
+        return false;
+    };
+    let p = hull.triangles[t].map(|i| hull.points[i as usize]);
+    let Some(nn) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
+        return false;
+    };
+    let len = (p[1] - p[0])
+        .length()
+        .max((p[2] - p[1]).length())
+        .max((p[0] - p[2]).length());
+    let [_, _, q, sp] = *tet;
+    nn.dot(sp - p[0]) * nn.dot(q - p[0]).signum() <= UNSIGNED_TOL * len
+}
+
+/// How many edge tetrahedra of `hull` are unsigned ([`unsigned`]); 0 when T is not a manifold.
+#[must_use]
+pub fn unsigned_count(hull: &SimplicialHull) -> usize {
+    let Ok(edges) = hull.edges() else {
+        return 0;
+    };
+    let tets = Tets::new(hull, &edges);
+    tets.owners
+        .iter()
+        .zip(&tets.tets)
+        .filter(|(&o, t)| unsigned(hull, o, t))
+        .count()
 }
 
 /// Relative overlap depth of two tetrahedra as `verify` measures it, when above
@@ -385,25 +478,31 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
         }
     }
     let mut tets = Tets::new(hull, &edges);
-    let pairs = overlapping_pairs(&tets.tets);
+    let unsigned_now = |hull: &SimplicialHull, tets: &Tets| -> Vec<usize> {
+        (0..tets.tets.len())
+            .filter(|&i| unsigned(hull, tets.owners[i], &tets.tets[i]))
+            .collect()
+    };
+    let mut pairs = overlapping_pairs(&tets.tets);
+    let mut flagged = unsigned_now(hull, &tets);
     let mut search = Search {
         before: pairs.len(),
         after: pairs.len(),
+        unsigned_before: flagged.len(),
+        unsigned_after: flagged.len(),
         ..Search::default()
     };
-    let mut pairs = pairs;
     for _ in 0..MAX_ROUNDS {
-        if pairs.is_empty() {
+        if pairs.is_empty() && flagged.is_empty() {
             break;
         }
-        // The apexes the overlapping pairs depend on, most named first.
+        // The apexes the overlapping pairs and unsigned edge tetrahedra depend on, most named
+        // first.
         let mut named: HashMap<(usize, usize), usize> = HashMap::new();
-        for &(i, j, _) in &pairs {
-            for k in [i, j] {
-                let (a, n) = tets.owners[k].apexes();
-                for &key in &a[..n] {
-                    *named.entry(key).or_default() += 1;
-                }
+        for k in pairs.iter().flat_map(|&(i, j, _)| [i, j]).chain(flagged.iter().copied()) {
+            let (a, n) = tets.owners[k].apexes();
+            for &key in &a[..n] {
+                *named.entry(key).or_default() += 1;
             }
         }
         let mut order: Vec<((usize, usize), usize)> = named.into_iter().collect();
@@ -453,23 +552,19 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
                         || lo.z > b.z)
                 })
                 .collect();
-            let current = local_score(&tets, &moved, &geoms[0], &near);
-            if current.0 == 0 {
+            let current = local_score(hull, &tets, &moved, &geoms[0], &near);
+            if current.is_clean() {
                 continue;
             }
-            let mut best: Option<(usize, f64, usize)> = None;
+            let mut best: Option<(Score, usize)> = None;
             for (c, g) in geoms.iter().enumerate().skip(1) {
                 search.trials += 1;
-                let score = local_score(&tets, &moved, g, &near);
-                let better_than_now =
-                    score.0 < current.0 || (score.0 == current.0 && score.1 < 0.5 * current.1);
-                let better_than_best =
-                    best.is_none_or(|(bc, bd, _)| score.0 < bc || (score.0 == bc && score.1 < bd));
-                if better_than_now && better_than_best {
-                    best = Some((score.0, score.1, c));
+                let score = local_score(hull, &tets, &moved, g, &near);
+                if score.improves_on(current) && best.is_none_or(|(b, _)| score.beats(b)) {
+                    best = Some((score, c));
                 }
             }
-            if let Some((_, _, c)) = best {
+            if let Some((_, c)) = best {
                 hull.apexes[t][s] = Some(cands[c - 1]);
                 for (&i, g) in moved.iter().zip(&geoms[c]) {
                     tets.tets[i] = *g;
@@ -481,7 +576,9 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
             }
         }
         pairs = overlapping_pairs(&tets.tets);
+        flagged = unsigned_now(hull, &tets);
         search.after = pairs.len();
+        search.unsigned_after = flagged.len();
         if !improved {
             break;
         }
