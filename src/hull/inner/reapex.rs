@@ -339,7 +339,7 @@ fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
     let h = nn.dot(q - g);
     let foot = q - h * nn;
     let mut out = Vec::new();
-    for f in [1.0, 0.7, 0.5, 0.35, 0.2, 0.1, 1.4, 2.0] {
+    for f in [1.0, 0.7, 0.5, 0.35, 0.2, 0.1, 1.4, 2.0, 3.0, 5.0, 8.0] {
         for pull in [0.0, 0.5, 1.0] {
             if f == 1.0 && pull == 0.0 {
                 continue;
