@@ -197,7 +197,9 @@ fn build(hull: &SimplicialHull, o: Owner, moved: Option<(usize, usize, DVec3)>) 
 }
 
 /// What a move is judged by, compared in this order: overlapping pairs, then unsigned edge
-/// tetrahedra ([`unsigned`]), then the overlaps' summed relative depth.
+/// tetrahedra ([`unsigned`]), then the summed relative depth of both (how far the pairs
+/// overlap, how far s lies on the wrong side: moves that bring two apexes part of the way
+/// count, so a pair that only both moves together clear can be cleared in turns).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Score {
     overlaps: usize,
@@ -268,11 +270,13 @@ fn local_score(
             }
         }
     }
-    let unsigned_here = moved
-        .iter()
-        .zip(geom)
-        .filter(|(&i, g)| unsigned(hull, tets.owners[i], g))
-        .count();
+    let mut unsigned_here = 0;
+    for (&i, g) in moved.iter().zip(geom) {
+        if let Some(d) = unsigned_depth(hull, tets.owners[i], g) {
+            unsigned_here += 1;
+            depth += d;
+        }
+    }
     Score {
         overlaps: count,
         unsigned: unsigned_here,
@@ -291,19 +295,24 @@ const UNSIGNED_TOL: f64 = 1e-9;
 /// hull whose boundary faces the surface crossed had such a tetrahedron (16 of 16; 183 edges
 /// had one).
 fn unsigned(hull: &SimplicialHull, o: Owner, tet: &[DVec3; 4]) -> bool {
+    unsigned_depth(hull, o, tet).is_some()
+}
+
+/// How far (relative to the triangle's longest edge) the shared point s of an unsigned edge
+/// tetrahedron lies on the wrong side of [`UNSIGNED_TOL`]; `None` when it is not unsigned.
+fn unsigned_depth(hull: &SimplicialHull, o: Owner, tet: &[DVec3; 4]) -> Option<f64> {
     let Owner::Edge(t, ..) = o else {
-        return false;
+        return None;
     };
     let p = hull.triangles[t].map(|i| hull.points[i as usize]);
-    let Some(nn) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
-        return false;
-    };
+    let nn = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
     let len = (p[1] - p[0])
         .length()
         .max((p[2] - p[1]).length())
         .max((p[0] - p[2]).length());
     let [_, _, q, sp] = *tet;
-    nn.dot(sp - p[0]) * nn.dot(q - p[0]).signum() <= UNSIGNED_TOL * len
+    let height = nn.dot(sp - p[0]) * nn.dot(q - p[0]).signum() / len;
+    (height <= UNSIGNED_TOL).then_some(UNSIGNED_TOL - height)
 }
 
 /// How many edge tetrahedra of `hull` are unsigned ([`unsigned`]); 0 when T is not a manifold.
@@ -365,7 +374,7 @@ fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
     ];
     for target in p.iter().chain(&mids) {
         for f in [1.0, 0.6, 0.3] {
-            for shift in [0.4, 0.8] {
+            for shift in [0.4, 0.8, 0.95] {
                 out.push(foot + shift * (*target - foot) + f * h * nn);
             }
         }
