@@ -340,7 +340,7 @@ fn pair_depth(a: &[DVec3; 4], la: f64, b: &[DVec3; 4], lb: f64) -> Option<f64> {
 /// The positions tried for the apex `q` over the triangle `p` (module docs): its height over
 /// the base scaled, its foot pulled towards the centroid, or shifted towards a base vertex or
 /// an edge midpoint.
-fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
+fn candidates(q: DVec3, p: [DVec3; 3], n: [DVec3; 3]) -> Vec<DVec3> {
     let Some(nn) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
         return Vec::new();
     };
@@ -376,6 +376,34 @@ fn candidates(q: DVec3, p: [DVec3; 3]) -> Vec<DVec3> {
         for f in [1.0, 0.6, 0.3] {
             for shift in [0.4, 0.8, 0.95] {
                 out.push(foot + shift * (*target - foot) + f * h * nn);
+            }
+        }
+    }
+    // An apex on base vertices' tangent planes (a step (5') cell's apex on the polyhedron's
+    // edge lies on both faces' planes) may not leave them to the wrong side; the moves above
+    // all do when the base does not lie on them. So also: towards each target within every
+    // plane it lies on (slope below 1e-6: far above rounding, far below the clearances).
+    let mut tight: Vec<DVec3> = Vec::new();
+    for k in 0..3 {
+        let d = q - p[k];
+        if n[k].dot(d).abs() <= 1e-6 * d.length() {
+            let mut m = n[k];
+            for u in &tight {
+                m -= m.dot(*u) * *u;
+            }
+            if let Some(m) = m.try_normalize() {
+                tight.push(m);
+            }
+        }
+    }
+    if !tight.is_empty() {
+        for target in p.iter().chain(&mids).chain(std::iter::once(&g)) {
+            let mut d = *target - q;
+            for u in &tight {
+                d -= d.dot(*u) * *u;
+            }
+            for shift in [0.4, 0.8, 0.95] {
+                out.push(q + shift * d);
             }
         }
     }
@@ -521,13 +549,20 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
             let old = hull.apexes[t][s].expect("named apexes exist");
             let moved = tets.by_apex[&(t, s)].clone();
             let p = hull.triangles[t].map(|i| hull.points[i as usize]);
+            let normals = hull.triangles[t].map(|i| hull.normals[i as usize]);
             let site = Site {
                 hull,
                 edges: &edges,
                 edges_of: &edges_of,
                 keep_slopes,
             };
-            let cands: Vec<DVec3> = candidates(old, p)
+            let debug = std::env::var("APATCH_REAPEX_DEBUG").is_ok_and(|v| v == format!("{t},{s}"));
+            if debug {
+                for q in candidates(old, p, normals) {
+                    eprintln!("cand {q:?} admissible {}", admissible(&site, t, s, old, q));
+                }
+            }
+            let cands: Vec<DVec3> = candidates(old, p, normals)
                 .into_iter()
                 .filter(|&q| admissible(&site, t, s, old, q))
                 .collect();
@@ -569,6 +604,9 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
             for (c, g) in geoms.iter().enumerate().skip(1) {
                 search.trials += 1;
                 let score = local_score(hull, &tets, &moved, g, &near);
+                if debug {
+                    eprintln!("  cand {c} {:?} score {score:?} now {current:?}", cands[c - 1]);
+                }
                 if score.improves_on(current) && best.is_none_or(|(b, _)| score.beats(b)) {
                     best = Some((score, c));
                 }
