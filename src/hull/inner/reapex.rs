@@ -133,6 +133,14 @@ fn bounds(t: &[DVec3; 4]) -> (DVec3, DVec3) {
     (lo, hi)
 }
 
+/// The longest side of the triangle `p`: the scale of its heights and clearances.
+fn longest_side(p: [DVec3; 3]) -> f64 {
+    (p[1] - p[0])
+        .length()
+        .max((p[2] - p[1]).length())
+        .max((p[0] - p[2]).length())
+}
+
 fn longest_edge(t: &[DVec3; 4]) -> f64 {
     let mut l: f64 = 0.0;
     for i in 0..4 {
@@ -315,10 +323,7 @@ fn unsigned_depth(hull: &SimplicialHull, o: Owner, tet: &[DVec3; 4]) -> Option<f
     };
     let p = hull.triangles[t].map(|i| hull.points[i as usize]);
     let nn = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
-    let len = (p[1] - p[0])
-        .length()
-        .max((p[2] - p[1]).length())
-        .max((p[0] - p[2]).length());
+    let len = longest_side(p);
     let [_, _, q, sp] = *tet;
     let height = nn.dot(sp - p[0]) * nn.dot(q - p[0]).signum() / len;
     (height <= UNSIGNED_TOL).then_some(UNSIGNED_TOL - height)
@@ -367,10 +372,7 @@ fn candidates(q: DVec3, p: [DVec3; 3], n: [DVec3; 3]) -> Vec<DVec3> {
     }
     // Standard heights over the base (as `sides` builds apexes: 0.08 of the longest edge),
     // for apexes far too flat or too tall.
-    let len = (p[1] - p[0])
-        .length()
-        .max((p[2] - p[1]).length())
-        .max((p[0] - p[2]).length());
+    let len = longest_side(p);
     for rel in [0.03, 0.08] {
         let up = h.signum() * rel * len * nn;
         out.push(g + up);
@@ -463,10 +465,7 @@ fn admissible(site: &Site, t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
     if sign * nn.dot(q - p[0]) <= 0.0 || vol.abs() < floor(relative_volume(p[0], p[1], p[2], old)) {
         return false;
     }
-    let len = (p[1] - p[0])
-        .length()
-        .max((p[2] - p[1]).length())
-        .max((p[0] - p[2]).length());
+    let len = longest_side(p);
     // Clearance over the base vertices' tangent planes, on the side the normals agree with
     // (as `clearance` measures it).
     let up = sign * nn;
@@ -706,6 +705,15 @@ mod tests {
         }
     }
 
+    /// `verify`'s messages other than overlaps.
+    fn others(hull: &SimplicialHull) -> Vec<String> {
+        verify(hull)
+            .into_iter()
+            .filter(|v| v.kind != ViolationKind::Intersecting)
+            .map(|v| v.message)
+            .collect()
+    }
+
     fn overlaps(hull: &SimplicialHull) -> usize {
         verify(hull)
             .iter()
@@ -729,21 +737,11 @@ mod tests {
         assert!(!log.moved.is_empty());
         // No other violation comes (T is open here, so verify also names its boundary edges:
         // the same ones before and after).
-        let others = |h: &SimplicialHull| {
-            verify(h)
-                .into_iter()
-                .filter(|v| v.kind != ViolationKind::Intersecting)
-                .map(|v| v.message)
-                .collect::<Vec<_>>()
-        };
         assert_eq!(others(&hull), others(&before));
         for (t, tri) in hull.triangles.iter().enumerate() {
             let (old, new) = (before.apexes[t][0].unwrap(), hull.apexes[t][0].unwrap());
             let p = tri.map(|i| hull.points[i as usize]);
-            let len = (p[1] - p[0])
-                .length()
-                .max((p[2] - p[1]).length())
-                .max((p[0] - p[2]).length());
+            let len = longest_side(p);
             for &k in tri {
                 let (pk, nk) = (hull.points[k as usize], hull.normals[k as usize]);
                 // Exact comparison with the admissibility bound; 1e-12 absorbs the rounding
@@ -810,13 +808,6 @@ mod tests {
         assert!(signed(&hull));
         assert_eq!(overlaps(&hull), 0);
         // T is open here: verify names its boundary edges, the same before and after.
-        let others = |h: &SimplicialHull| {
-            verify(h)
-                .into_iter()
-                .filter(|v| v.kind != ViolationKind::Intersecting)
-                .map(|v| v.message)
-                .collect::<Vec<_>>()
-        };
         assert_eq!(others(&hull), others(&before));
     }
 
