@@ -391,7 +391,10 @@ fn survey_flat_nets() {
 #[test]
 #[ignore = "exploration for humans: where fandisk's crossed boundary faces are"]
 fn explore_fandisk_holes() {
-    let sc = apatch::scene::load(Path::new("scenes/pending/paper1994/fandisk.toml")).unwrap();
+    // `HOLES_SCENE=path` for another cubic scene (mpi_poly, spot_control_cage).
+    let path = std::env::var("HOLES_SCENE")
+        .unwrap_or_else(|_| "scenes/pending/paper1994/fandisk.toml".into());
+    let sc = apatch::scene::load(Path::new(&path)).unwrap();
     let built = apatch::scene::build_scene(&sc).unwrap();
     classify_holes(&built.hull.unwrap(), &built.complex);
 }
