@@ -351,9 +351,11 @@ fn pair_depth(a: &[DVec3; 4], la: f64, b: &[DVec3; 4], lb: f64) -> Option<f64> {
     (d > OVERLAP_DEPTH).then_some(d)
 }
 
-/// The positions tried for the apex `q` over the triangle `p` (module docs): its height over
-/// the base scaled, its foot pulled towards the centroid, or shifted towards a base vertex or
-/// an edge midpoint.
+/// The positions tried for the apex `q` over the triangle `p` with vertex normals `n` (module
+/// docs): its height over the base scaled, its foot pulled towards the centroid or shifted
+/// towards a base vertex or an edge midpoint, standard heights over the centroid and the foot,
+/// and, when `q` lies on base vertices' tangent planes, moves within those planes and off them
+/// to its side.
 fn candidates(q: DVec3, p: [DVec3; 3], n: [DVec3; 3]) -> Vec<DVec3> {
     let Some(nn) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
         return Vec::new();
