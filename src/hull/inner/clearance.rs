@@ -121,11 +121,7 @@ fn lift(q: DVec3, p: [DVec3; 3], n: [DVec3; 3], up: DVec3, len: f64, g: DVec3) -
     let side = up.dot(n[0] + n[1] + n[2]).signum();
     // Height of x over each tangent plane on q's side (the side whose normal agrees with `up`).
     let h = |k: usize, x: DVec3| side * n[k].dot(x - p[k]);
-    if std::env::var("APATCH_LIFT_ON_PLANE").is_ok() {
-        if (0..3).all(|k| h(k, q) >= 1e-9 * (q - p[k]).length()) {
-            return None;
-        }
-    } else if (0..3).all(|k| h(k, q) >= -crate::mesh::PLANARITY_TOL * len) {
+    if (0..3).all(|k| h(k, q) >= -crate::mesh::PLANARITY_TOL * len) {
         return None;
     }
     move_over(q, p, n, up, len, g, CLEARANCE * len)
