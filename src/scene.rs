@@ -765,7 +765,9 @@ pub fn inner_hull(
         .with_context(|| format!("{}", file.display()))?;
     if scheme.get("type").and_then(|v| v.as_str()) == Some("cubic-c1") {
         let (cubic, _) = crate::scheme::cubic_c1::options_from_toml(scheme, &scene.path)?;
-        return Ok(Some(cubic_prepared_hull(&hull, &cubic, &options)));
+        return Ok(Some(
+            crate::scheme::cubic_c1::prepare_hull(&hull, &cubic).hull,
+        ));
     }
     Ok(Some(hull))
 }
@@ -784,7 +786,7 @@ fn build_1994(
     if ty == "cubic-c1" {
         let (options, inner) = cubic_c1::options_from_toml(scheme, scene)?;
         let hull = crate::hull::inner::build(m, vn, &inner).with_context(at)?;
-        Ok(cubic_on_prepared(&hull, &options, &inner).with_context(at)?)
+        Ok(cubic_on_prepared(&hull, &options).with_context(at)?)
     } else {
         let options = quintic_c2::QuinticOptions::from_toml(scheme, scene)?;
         let inner = crate::hull::inner::InnerOptions::from_toml(scheme, scene)?;
@@ -794,36 +796,19 @@ fn build_1994(
     }
 }
 
-/// The hull the cubic's patches fill: `hull` after the scheme's apex changes
-/// ([`crate::scheme::cubic_c1::prepare_hull`]: L-U pairs completed, apexes moved over the tangent
-/// planes) and, with `apex_search`, the apex search again on what those changes made overlap
-/// ([`crate::hull::inner::search_apexes`], whose moves keep the scheme's tangent slopes).
-fn cubic_prepared_hull(
-    hull: &crate::hull::simplicial::SimplicialHull,
-    options: &crate::scheme::cubic_c1::CubicOptions,
-    inner: &crate::hull::inner::InnerOptions,
-) -> crate::hull::simplicial::SimplicialHull {
-    let prepared = crate::scheme::cubic_c1::prepare_hull(hull, options).hull;
-    if inner.apex_search {
-        crate::hull::inner::search_apexes(prepared, true).0
-    } else {
-        prepared
-    }
-}
-
 /// [`crate::scheme::cubic_c1::build`] on `hull`, returning the hull its patches fill: the
 /// scheme's apex changes ([`crate::scheme::cubic_c1::prepare_hull`]) are made here, once, and
 /// the build is told not to make them again (the same patches as `build(hull, options)`).
 fn cubic_on_prepared(
     hull: &crate::hull::simplicial::SimplicialHull,
     options: &crate::scheme::cubic_c1::CubicOptions,
-    inner: &crate::hull::inner::InnerOptions,
 ) -> crate::error::Result<(PatchComplex, crate::hull::simplicial::SimplicialHull)> {
     use crate::scheme::cubic_c1;
-    let prepared = cubic_prepared_hull(hull, options, inner);
+    let prepared = cubic_c1::prepare_hull(hull, options).hull;
     let once = cubic_c1::CubicOptions {
         complete_lu_pairs: false,
         contain_tangents: false,
+        search_apexes: false,
         ..options.clone()
     };
     Ok((cubic_c1::build(&prepared, &once)?, prepared))
@@ -1035,7 +1020,7 @@ irradiance = 2.0
     /// hull's face and edge tetrahedra, the hull is the one `inner_hull` builds anew, and the
     /// patches are the schemes' own `build_from_scene`'s, bit for bit. Scenes with shape options
     /// (an icosahedron with `alpha`, whose hull the option changes; the hallway corner's
-    /// `levels`), both schemes.
+    /// `levels`; mpi_poly's `apex_search`), both schemes.
     #[test]
     fn built_scene_returns_the_mesh_and_the_hull_its_patches_fill() {
         let ico = std::fs::read_to_string(paper1994("icosahedron")).unwrap();
@@ -1052,6 +1037,11 @@ irradiance = 2.0
         for name in ["cube", "hallway_corner", "cube_quintic", "l_prism_quintic"] {
             scenes.push(load(&paper1994(name)).unwrap());
         }
+        // The apex search moves apexes again after the cubic's own changes (one on mpi_poly):
+        // every path to the cubic's patches must make that move.
+        let mpi =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/pending/paper1994/mpi_poly.toml");
+        scenes.push(load(&mpi).unwrap());
         for (k, sc) in scenes.iter().enumerate() {
             let name = sc.path.display();
             let built = build_scene(sc).unwrap();
@@ -1108,7 +1098,7 @@ irradiance = 2.0
         let prepared = cubic_c1::prepare_hull(&hull, &options);
         // The premise: the changes add tetrahedra.
         assert!(!prepared.lu_completed.is_empty());
-        let (complex, filled) = cubic_on_prepared(&hull, &options, &inner).unwrap();
+        let (complex, filled) = cubic_on_prepared(&hull, &options).unwrap();
         assert!(same_hull(&filled, &prepared.hull));
         assert_eq!(patch_tets(&complex), hull_tets(&filled));
         assert_ne!(patch_tets(&complex), hull_tets(&hull));

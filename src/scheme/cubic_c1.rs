@@ -77,6 +77,10 @@ pub struct CubicOptions {
     /// for L-U pairs by Definition 3.5) to their own side of all three ([`tangent`]). Without
     /// it the surface leaves the hull through the edge tetrahedra's outer faces there (holes).
     pub contain_tangents: bool,
+    /// After those changes, run the hull's apex search again on what they made overlap
+    /// ([`crate::hull::inner::search_apexes`], keeping this scheme's tangent slopes); set from
+    /// the hull's `apex_search` key.
+    pub search_apexes: bool,
 }
 
 impl Default for CubicOptions {
@@ -89,6 +93,7 @@ impl Default for CubicOptions {
             complete_lu_pairs: true,
             contain_tangents: true,
             free: FreeWeights::Fair,
+            search_apexes: false,
         }
     }
 }
@@ -151,12 +156,15 @@ pub struct PreparedHull {
     pub tangent_moved: Vec<(usize, Side)>,
     /// Apexes beyond a tangent plane that could not be moved.
     pub tangent_stuck: usize,
+    /// The apex search's log ([`CubicOptions::search_apexes`]; empty when off or not kept).
+    pub reapex: crate::hull::inner::reapex::Search,
 }
 
 /// The changes the cubic scheme makes to a hull's apexes before building (as `options` ask):
 /// L-U partners for single-sided triangles not convex for their side ([`sided`]), then apexes
-/// moved to their side of their triangle's tangent planes ([`tangent`]). `hull::inner::verify`
-/// applies to the result as to any hull.
+/// moved to their side of their triangle's tangent planes ([`tangent`]), then, with
+/// `search_apexes`, the hull's apex search on what those moves made overlap.
+/// `hull::inner::verify` applies to the result as to any hull.
 #[must_use]
 pub fn prepare_hull(hull: &SimplicialHull, options: &CubicOptions) -> PreparedHull {
     let (completed, lu_completed) = if options.complete_lu_pairs {
@@ -169,11 +177,17 @@ pub fn prepare_hull(hull: &SimplicialHull, options: &CubicOptions) -> PreparedHu
     } else {
         (completed, Vec::new(), 0)
     };
+    let (hull, reapex) = if options.search_apexes {
+        crate::hull::inner::search_apexes(hull, true)
+    } else {
+        (hull, Default::default())
+    };
     PreparedHull {
         hull,
         lu_completed,
         tangent_moved,
         tangent_stuck,
+        reapex,
     }
 }
 
@@ -650,6 +664,7 @@ pub fn options_from_toml(
     let inner = InnerOptions::from_toml(table, scene)?;
     let mut o = CubicOptions {
         level: inner.trihedral_level.clamp(0.02, 0.98),
+        search_apexes: inner.apex_search,
         ..CubicOptions::default()
     };
     let bad = |m: String| anyhow!("{}: {m}", scene.display());
