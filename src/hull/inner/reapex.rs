@@ -39,7 +39,10 @@
 
 use super::clearance::CLEARANCE;
 use super::degenerate::relative_volume;
-use super::verify::{overlapping_pairs, sat_depth_above, DEGENERATE_VOLUME, OVERLAP_DEPTH};
+use super::verify::{
+    longest_edge, overlapping_pairs, sat_depth_above, tangent_contains, DEGENERATE_VOLUME,
+    OVERLAP_DEPTH,
+};
 use crate::hull::simplicial::{HullEdge, Side, SimplicialHull};
 use crate::scheme::cubic_c1::tangent::TANGENT_MARGIN;
 use glam::DVec3;
@@ -79,21 +82,10 @@ fn side_of(slot: usize) -> Side {
     }
 }
 
-/// Tangent containment (Definition 3.5) as `verify` tests it: the plane through `pk` with
-/// normal `nk` leaves the other vertices of one of `tets` on both sides (within
-/// [`super::verify::PLANE_TOL`] of the tetrahedron's size).
+/// Tangent containment of an L-U pair (or single tetrahedron) `tets` at `pk`, as `verify`
+/// tests it: one of them contains the tangent plane.
 fn contains(tets: &[[DVec3; 4]], pk: DVec3, nk: DVec3) -> bool {
-    tets.iter().any(|tet| {
-        let tol = super::verify::PLANE_TOL * longest_edge(tet);
-        let (lo, hi) = tet
-            .iter()
-            .filter(|&&x| x != pk)
-            .map(|&x| nk.dot(x - pk))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v), hi.max(v))
-            });
-        lo <= tol && hi >= -tol
-    })
+    tets.iter().any(|tet| tangent_contains(tet, pk, nk))
 }
 
 /// Who a tetrahedron of the hull depends on: the apexes (triangle, side slot) it is built from.
@@ -139,16 +131,6 @@ fn longest_side(p: [DVec3; 3]) -> f64 {
         .length()
         .max((p[2] - p[1]).length())
         .max((p[0] - p[2]).length())
-}
-
-fn longest_edge(t: &[DVec3; 4]) -> f64 {
-    let mut l: f64 = 0.0;
-    for i in 0..4 {
-        for j in i + 1..4 {
-            l = l.max((t[i] - t[j]).length());
-        }
-    }
-    l
 }
 
 impl Tets {
@@ -396,17 +378,21 @@ fn candidates(q: DVec3, p: [DVec3; 3], n: [DVec3; 3]) -> Vec<DVec3> {
     // edge lies on both faces' planes) may not leave them to the wrong side; the moves above
     // all do when the base does not lie on them. So also: towards each target within every
     // plane it lies on (slope below 1e-6: far above rounding, far below the clearances).
+    let on_plane: Vec<usize> = (0..3)
+        .filter(|&k| {
+            let d = q - p[k];
+            n[k].dot(d).abs() <= 1e-6 * d.length()
+        })
+        .collect();
+    // An orthonormal basis of the planes' normals.
     let mut tight: Vec<DVec3> = Vec::new();
-    for k in 0..3 {
-        let d = q - p[k];
-        if n[k].dot(d).abs() <= 1e-6 * d.length() {
-            let mut m = n[k];
-            for u in &tight {
-                m -= m.dot(*u) * *u;
-            }
-            if let Some(m) = m.try_normalize() {
-                tight.push(m);
-            }
+    for &k in &on_plane {
+        let mut m = n[k];
+        for u in &tight {
+            m -= m.dot(*u) * *u;
+        }
+        if let Some(m) = m.try_normalize() {
+            tight.push(m);
         }
     }
     if !tight.is_empty() {
@@ -423,13 +409,7 @@ fn candidates(q: DVec3, p: [DVec3; 3], n: [DVec3; 3]) -> Vec<DVec3> {
         // rise over its base where moving along the base's normal would sink below a plane.
         let up = h.signum() * nn;
         let side = up.dot(n[0] + n[1] + n[2]).signum();
-        let off: DVec3 = (0..3)
-            .filter(|&k| {
-                let d = q - p[k];
-                n[k].dot(d).abs() <= 1e-6 * d.length()
-            })
-            .map(|k| side * n[k])
-            .sum();
+        let off: DVec3 = on_plane.iter().map(|&k| side * n[k]).sum();
         if let Some(off) = off.try_normalize() {
             for rel in [0.02, 0.05, 0.1, 0.2] {
                 out.push(q + rel * len * off);

@@ -298,18 +298,7 @@ pub fn verify(hull: &SimplicialHull) -> Vec<HullViolation> {
         }
         for k in 0..3 {
             let (pk, nk) = (base[k], hull.normals[tri[k] as usize]);
-            let contained = tets.iter().any(|(_, tet)| {
-                let tol = PLANE_TOL * longest_edge(tet);
-                let vals: Vec<f64> = tet
-                    .iter()
-                    .filter(|&&x| x != pk)
-                    .map(|&x| nk.dot(x - pk))
-                    .collect();
-                let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                lo <= tol && hi >= -tol
-            });
-            if !contained {
+            if !tets.iter().any(|(_, tet)| tangent_contains(tet, pk, nk)) {
                 out.push(
                     ViolationKind::NotTangentContaining,
                     Some(t),
@@ -382,8 +371,22 @@ impl Sink {
     }
 }
 
+/// Definition 3.5 at the vertex `pk` (normal `nk`) of `tet`: its tangent plane does not leave
+/// the other vertices strictly on one side (within [`PLANE_TOL`] of the longest edge).
+pub(super) fn tangent_contains(tet: &[DVec3; 4], pk: DVec3, nk: DVec3) -> bool {
+    let tol = PLANE_TOL * longest_edge(tet);
+    let (lo, hi) = tet
+        .iter()
+        .filter(|&&x| x != pk)
+        .map(|&x| nk.dot(x - pk))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    lo <= tol && hi >= -tol
+}
+
 /// Longest edge of a tetrahedron.
-fn longest_edge(t: &[DVec3; 4]) -> f64 {
+pub(super) fn longest_edge(t: &[DVec3; 4]) -> f64 {
     let mut l: f64 = 0.0;
     for i in 0..4 {
         for j in i + 1..4 {
