@@ -125,6 +125,11 @@ fn bounds(t: &[DVec3; 4]) -> (DVec3, DVec3) {
     (lo, hi)
 }
 
+/// True when two axis-aligned boxes (low, high corners) intersect or touch.
+fn boxes_meet(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> bool {
+    a.0.cmple(b.1).all() && b.0.cmple(a.1).all()
+}
+
 /// The longest side of the triangle `p`: the scale of its heights and clearances.
 fn longest_side(p: [DVec3; 3]) -> f64 {
     (p[1] - p[0])
@@ -253,14 +258,7 @@ fn local_score(
                 }
                 continue;
             }
-            let (blo, bhi) = tets.boxes[j];
-            if lo.x > bhi.x
-                || blo.x > hi.x
-                || lo.y > bhi.y
-                || blo.y > hi.y
-                || lo.z > bhi.z
-                || blo.z > hi.z
-            {
+            if !boxes_meet((lo, hi), tets.boxes[j]) {
                 continue;
             }
             if let Some(d) = pair_depth(ti, li, &tets.tets[j], tets.longest[j]) {
@@ -590,15 +588,7 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
                 hi = hi.max(b);
             }
             let near: Vec<usize> = (0..tets.tets.len())
-                .filter(|&j| {
-                    let (a, b) = tets.boxes[j];
-                    !(a.x > hi.x
-                        || lo.x > b.x
-                        || a.y > hi.y
-                        || lo.y > b.y
-                        || a.z > hi.z
-                        || lo.z > b.z)
-                })
+                .filter(|&j| boxes_meet((lo, hi), tets.boxes[j]))
                 .collect();
             let current = local_score(hull, &tets, &moved, &geoms[0], &near);
             if current.is_clean() {
