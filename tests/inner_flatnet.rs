@@ -188,7 +188,7 @@ fn fandisk_flat_regions_get_zero_coplanar_groups() {
 /// 181 violations (measured; the premise is only that it has some).
 #[test]
 fn fandisk_hull_verifies_after_the_apex_search() {
-    let path = Path::new("scenes/pending/paper1994/fandisk.toml");
+    let path = Path::new("scenes/paper1994/fandisk.toml");
     let scene = apatch::scene::load(path).unwrap();
     let hull = apatch::scene::inner_hull(&scene).unwrap().unwrap();
     let v = inner::verify(&hull);
@@ -393,7 +393,7 @@ fn survey_flat_nets() {
 fn explore_fandisk_holes() {
     // `HOLES_SCENE=path` for another cubic scene (mpi_poly, spot_control_cage).
     let path = std::env::var("HOLES_SCENE")
-        .unwrap_or_else(|_| "scenes/pending/paper1994/fandisk.toml".into());
+        .unwrap_or_else(|_| "scenes/paper1994/fandisk.toml".into());
     let sc = apatch::scene::load(Path::new(&path)).unwrap();
     let built = apatch::scene::build_scene(&sc).unwrap();
     classify_holes(&built.hull.unwrap(), &built.complex);
