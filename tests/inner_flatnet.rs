@@ -392,8 +392,8 @@ fn survey_flat_nets() {
 #[ignore = "exploration for humans: where fandisk's crossed boundary faces are"]
 fn explore_fandisk_holes() {
     // `HOLES_SCENE=path` for another cubic scene (mpi_poly, spot_control_cage).
-    let path = std::env::var("HOLES_SCENE")
-        .unwrap_or_else(|_| "scenes/paper1994/fandisk.toml".into());
+    let path =
+        std::env::var("HOLES_SCENE").unwrap_or_else(|_| "scenes/paper1994/fandisk.toml".into());
     let sc = apatch::scene::load(Path::new(&path)).unwrap();
     let built = apatch::scene::build_scene(&sc).unwrap();
     classify_holes(&built.hull.unwrap(), &built.complex);
@@ -453,6 +453,33 @@ fn classify_holes(
                 e.v.map(|i| hull.points[i as usize]),
                 e.faces.map(|f| hull.apexes.get(f as usize).copied())
             );
+        }
+        if std::env::var("VERBOSE").is_ok() {
+            // The crossed face's weights (multi-indices without the opposite vertex).
+            let face: Vec<String> = apatch::bb::multi_indices(p.degree as usize)
+                .into_iter()
+                .enumerate()
+                .filter(|(_, m)| m[opp] == 0)
+                .map(|(k, m)| format!("{m:?}={:.3e}", p.weights[k]))
+                .collect();
+            eprintln!("    tet {:?}\n    face {}", p.tet, face.join(" "));
+            let e = &edges[p.element as usize];
+            for &v in &e.v {
+                eprintln!(
+                    "    point {v} {:?} normal {:?} origin {:?}",
+                    hull.points[v as usize], hull.normals[v as usize], hull.origins[v as usize]
+                );
+            }
+            for &f in e.faces.iter().filter(|&&f| f != u32::MAX) {
+                let t = hull.triangles[f as usize];
+                let q = t.map(|i| hull.points[i as usize]);
+                let n = (q[1] - q[0]).cross(q[2] - q[0]).normalize();
+                let dots: Vec<f64> = t.iter().map(|&i| n.dot(hull.normals[i as usize])).collect();
+                eprintln!(
+                    "    tri {f} {t:?} n {n:?} n·n_v {dots:?} origins {:?}",
+                    t.map(|i| hull.origins[i as usize])
+                );
+            }
         }
         *by.entry(label).or_insert(0) += 1;
     }
