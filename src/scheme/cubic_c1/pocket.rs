@@ -20,7 +20,9 @@
 //! the number 2 weights, Kaczmarz), triangles on flat edges (whose number 2 weights solve
 //! [`super::flat`]'s equations) left out. Where the other triangle has no apex on σ, q's side
 //! face over e is a boundary face of the hull and a pocket there is a hole: such constraints
-//! left unmet (they can disagree with one inside the hull) are projected onto again, alone.
+//! left unmet (they can disagree with one inside the hull) are projected onto again, alone. A
+//! one-sided triangle's base is a boundary face too: its number 2 weight does not cross zero
+//! from the sign its edges give F there.
 
 use crate::hull::simplicial::{HullEdge, Side, SimplicialHull};
 use glam::DVec3;
@@ -180,16 +182,28 @@ pub fn clear_pockets(
             m
         })
         .collect();
-    meet(&cons, &largest, center);
+    // The sign of F on a one-sided triangle's base (−σ for a triangle on side σ alone).
+    let base_sign: Vec<f64> = hull
+        .apexes
+        .iter()
+        .map(|a| match a {
+            [Some(_), None] => -1.0,
+            [None, Some(_)] => 1.0,
+            _ => 0.0,
+        })
+        .collect();
+    meet(&cons, &largest, &base_sign, center);
     cons.len()
 }
 
 /// Meets the constraints by cyclic projection, each number 2 weight within [`POCKET_CAP`] ×
-/// `largest` (its triangle's largest number 1 weight) of where it was; then projects again onto
-/// the constraints at boundary faces left unmet, alone. Where such a constraint disagrees with
-/// one inside the hull (whose pocket stays inside the hull), the first projection balances the
-/// two and meets neither; the second gives the boundary face's its way, since its pocket would
-/// be a hole.
+/// `largest` (its triangle's largest number 1 weight) of where it was and, on a one-sided
+/// triangle (whose base is a boundary face of the hull too), not past zero from the base's
+/// sign `base_sign` (−σ on side σ: the sign its convex edges give F on the base) where it had
+/// that sign. Then it projects again onto the constraints at boundary faces left unmet, alone:
+/// where such a constraint disagrees with one inside the hull (whose pocket stays inside the
+/// hull), the first projection balances the two and meets neither; the second gives the
+/// boundary face's its way, since its pocket would be a hole.
 ///
 /// Needed on fandisk: triangle 18209 of T runs through the pseudo-centroid of vertex 4124,
 /// which is V itself (an unseparable corner), on the plane of the nearly flat fan next to it
@@ -197,23 +211,43 @@ pub fn clear_pockets(
 /// weight (−1.07e-3, its curved corner) makes the edge blossom steep across the plane
 /// (coordinates ≈ 430), and the fan triangle 17625's free inner side face had a pocket of depth
 /// 2.5e-3 that a number 2 weight of 18209 near zero removes; its other neighbour's condition,
-/// inside the hull, asked for the opposite.
-fn meet(cons: &[Constraint], largest: &[f64], center: &mut [f64]) {
+/// inside the hull, asked for the opposite. The base's sign: without it, mpi_poly's second
+/// projection moved a weight across zero (−0.32 to +0.31) and a face hole came (holes 30 → 31;
+/// with the bound in both projections, 28).
+fn meet(cons: &[Constraint], largest: &[f64], base_sign: &[f64], center: &mut [f64]) {
     let before = center.to_vec();
-    let cap: Vec<f64> = largest.iter().map(|m| POCKET_CAP * m).collect();
-    project(cons, &before, &cap, center, POCKET_SWEEPS);
+    let mut lo: Vec<f64> = before
+        .iter()
+        .zip(largest)
+        .map(|(b, m)| b - POCKET_CAP * m)
+        .collect();
+    let mut hi: Vec<f64> = before
+        .iter()
+        .zip(largest)
+        .map(|(b, m)| b + POCKET_CAP * m)
+        .collect();
+    for (t, &s) in base_sign.iter().enumerate() {
+        if s * before[t] >= 0.0 {
+            if s < 0.0 {
+                hi[t] = hi[t].min(0.0);
+            } else if s > 0.0 {
+                lo[t] = lo[t].max(0.0);
+            }
+        }
+    }
+    project(cons, &lo, &hi, center, POCKET_SWEEPS);
     let unmet: Vec<Constraint> = cons
         .iter()
         .filter(|c| c.free && c.coef[0] * center[c.tri[0]] + c.coef[1] * center[c.tri[1]] > c.rhs)
         .copied()
         .collect();
     if !unmet.is_empty() {
-        project(&unmet, &before, &cap, center, POCKET_BOUNDARY_SWEEPS);
+        project(&unmet, &lo, &hi, center, POCKET_BOUNDARY_SWEEPS);
     }
 }
 
 /// Cyclic projection onto the constraints `cons`, each weight kept within `cap` of `before`.
-fn project(cons: &[Constraint], before: &[f64], cap: &[f64], center: &mut [f64], sweeps: usize) {
+fn project(cons: &[Constraint], lo: &[f64], hi: &[f64], center: &mut [f64], sweeps: usize) {
     for _ in 0..sweeps {
         let mut moved = false;
         for c in cons {
@@ -223,8 +257,7 @@ fn project(cons: &[Constraint], before: &[f64], cap: &[f64], center: &mut [f64],
                 let step = (lhs - c.rhs) / n2;
                 for k in 0..2 {
                     let t = c.tri[k];
-                    center[t] = (center[t] - step * c.coef[k])
-                        .clamp(before[t] - cap[t], before[t] + cap[t]);
+                    center[t] = (center[t] - step * c.coef[k]).clamp(lo[t], hi[t]);
                 }
                 moved = true;
             }
@@ -341,11 +374,12 @@ mod tests {
         let lhs = |c: &Constraint, x: &[f64]| c.coef[0] * x[c.tri[0]] + c.coef[1] * x[c.tri[1]];
         // Premise: the capped projection leaves the boundary condition unmet.
         let mut capped = vec![0.0; 3];
-        let cap: Vec<f64> = largest.iter().map(|m| POCKET_CAP * m).collect();
-        project(&cons, &[0.0; 3], &cap, &mut capped, POCKET_SWEEPS);
+        let hi: Vec<f64> = largest.iter().map(|m| POCKET_CAP * m).collect();
+        let lo: Vec<f64> = hi.iter().map(|h| -h).collect();
+        project(&cons, &lo, &hi, &mut capped, POCKET_SWEEPS);
         assert!(lhs(&cons[0], &capped) > cons[0].rhs);
         let mut center = vec![0.0; 3];
-        meet(&cons, &largest, &mut center);
+        meet(&cons, &largest, &[0.0; 3], &mut center);
         // Met up to the projection's convergence (exact here: one constraint, one step).
         assert!(lhs(&cons[0], &center) <= cons[0].rhs + 1e-12, "{center:?}");
         // Every weight within its cap (round-off of the clamps: 1e-12 on O(1) weights).
@@ -355,5 +389,26 @@ mod tests {
                 "{center:?}"
             );
         }
+    }
+
+    /// A one-sided triangle's weight does not cross zero from its base's sign, however far a
+    /// condition pulls it: from −0.5 towards c ≥ 0.8 it stops at 0 (without the base's sign, at
+    /// the cap, 0.5).
+    #[test]
+    fn one_sided_triangle_keeps_its_base_sign() {
+        let cons = [Constraint {
+            tri: [0, 1],
+            coef: [0.0, -1.0],
+            rhs: -0.8,
+            free: true,
+        }];
+        let largest = [0.0, 1.0];
+        let mut free = vec![0.0, -0.5];
+        meet(&cons, &largest, &[0.0, 0.0], &mut free);
+        // Premise: the cap alone lets it cross (1e-12: round-off of one projection step).
+        assert!((free[1] - 0.5).abs() < 1e-12, "{free:?}");
+        let mut center = vec![0.0, -0.5];
+        meet(&cons, &largest, &[0.0, -1.0], &mut center);
+        assert_eq!(center[1], 0.0);
     }
 }
