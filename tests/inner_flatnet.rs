@@ -453,8 +453,6 @@ fn classify_holes(
                 e.v.map(|i| hull.points[i as usize]),
                 e.faces.map(|f| hull.apexes.get(f as usize).copied())
             );
-        }
-        if std::env::var("VERBOSE").is_ok() {
             // The crossed face's weights (multi-indices without the opposite vertex).
             let face: Vec<String> = apatch::bb::multi_indices(p.degree as usize)
                 .into_iter()
@@ -463,7 +461,6 @@ fn classify_holes(
                 .map(|(k, m)| format!("{m:?}={:.3e}", p.weights[k]))
                 .collect();
             eprintln!("    tet {:?}\n    face {}", p.tet, face.join(" "));
-            let e = &edges[p.element as usize];
             for &v in &e.v {
                 eprintln!(
                     "    point {v} {:?} normal {:?} origin {:?}",

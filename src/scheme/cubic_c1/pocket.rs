@@ -58,7 +58,7 @@ struct Constraint {
 /// One pocket condition σ·(α_0 c[t_0] + α_1 c[t_1]) ≥ bound on the number 2 weights of the two
 /// triangles at an edge: the edge blossom at an apex q on side σ has that side's sign with the
 /// margin ([`POCKET_MARGIN`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug)]
 struct PocketRow {
     /// The two triangles at the edge.
     tri: [usize; 2],
@@ -74,8 +74,14 @@ struct PocketRow {
 }
 
 /// Every pocket condition of the hull (see the module documentation): one per apex on a side
-/// σ of the two triangles at an edge whose number 1 weights have (mostly) the sign σ.
-fn pocket_rows(hull: &SimplicialHull, edges: &[HullEdge], g: &[DVec3]) -> Vec<PocketRow> {
+/// σ of the two triangles at an edge whose number 1 weights have (mostly) the sign σ; none at
+/// an edge whose two triangles are both `frozen`.
+fn pocket_rows(
+    hull: &SimplicialHull,
+    edges: &[HullEdge],
+    g: &[DVec3],
+    frozen: &[bool],
+) -> Vec<PocketRow> {
     let p = &hull.points;
     let mut rows = Vec::new();
     for e in edges {
@@ -84,6 +90,9 @@ fn pocket_rows(hull: &SimplicialHull, edges: &[HullEdge], g: &[DVec3]) -> Vec<Po
             continue;
         }
         let (t0, t1) = (t0 as usize, t1 as usize);
+        if frozen[t0] && frozen[t1] {
+            continue;
+        }
         let [i, j] = e.v.map(|v| v as usize);
         let third = |t: usize| {
             hull.triangles[t]
@@ -142,11 +151,7 @@ pub fn clear_pockets(
 ) -> usize {
     let p = &hull.points;
     let mut cons = Vec::new();
-    for row in pocket_rows(hull, edges, g) {
-        let [t0, t1] = row.tri;
-        if frozen[t0] && frozen[t1] {
-            continue;
-        }
+    for row in pocket_rows(hull, edges, g, frozen) {
         // σ(α_0 c_0 + α_1 c_1) ≥ bound ⇔ −σα_0 c_0 − σα_1 c_1 ≤ −bound; frozen terms move
         // to the right.
         let mut coef = [-row.sigma * row.alpha[0], -row.sigma * row.alpha[1]];
@@ -246,7 +251,7 @@ fn meet(cons: &[Constraint], largest: &[f64], base_sign: &[f64], center: &mut [f
     }
 }
 
-/// Cyclic projection onto the constraints `cons`, each weight kept within `cap` of `before`.
+/// Cyclic projection onto the constraints `cons`, each weight kept between `lo` and `hi`.
 fn project(cons: &[Constraint], lo: &[f64], hi: &[f64], center: &mut [f64], sweeps: usize) {
     for _ in 0..sweeps {
         let mut moved = false;
@@ -348,6 +353,7 @@ mod tests {
             );
         }
     }
+
     /// The fandisk conflict in miniature: triangle 1 must rise to 0.8 for a condition at a
     /// boundary face while a condition inside the hull, shared with triangle 2, asks it to stay
     /// low. The first projection alone balances them (c1 ends at 0.65, c2 at its cap −1);
