@@ -35,6 +35,17 @@ pub const RETRY_PIVOT: f64 = 1e-9;
 /// Rounds of iterative refinement after the first solve.
 const REFINE: usize = 4;
 
+/// Most entries a factor of Â Âᵀ may hold ([`Ordering::entries`]). Each entry costs its
+/// pattern, two f64 factors and, where f64 falls short, a double-double one: about 100 bytes
+/// with the work arrays, so 6e7 is ~6 GB, a quarter of the 24 GB machines we run on. The
+/// largest group of a model that passes is fandisk's edge middles (nnz(L) 3.3e6); the group
+/// that exceeded memory was fandisk's quintic with every point relaxed (2.27e8).
+pub const MAX_FACTOR_ENTRIES: usize = 60_000_000;
+
+/// Most rows a group may have for a sparse direct solve to be tried at all: the minimum degree
+/// ordering grows faster than its rows (fandisk: 197322 rows 2 s, 1297197 rows 268 s).
+pub const MAX_FACTOR_ROWS: usize = 1_000_000;
+
 /// The Cholesky factor of a sparse symmetric matrix in elimination order, in f64 or, where
 /// the normal equations need more digits, in double-double ([`Precise`]).
 struct Factor<T: Real = f64> {
@@ -151,6 +162,12 @@ pub struct Ordering {
 }
 
 impl Ordering {
+    /// The factor's entries (nnz(L)), known before any value is computed.
+    #[must_use]
+    pub fn entries(&self) -> usize {
+        self.pattern.iter().map(Vec::len).sum()
+    }
+
     /// The ordering for the rows' structure (`n` unknowns): rows sharing a column are
     /// neighbours, whatever their values (an entry that cancels in one solve may not in the
     /// next).

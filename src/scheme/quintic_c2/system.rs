@@ -539,6 +539,12 @@ struct Group {
     tgt: Vec<f64>,
     /// Largest |datum| (right-hand side or target).
     scale: f64,
+    /// `scale`, or the largest sum of |known terms| of one row if larger: what a residual is
+    /// measured against ([`consistent`]). A right-hand side that is the small difference of
+    /// large known weights (a star on a flat part of the model: data 2e-3 from weights of
+    /// 0.1) is only as accurate as those weights, which their own groups met to 1e-9 of
+    /// *their* scale; against `scale` alone fandisk's flat stars missed by 2e-12 of 2e-12.
+    reach: f64,
     /// Whether it is solved in the parallel phase of its stage: its sign conditions read no
     /// other group of the stage, and it is dense.
     parallel: bool,
@@ -812,6 +818,9 @@ impl System {
                 let mut other = [0usize; 8];
                 for f in failures.iter().filter(|f| f.stage != NEAR_NULL) {
                     other[usize::from(f.stage)] += 1;
+                }
+                for f in failures.iter().filter(|f| f.stage != NEAR_NULL).take(20) {
+                    eprintln!("quintic-c2 failure (pass stage {}): {}", f.stage, f.message);
                 }
                 eprintln!(
                     "quintic-c2 pass: {} + {} near-null conditions imposed; nearly singular stars {near}, failures by stage {other:?}",
@@ -1108,14 +1117,20 @@ impl System {
                         unk.iter().enumerate().map(|(i, s)| (*s, i)).collect();
                     let mut rows: Vec<sparse::Row> = Vec::with_capacity(eqs.len() + unk.len());
                     let mut c = vec![0.0; eqs.len()];
+                    let mut known_size = 0.0_f64;
                     for (i, &e) in eqs.iter().enumerate() {
                         let mut row = Vec::new();
+                        let mut size = 0.0;
                         for &(s, k) in &all[e].terms {
                             match col.get(&s) {
                                 Some(&j) => row.push((j, k)),
-                                None => c[i] -= k * value[s as usize],
+                                None => {
+                                    c[i] -= k * value[s as usize];
+                                    size += (k * value[s as usize]).abs();
+                                }
                             }
                         }
+                        known_size = known_size.max(size);
                         rows.push(row);
                     }
                     let tgt: Vec<f64> = unk
@@ -1155,6 +1170,7 @@ impl System {
                         c,
                         tgt,
                         scale,
+                        reach: scale.max(known_size),
                         parallel,
                     }
                 })
@@ -1212,18 +1228,28 @@ impl System {
                     }
                     pts
                 };
-                if !consistent(&sol, g.scale) {
-                    let pts = where_();
+                if !consistent(&sol, g.reach) {
+                    // A large group names the points of its unmet rows only: relaxing every
+                    // point of a group that spans the model (fandisk's edge middles with the
+                    // stars' consistency conditions: 197322 rows, a few unmet by 1e-9) made
+                    // the next pass's relaxed group the whole model (1.3M equations).
+                    let pts = if n > DENSE_LIMIT {
+                        unmet_points(g, &sol.x, st, np, &self.keys)
+                    } else {
+                        where_()
+                    };
+                    let shown = brief(&pts);
                     let what = match st {
-                        1 => format!("the middle of hull edge {pts:?}"),
+                        1 if global => format!("every weight at hull points {shown}"),
+                        1 => format!("the middle of hull edge {shown}"),
                         // Pass stages: 2 relaxed stars, 3 stars, 4 far face weights, 5 face
                         // middles, 6 the rest of the edge tetrahedra.
-                        2 | 3 => format!("the star of hull point(s) {pts:?}"),
+                        2 | 3 => format!("the star of hull point(s) {shown}"),
                         4 => {
-                            format!("the far weights of the face tetrahedra at hull points {pts:?}")
+                            format!("the far weights of the face tetrahedra at hull points {shown}")
                         }
-                        5 => format!("the face middles at hull points {pts:?}"),
-                        _ => format!("the edge tetrahedra at hull points {pts:?}"),
+                        5 => format!("the face middles at hull points {shown}"),
+                        _ => format!("the edge tetrahedra at hull points {shown}"),
                     };
                     // What the known weights must meet for this group to be consistent:
                     // the dependencies y of its rows (yᵀA = 0) applied to their known terms.
@@ -1235,24 +1261,64 @@ impl System {
                                 a[i * n + j] += k;
                             }
                         }
+                        if trace && st == 3 {
+                            // Opt-in exploration: the star's smallest singular values (rows
+                            // scaled to unit norm) and how far its data miss each direction.
+                            let mut u = a.clone();
+                            let mut cu = g.c[..m].to_vec();
+                            for i in 0..m {
+                                let r = u[i * n..(i + 1) * n]
+                                    .iter()
+                                    .map(|v| v * v)
+                                    .sum::<f64>()
+                                    .sqrt()
+                                    .max(1e-300);
+                                u[i * n..(i + 1) * n].iter_mut().for_each(|v| *v /= r);
+                                cu[i] /= r;
+                            }
+                            let small: Vec<String> = dense::near_null_left(&u, m, n, 1e-5)
+                                .iter()
+                                .map(|(sg, v)| {
+                                    let uc: f64 = v.iter().zip(&cu).map(|(a, b)| a * b).sum();
+                                    format!("{sg:.1e}:{uc:.1e}")
+                                })
+                                .collect();
+                            eprintln!(
+                                "quintic-c2 failing star {:?}: {m}x{n} rank {} residual {:.2e} reach {:.2e}; sigma:u.c {}",
+                                where_(),
+                                sol.rank,
+                                sol.residual,
+                                g.reach,
+                                small.join(" ")
+                            );
+                        }
                         for y in dense::dependencies(&a, m, n, 1e-11) {
                             consistency.extend(known_condition(&all, &g.eqs, &g.col, &y));
                         }
                     }
+                    let message = if sol.residual == f64::INFINITY {
+                        format!(
+                            "quintic-c2: the C1/C2 system of {what} is too large to solve at once ({m} equations, {n} unknowns; a direct factor is tried up to {} rows and {} entries)",
+                            cholesky::MAX_FACTOR_ROWS,
+                            cholesky::MAX_FACTOR_ENTRIES
+                        )
+                    } else {
+                        format!(
+                            "quintic-c2: the C1/C2 system of {what} is singular ({m} equations, {n} unknowns, rank {}, residual {:.3e}): points of T are not in general position",
+                            sol.rank, sol.residual
+                        )
+                    };
                     failures.push(Failure {
                         consistency,
                         stage: st,
                         points: pts,
-                        message: format!(
-                            "quintic-c2: the C1/C2 system of {what} is singular ({m} equations, {n} unknowns, rank {}, residual {:.3e}): points of T are not in general position",
-                            sol.rank, sol.residual
-                        ),
+                        message,
                     });
                 }
                 // A star solved exactly but nearly singular: the conditions that keep it from
                 // amplifying its data's noise (`star_tau`), for the next pass; a placeholder
                 // keeps its place among the failures.
-                if st == 3 && near && n <= DENSE_LIMIT && consistent(&sol, g.scale) {
+                if st == 3 && near && n <= DENSE_LIMIT && consistent(&sol, g.reach) {
                     near_jobs.push((gi, failures.len()));
                     failures.push(Failure {
                         stage: NEAR_NULL,
@@ -1287,7 +1353,7 @@ impl System {
                 // groups' rows only), then their conditions in their places.
                 let conds: Vec<Vec<Equation>> = near_jobs
                     .par_iter()
-                    .map(|&(gi, _)| self.near_null_conditions(&groups[gi], &all))
+                    .map(|&(gi, _)| Self::near_null_conditions(&groups[gi], &all, self.star_tau))
                     .collect();
                 for (&(_, at), conds) in near_jobs.iter().zip(conds) {
                     failures[at].consistency = conds;
@@ -1342,7 +1408,7 @@ impl System {
     ) -> GroupSolution {
         let mut sol = solve_rows(&g.rows, g.unk.len(), &g.c, &g.tgt, g.scale);
         let (mut pinned, mut given_up) = (0, 0);
-        if pin && consistent(&sol, g.scale) {
+        if pin && consistent(&sol, g.reach) {
             let conds = self.sign_conditions(&g.unk, &g.col, value, known, stage_of, st, eqs_of);
             (pinned, given_up) =
                 pin_signs(&mut sol, &mut g.rows, &mut g.c, &conds, &g.tgt, g.scale);
@@ -1350,10 +1416,10 @@ impl System {
         (sol, pinned, given_up)
     }
 
-    /// A solved star's near-null conditions (`star_tau`): the left singular vectors u of its
-    /// rows scaled to unit norm with σ ≤ `star_tau` × σ_max, each as the condition uᵀc = 0 on
+    /// A solved star's near-null conditions (`tau`: `star_tau`): the left singular vectors u
+    /// of its rows scaled to unit norm with σ ≤ `tau` × σ_max, each as the condition uᵀc = 0 on
     /// the known weights its right-hand side reads ([`known_condition`]).
-    fn near_null_conditions(&self, g: &Group, all: &[&Equation]) -> Vec<Equation> {
+    fn near_null_conditions(g: &Group, all: &[&Equation], tau: f64) -> Vec<Equation> {
         let (m, n) = (g.m, g.unk.len());
         let mut a = vec![0.0; m * n];
         let mut norm = vec![0.0_f64; m];
@@ -1368,7 +1434,7 @@ impl System {
                 a[i * n + j] += k / norm[i];
             }
         }
-        dense::near_null_left(&a, m, n, self.star_tau)
+        dense::near_null_left(&a, m, n, tau)
             .into_iter()
             .filter_map(|(_, u)| {
                 // uᵀ(row_i / |row_i|): the condition on the unscaled equations.
@@ -1504,6 +1570,52 @@ impl System {
     }
 }
 
+/// `pts` for a message: all of them up to 12, else the first 12 and how many there are.
+fn brief(pts: &[u32]) -> String {
+    if pts.len() <= 12 {
+        format!("{pts:?}")
+    } else {
+        let head: Vec<String> = pts[..12].iter().map(u32::to_string).collect();
+        format!("[{}, … ({} points)]", head.join(", "), pts.len())
+    }
+}
+
+/// The points of the unknowns (the stars' centres at stages 2 and 3) in the rows of group `g`
+/// that `x` misses by more than [`consistent`] allows, sorted; all of the group's points if
+/// none does (a non-finite solution).
+fn unmet_points(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128]) -> Vec<u32> {
+    let tol = 1e-9 * g.reach;
+    let finite = x.iter().all(|v| v.is_finite());
+    let mut cols: Vec<usize> = Vec::new();
+    for (row, &c) in g.rows.iter().zip(&g.c).take(g.m) {
+        let r: f64 = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
+        if !finite || r.is_nan() || r.abs() > tol {
+            cols.extend(row.iter().map(|t| t.0));
+        }
+    }
+    if cols.is_empty() {
+        cols = (0..g.unk.len()).collect();
+    }
+    let mut pts: Vec<u32> = cols
+        .into_iter()
+        .flat_map(|j| {
+            let key = keys[g.unk[j] as usize];
+            if st == 2 || st == 3 {
+                unkey(key)
+                    .into_iter()
+                    .filter(|p| p.0 < np && p.1 >= 2)
+                    .map(|p| p.0)
+                    .collect()
+            } else {
+                stage(key, np).1
+            }
+        })
+        .collect();
+    pts.sort_unstable();
+    pts.dedup();
+    pts
+}
+
 /// Whether a group's solution meets its equations (to 1e-9 of the group's largest datum: far
 /// above the rounding of the solves, far below any inconsistency the systems have shown).
 fn consistent(sol: &dense::Solution, scale: f64) -> bool {
@@ -1536,7 +1648,8 @@ fn solve_rows(
             // Opt-in dump of the large groups for offline solver experiments.
             dump_group(std::path::Path::new(&dir), rows, n, c, tgt, scale);
         }
-        let sol = cholesky::solve_near(rows, n, c, tgt, 1e-13 * scale);
+        let limits = (cholesky::MAX_FACTOR_ROWS, cholesky::MAX_FACTOR_ENTRIES);
+        let sol = solve_sparse(rows, n, c, tgt, 1e-13 * scale, limits);
         if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
             // Opt-in timing of the large groups on stderr (exploration; results unaffected).
             eprintln!(
@@ -1547,6 +1660,28 @@ fn solve_rows(
             );
         }
         sol
+    }
+}
+
+/// [`cholesky::solve_near`] within `(max rows, max factor entries)`; a group beyond either is
+/// left unsolved (its targets, infinite residual), which the caller reports as too large: a
+/// factor that does not fit in memory would end the process instead of the scene.
+fn solve_sparse(
+    rows: &[sparse::Row],
+    n: usize,
+    c: &[f64],
+    tgt: &[f64],
+    tol: f64,
+    (max_rows, max_entries): (usize, usize),
+) -> dense::Solution {
+    let ordering = (rows.len() <= max_rows).then(|| cholesky::Ordering::of(rows, n));
+    match ordering.filter(|o| o.entries() <= max_entries) {
+        Some(ordering) => cholesky::solve_near_ordered(rows, n, c, tgt, tol, &ordering),
+        None => dense::Solution {
+            x: tgt.to_vec(),
+            rank: 0,
+            residual: f64::INFINITY,
+        },
     }
 }
 
@@ -1684,4 +1819,79 @@ fn pin_signs(
         }
     }
     (pinned, given_up)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A group of three edge-middle slots over T's points 0–3 (`np` = 10) and two rows, of
+    /// which `x` meets only the first.
+    fn two_row_group() -> (Group, Vec<u128>) {
+        let keys = vec![
+            key(&[0, 1, 20, 21], [2, 2, 1, 0]),
+            key(&[1, 2, 20, 21], [2, 2, 1, 0]),
+            key(&[2, 3, 20, 21], [2, 2, 1, 0]),
+        ];
+        let g = Group {
+            m: 2,
+            unk: vec![0, 1, 2],
+            eqs: vec![0, 1],
+            col: (0..3).map(|j| (j as u32, j)).collect(),
+            rows: vec![vec![(0, 1.0), (1, -1.0)], vec![(2, 1.0)]],
+            c: vec![0.0, 1.0],
+            tgt: vec![0.0; 3],
+            scale: 1.0,
+            reach: 1.0,
+            parallel: false,
+        };
+        (g, keys)
+    }
+
+    #[test]
+    fn a_large_group_names_the_points_of_its_unmet_rows_only() {
+        let (g, keys) = two_row_group();
+        // Row 0 (slots 0, 1: points 0, 1, 2) is met; row 1 (slot 2: points 2, 3) is missed by
+        // 0.5, far above the 1e-9 of `consistent`.
+        let x = [0.25, 0.25, 0.5];
+        assert_eq!(unmet_points(&g, &x, 1, 10, &keys), vec![2, 3]);
+        // Met within 1e-9 × scale: no row is unmet, so every point is named (the caller only
+        // asks for a group that `consistent` rejected, e.g. for a non-finite weight).
+        let x = [0.25, 0.25, 1.0 + 1e-12];
+        assert_eq!(unmet_points(&g, &x, 1, 10, &keys), vec![0, 1, 2, 3]);
+        // A non-finite solution names every point.
+        let x = [f64::NAN, 0.0, 1.0];
+        assert_eq!(unmet_points(&g, &x, 1, 10, &keys), vec![0, 1, 2, 3]);
+    }
+
+    #[test]
+    fn groups_beyond_the_factor_limits_are_left_unsolved() {
+        // A chain x_i - x_{i+1} = 1: one sparse group whose factor has 2n - 1 entries.
+        let n = 50;
+        let rows: Vec<sparse::Row> = (0..n - 1).map(|i| vec![(i, 1.0), (i + 1, -1.0)]).collect();
+        let c = vec![1.0; n - 1];
+        let tgt = vec![0.0; n];
+        let solved = solve_sparse(&rows, n, &c, &tgt, 1e-13, (1000, 1000));
+        // Solved: the chain's rows hold to rounding (unit coefficients, values up to 25).
+        assert!(solved.residual < 1e-12, "{}", solved.residual);
+        assert!(consistent(&solved, 1.0));
+        let entries = cholesky::Ordering::of(&rows, n).entries();
+        for limits in [(n - 2, 1000), (1000, entries - 1)] {
+            let left = solve_sparse(&rows, n, &c, &tgt, 1e-13, limits);
+            assert_eq!(left.residual, f64::INFINITY, "{limits:?}");
+            assert!(!consistent(&left, 1.0));
+        }
+        let fits = solve_sparse(&rows, n, &c, &tgt, 1e-13, (n - 1, entries));
+        assert!(fits.residual < 1e-12);
+    }
+
+    #[test]
+    fn long_point_lists_are_cut_in_messages() {
+        assert_eq!(brief(&[3, 5]), "[3, 5]");
+        let many: Vec<u32> = (0..20).collect();
+        assert_eq!(
+            brief(&many),
+            "[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, … (20 points)]"
+        );
+    }
 }
