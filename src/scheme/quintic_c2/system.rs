@@ -1283,8 +1283,12 @@ impl System {
                                     format!("{sg:.1e}:{uc:.1e}")
                                 })
                                 .collect();
+                            // Where the star's centre is: a slot's tetrahedron vertex at
+                            // multiplicity 2.
+                            let (t, l) = self.home[g.unk[0] as usize];
+                            let at = (0..4).find(|&k| l[k] == 2).map(|k| tets[t as usize].pts[k]);
                             eprintln!(
-                                "quintic-c2 failing star {:?}: {m}x{n} rank {} residual {:.2e} reach {:.2e}; sigma:u.c {}",
+                                "quintic-c2 failing star {:?} at {at:?}: {m}x{n} rank {} residual {:.2e} reach {:.2e}; sigma:u.c {}",
                                 where_(),
                                 sol.rank,
                                 sol.residual,
