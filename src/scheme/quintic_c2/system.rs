@@ -1204,30 +1204,7 @@ impl System {
                 stats.signs.pinned += pinned;
                 stats.signs.given_up += given_up;
                 let unk = &g.unk;
-                let where_ = || {
-                    let mut pts: Vec<u32> = unk
-                        .iter()
-                        .flat_map(|&s| stage(self.keys[s as usize], np).1)
-                        .collect();
-                    pts.sort_unstable();
-                    pts.dedup();
-                    if st == 2 || st == 3 {
-                        // The stars' centres: points at multiplicity 2 in some slot.
-                        let mut c: Vec<u32> = unk
-                            .iter()
-                            .flat_map(|&s| {
-                                unkey(self.keys[s as usize])
-                                    .into_iter()
-                                    .filter(|p| p.0 < np && p.1 >= 2)
-                                    .map(|p| p.0)
-                            })
-                            .collect();
-                        c.sort_unstable();
-                        c.dedup();
-                        pts = c;
-                    }
-                    pts
-                };
+                let where_ = || group_points(unk.iter().copied(), st, np, &self.keys);
                 if !consistent(&sol, g.reach) {
                     // A large group names the points of its unmet rows only: relaxing every
                     // point of a group that spans the model (fandisk's edge middles with the
@@ -1264,18 +1241,9 @@ impl System {
                         if trace && st == 3 {
                             // Opt-in exploration: the star's smallest singular values (rows
                             // scaled to unit norm) and how far its data miss each direction.
-                            let mut u = a.clone();
-                            let mut cu = g.c[..m].to_vec();
-                            for i in 0..m {
-                                let r = u[i * n..(i + 1) * n]
-                                    .iter()
-                                    .map(|v| v * v)
-                                    .sum::<f64>()
-                                    .sqrt()
-                                    .max(1e-300);
-                                u[i * n..(i + 1) * n].iter_mut().for_each(|v| *v /= r);
-                                cu[i] /= r;
-                            }
+                            let (u, norm) = unit_rows(g);
+                            let cu: Vec<f64> =
+                                g.c[..m].iter().zip(&norm).map(|(c, r)| c / r).collect();
                             let small: Vec<String> = dense::near_null_left(&u, m, n, 1e-5)
                                 .iter()
                                 .map(|(sg, v)| {
@@ -1424,21 +1392,8 @@ impl System {
     /// of its rows scaled to unit norm with σ ≤ `tau` × σ_max, each as the condition uᵀc = 0 on
     /// the known weights its right-hand side reads ([`known_condition`]).
     fn near_null_conditions(g: &Group, all: &[&Equation], tau: f64) -> Vec<Equation> {
-        let (m, n) = (g.m, g.unk.len());
-        let mut a = vec![0.0; m * n];
-        let mut norm = vec![0.0_f64; m];
-        for (i, row) in g.rows.iter().enumerate().take(m) {
-            norm[i] = row
-                .iter()
-                .map(|t| t.1 * t.1)
-                .sum::<f64>()
-                .sqrt()
-                .max(1e-300);
-            for &(j, k) in row {
-                a[i * n + j] += k / norm[i];
-            }
-        }
-        dense::near_null_left(&a, m, n, tau)
+        let (a, norm) = unit_rows(g);
+        dense::near_null_left(&a, g.m, g.unk.len(), tau)
             .into_iter()
             .filter_map(|(_, u)| {
                 // uᵀ(row_i / |row_i|): the condition on the unscaled equations.
@@ -1574,6 +1529,25 @@ impl System {
     }
 }
 
+/// The group's own rows (its first `m`) each over its norm, dense row-major, with the norms.
+fn unit_rows(g: &Group) -> (Vec<f64>, Vec<f64>) {
+    let (m, n) = (g.m, g.unk.len());
+    let mut a = vec![0.0; m * n];
+    let mut norm = vec![0.0_f64; m];
+    for (i, row) in g.rows.iter().enumerate().take(m) {
+        norm[i] = row
+            .iter()
+            .map(|t| t.1 * t.1)
+            .sum::<f64>()
+            .sqrt()
+            .max(1e-300);
+        for &(j, k) in row {
+            a[i * n + j] += k / norm[i];
+        }
+    }
+    (a, norm)
+}
+
 /// `pts` for a message: all of them up to 12, else the first 12 and how many there are.
 fn brief(pts: &[u32]) -> String {
     if pts.len() <= 12 {
@@ -1600,10 +1574,15 @@ fn unmet_points(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128]) -> Vec<u32
     if cols.is_empty() {
         cols = (0..g.unk.len()).collect();
     }
-    let mut pts: Vec<u32> = cols
-        .into_iter()
-        .flat_map(|j| {
-            let key = keys[g.unk[j] as usize];
+    group_points(cols.into_iter().map(|j| g.unk[j]), st, np, keys)
+}
+
+/// The points of T that the slots `slots` of a group at pass stage `st` name, sorted: the
+/// stars' centres (points at multiplicity 2) at stages 2 and 3, else every point of T in them.
+fn group_points(slots: impl Iterator<Item = u32>, st: u8, np: u32, keys: &[u128]) -> Vec<u32> {
+    let mut pts: Vec<u32> = slots
+        .flat_map(|s| {
+            let key = keys[s as usize];
             if st == 2 || st == 3 {
                 unkey(key)
                     .into_iter()
@@ -1620,7 +1599,7 @@ fn unmet_points(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128]) -> Vec<u32
     pts
 }
 
-/// Whether a group's solution meets its equations (to 1e-9 of the group's largest datum: far
+/// Whether a group's solution meets its equations (to 1e-9 of `scale`, the group's reach: far
 /// above the rounding of the solves, far below any inconsistency the systems have shown).
 fn consistent(sol: &dense::Solution, scale: f64) -> bool {
     !(sol.residual.is_nan() || sol.residual > 1e-9 * scale || sol.x.iter().any(|x| !x.is_finite()))
