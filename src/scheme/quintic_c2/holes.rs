@@ -920,10 +920,13 @@ fn solve(
     pins: &[(usize, f64)],
     n: usize,
     x0: &[f64],
-    sparse: &OnceLock<PinnedSolves>,
+    sparse: &Factor,
 ) -> dense::Solution {
     if n > super::system::DENSE_LIMIT {
-        return pinned_solves(rows, c, n, x0, sparse).solve(rows, c, pins, None);
+        return match pinned_solves(rows, c, n, x0, sparse) {
+            Some(p) => p.solve(rows, c, pins, None),
+            None => unsolved(x0),
+        };
     }
     let m = rows.len() + pins.len();
     let mut a = vec![0.0; m * n];
@@ -941,15 +944,60 @@ fn solve(
     dense::solve_near(&a, m, n, &rhs, x0, 1e-11)
 }
 
-/// The group's [`PinnedSolves`], made at its first sparse solve.
+/// The group's [`PinnedSolves`], made at its first sparse solve; `None` for a group too large
+/// to factor ([`factored`] within the staged solve's limits).
 fn pinned_solves<'a>(
     rows: &[Vec<(usize, f64)>],
     c: &[f64],
     n: usize,
     x0: &[f64],
-    sparse: &'a OnceLock<PinnedSolves>,
-) -> &'a PinnedSolves {
-    sparse.get_or_init(|| PinnedSolves::new(rows, c, n, x0, &cholesky::Ordering::of(rows, n)))
+    sparse: &'a Factor,
+) -> Option<&'a PinnedSolves> {
+    sparse
+        .get_or_init(|| {
+            let limits = (cholesky::MAX_FACTOR_ROWS, cholesky::MAX_FACTOR_ENTRIES);
+            let p = factored(rows, c, n, x0, limits);
+            if p.is_none() {
+                trace(|| {
+                    format!(
+                        "a group of {} equations, {n} unknowns is too large to factor",
+                        rows.len()
+                    )
+                });
+            }
+            p
+        })
+        .as_ref()
+}
+
+/// A repair group's factor, kept for its rounds (none until its first sparse solve).
+type Factor = OnceLock<Option<PinnedSolves>>;
+
+/// The group's [`PinnedSolves`] when it has at most `max rows` equations and its factor at
+/// most `max entries`, as the staged solve allows (`system::solve_sparse`): a repair of a
+/// defect whose neighbourhood has grown beyond them is refused instead of filling the memory.
+fn factored(
+    rows: &[Vec<(usize, f64)>],
+    c: &[f64],
+    n: usize,
+    x0: &[f64],
+    (max_rows, max_entries): (usize, usize),
+) -> Option<PinnedSolves> {
+    if rows.len() > max_rows {
+        return None;
+    }
+    let ordering = cholesky::Ordering::of(rows, n);
+    (ordering.entries() <= max_entries).then(|| PinnedSolves::new(rows, c, n, x0, &ordering))
+}
+
+/// What a solve that was not made returns: the targets, with an infinite residual (which no
+/// repair accepts).
+fn unsolved(x0: &[f64]) -> dense::Solution {
+    dense::Solution {
+        x: x0.to_vec(),
+        rank: 0,
+        residual: f64::INFINITY,
+    }
 }
 
 /// [`solve`] with the pins as targets weighted by `weight` ([`SOFT`] first) instead of
@@ -963,10 +1011,13 @@ fn solve_soft(
     n: usize,
     x0: &[f64],
     weight: f64,
-    sparse: &OnceLock<PinnedSolves>,
+    sparse: &Factor,
 ) -> dense::Solution {
     if n > super::system::DENSE_LIMIT {
-        return pinned_solves(rows, c, n, x0, sparse).solve(rows, c, pins, Some(weight));
+        return match pinned_solves(rows, c, n, x0, sparse) {
+            Some(p) => p.solve(rows, c, pins, Some(weight)),
+            None => unsolved(x0),
+        };
     }
     let mut w = vec![1.0; n];
     let mut y0 = x0.to_vec();
@@ -1101,5 +1152,28 @@ mod tests {
             "{s:?}"
         );
         assert!((s.x[2] - 7.0).abs() < 1e-12, "{s:?}");
+    }
+
+    /// A repair group beyond either factor limit is not factored (the staged solve's
+    /// `groups_beyond_the_factor_limits_are_left_unsolved`, for the repair), one within both
+    /// is, and a solve without a factor is refused by any residual bound.
+    #[test]
+    fn repair_groups_beyond_the_factor_limits_are_refused() {
+        // A chain x_i - x_{i+1} = 1 over more unknowns than the dense limit.
+        let n = super::super::system::DENSE_LIMIT + 10;
+        let rows: Vec<Vec<(usize, f64)>> =
+            (0..n - 1).map(|i| vec![(i, 1.0), (i + 1, -1.0)]).collect();
+        let c = vec![1.0; n - 1];
+        let x0 = vec![0.0; n];
+        let entries = cholesky::Ordering::of(&rows, n).entries();
+        for limits in [(n - 2, entries), (n - 1, entries - 1)] {
+            assert!(factored(&rows, &c, n, &x0, limits).is_none(), "{limits:?}");
+        }
+        let p = factored(&rows, &c, n, &x0, (n - 1, entries)).expect("within both limits");
+        let s = p.solve(&rows, &c, &[], None);
+        // Unit coefficients, values up to n/2: rounding of the factor's refined solve.
+        assert!(s.residual < 1e-9, "{}", s.residual);
+        let left = unsolved(&x0);
+        assert!(left.residual.is_infinite() && left.x == x0);
     }
 }
