@@ -625,6 +625,10 @@ pub struct BuiltScene {
     /// ([`crate::scheme::cubic_c1::prepare_hull`]), for `quintic-c2` as the hull builder made it
     /// (the scheme completes L-U pairs internally). `None` for other scenes.
     pub hull: Option<crate::hull::simplicial::SimplicialHull>,
+    /// What the quintic scheme's solve did (`quintic-c2` scenes; `None` otherwise): its size,
+    /// relaxed stars, consistency conditions, whether it fell back to solving every weight at
+    /// once, the weights' signs and the hole repair.
+    pub solve: Option<crate::scheme::quintic_c2::BuildStats>,
 }
 
 /// [`build_complex`], returning the loaded mesh and the hull beside the complex
@@ -639,6 +643,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
             info: None,
             mesh: None,
             hull: None,
+            solve: None,
         }),
         Model::Mesh {
             file,
@@ -701,6 +706,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                         info: Some(info),
                         mesh: Some(m),
                         hull: None,
+                        solve: None,
                     })
                 }
                 "cubic-c1" | "quintic-c2" => {
@@ -710,13 +716,14 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                     let (m, report) = mesh::load(file)?;
                     crate::hull::inner::closed::require_closed(&m, &report)?;
                     let vn = mesh::vertex_normals(&m, method)?;
-                    let (complex, hull) = build_1994(ty, &m, &vn, scheme, &scene.path)
+                    let (complex, hull, solve) = build_1994(ty, &m, &vn, scheme, &scene.path)
                         .with_context(|| format!("{}", file.display()))?;
                     Ok(BuiltScene {
                         complex,
                         info: None,
                         mesh: Some(m),
                         hull: Some(hull),
+                        solve,
                     })
                 }
                 _ => bail!(
@@ -773,26 +780,31 @@ pub fn inner_hull(
 }
 
 /// Builds a `cubic-c1` or `quintic-c2` complex as the schemes' `build_from_scene` do (same
-/// options, hull, patches and errors), returning the hull the patches fill beside it.
+/// options, hull, patches and errors), returning the hull the patches fill and (quintic) what its solve did beside it.
 fn build_1994(
     ty: &str,
     m: &mesh::Mesh,
     vn: &[DVec3],
     scheme: &toml::Table,
     scene: &Path,
-) -> anyhow::Result<(PatchComplex, crate::hull::simplicial::SimplicialHull)> {
+) -> anyhow::Result<(
+    PatchComplex,
+    crate::hull::simplicial::SimplicialHull,
+    Option<crate::scheme::quintic_c2::BuildStats>,
+)> {
     use crate::scheme::{cubic_c1, quintic_c2};
     let at = || format!("{}", scene.display());
     if ty == "cubic-c1" {
         let (options, inner) = cubic_c1::options_from_toml(scheme, scene)?;
         let hull = crate::hull::inner::build(m, vn, &inner).with_context(at)?;
-        Ok(cubic_on_prepared(&hull, &options).with_context(at)?)
+        let (complex, hull) = cubic_on_prepared(&hull, &options).with_context(at)?;
+        Ok((complex, hull, None))
     } else {
         let options = quintic_c2::QuinticOptions::from_toml(scheme, scene)?;
         let inner = crate::hull::inner::InnerOptions::from_toml(scheme, scene)?;
         let hull = crate::hull::inner::build(m, vn, &inner)?;
-        let complex = quintic_c2::build(&hull, &options)?;
-        Ok((complex, hull))
+        let (complex, stats) = quintic_c2::build_with_stats(&hull, &options)?;
+        Ok((complex, hull, Some(stats)))
     }
 }
 

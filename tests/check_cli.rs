@@ -382,3 +382,46 @@ fn inner_hull_scene_reports_hull_and_distance() {
         stdout(&o)
     );
 }
+
+/// A quintic scene: `check` reports what the scheme's solve did, the same figures as the
+/// library's `quintic_c2::build_with_stats` on the scene's hull and options (a second path to
+/// the numbers); a cubic scene has no solve to report.
+#[test]
+fn quintic_scene_reports_its_solve() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper1994/l_prism_quintic.toml");
+    let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let s = &v["solve"];
+    let loaded = apatch::scene::load(&scene).unwrap();
+    let hull = apatch::scene::inner_hull(&loaded).unwrap().unwrap();
+    let table: toml::Table = toml::from_str(&std::fs::read_to_string(&scene).unwrap()).unwrap();
+    let scheme = table["scheme"].as_table().unwrap();
+    let options = apatch::scheme::quintic_c2::QuinticOptions::from_toml(scheme, &scene).unwrap();
+    let (_, stats) = apatch::scheme::quintic_c2::build_with_stats(&hull, &options).unwrap();
+    assert_eq!(s["unknowns"].as_u64(), Some(stats.unknowns as u64), "{s}");
+    assert_eq!(s["equations"].as_u64(), Some(stats.equations as u64), "{s}");
+    assert_eq!(
+        s["relaxed_points"].as_u64(),
+        Some(stats.relaxed_points as u64),
+        "{s}"
+    );
+    assert_eq!(s["global"], false, "{s}");
+    assert!(stats.unknowns > 0 && stats.equations > 0);
+    let text = stdout(&apatch(&["check", scene.to_str().unwrap()]));
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("solve "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        line.contains(&format!(
+            "{} unknowns, {} equations",
+            stats.unknowns, stats.equations
+        )),
+        "{line}"
+    );
+    let cubic = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper1994/octahedron.toml");
+    let o = apatch(&["check", cubic.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert!(v.get("solve").is_none(), "{v}");
+}

@@ -85,6 +85,7 @@ pub fn load_built(
         info: None,
         mesh: None,
         hull: None,
+        solve: None,
     };
     match ext.as_str() {
         "json" => Ok((only(apatch::complex_io::read_json_file(path)?), None)),
@@ -201,6 +202,41 @@ fn hull_repairs(scene: &apatch::scene::Scene) -> anyhow::Result<HullRepairs> {
     Ok((merged.map(|c| (options.merge_close, c)), split))
 }
 
+/// The quintic scheme's solve in one `info` line: its size, what it relaxed or conditioned,
+/// whether it fell back to solving every weight at once, the weights off Theorem 2.1's signs
+/// (sufficient for one sheet, not necessary: the `sheets`, `j-sheets` and `holes` lines test
+/// the surface itself), and the hole repair when it ran.
+fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
+    let r = &s.hole_repair;
+    let repair = if r == &Default::default() {
+        String::new()
+    } else {
+        format!(
+            "; hole repair: crossed faces {} -> {}, j-sheets {} -> {}",
+            r.crossed_before, r.crossed_after, r.sheets_before, r.sheets_after
+        )
+    };
+    format!(
+        "solve            {} unknowns, {} equations, largest group {} ({} sparse), residual \
+         {:.1e}; {} points of T relaxed, {} consistency conditions{}; {} weights off Theorem \
+         2.1's sufficient signs, in {} patches{repair}  info",
+        s.unknowns,
+        s.equations,
+        s.largest_group,
+        s.sparse_groups,
+        s.max_residual,
+        s.relaxed_points,
+        s.consistency_conditions,
+        if s.global {
+            "; the staged solve failed: every weight solved at once"
+        } else {
+            ""
+        },
+        s.signs.violated(),
+        s.signs.violating_patches
+    )
+}
+
 /// One line per hull violation: the condition, the triangle of T, the detail.
 fn violation_line(v: &apatch::hull::inner::HullViolation) -> String {
     match v.triangle {
@@ -259,6 +295,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         if let Some(info) = &build_info {
             out.insert("mesh_build".into(), serde_json::to_value(info)?);
+        }
+        if let Some(stats) = &built.solve {
+            out.insert("solve".into(), serde_json::to_value(stats)?);
         }
         if let Some((t, c)) = &merged {
             out.insert(
@@ -322,6 +361,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 },
                 info.refined_edges
             );
+        }
+        if let Some(stats) = &built.solve {
+            println!("{}", solve_line(stats));
         }
         if let Some((t, c)) = &merged {
             println!(

@@ -38,7 +38,7 @@ use std::collections::{HashMap, HashSet};
 use std::sync::OnceLock;
 
 /// What [`repair`] did.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct HoleRepair {
     /// Boundary faces crossed (by [`crossed`]) after the solve.
     pub crossed_before: usize,

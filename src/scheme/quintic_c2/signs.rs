@@ -73,7 +73,7 @@ pub fn combine(a: i8, b: i8) -> i8 {
 pub const CONFLICT: i8 = 2;
 
 /// How the solved weights meet Theorem 2.1.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct SignStats {
     /// Weights (after C0 sharing) that Theorem 2.1 asks a sign of.
     pub constrained: usize,
@@ -155,7 +155,7 @@ pub fn base_conflicts(hull: &SimplicialHull) -> Vec<BaseConflict> {
 }
 
 /// What [`fit_hessians`] did.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct HessianFit {
     /// Points of T whose estimated Hessian missed a sign condition and was moved.
     pub moved: usize,

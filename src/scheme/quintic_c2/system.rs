@@ -412,7 +412,7 @@ fn stage(key: u128, np: u32) -> (u8, Vec<u32>) {
 }
 
 /// What the solve measured.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct SolveStats {
     /// Unknown slots (after C0 sharing), jets excluded.
     pub unknowns: usize,
