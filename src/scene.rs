@@ -53,6 +53,7 @@
 //! isophote = "light"              # light | view
 //! over = "shaded"                 # shaded | none (isophotes alone)
 //! curvature = "mean"              # mean | gaussian
+//! curvature_range = 20.0          # fixed colour span ±range (default: the image's 99th percentile)
 //! patch_boundaries = true
 //! ```
 
@@ -252,7 +253,21 @@ struct RenderSection {
     isophote: Option<String>,
     over: Option<String>,
     curvature: Option<String>,
+    curvature_range: Option<f64>,
     patch_boundaries: Option<bool>,
+}
+
+/// A curvature colour range (`render.curvature_range`, `--curvature-range`): positive and
+/// finite, and representable in the frame's f32 values.
+///
+/// # Errors
+/// What is wrong with `v`.
+pub fn curvature_range(v: f64) -> Result<f64, String> {
+    if v.is_finite() && v > 0.0 && v <= f64::from(f32::MAX) && v >= f64::from(f32::MIN_POSITIVE) {
+        Ok(v)
+    } else {
+        Err(format!("`{v}` is not a positive finite number"))
+    }
 }
 
 /// "file:line: message (key `k`)" from a TOML error.
@@ -535,6 +550,10 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                 ))
             }
         };
+    }
+    if let Some(v) = r.curvature_range {
+        options.curvature_range =
+            Some(curvature_range(v).map_err(|e| bad("render.curvature_range", e))?);
     }
     if let Some(b) = r.patch_boundaries {
         options.patch_boundaries = b;

@@ -155,6 +155,47 @@ fn curvature_mode_reports_the_sphere_curvature() {
     );
 }
 
+/// A fixed colour range (`render.curvature_range`): the map spans ±range whatever the image
+/// holds, so each sphere pixel has the diverging map's colour at H / range; the scene key
+/// reaches the settings, and a range that is not positive is refused naming the key.
+#[test]
+fn curvature_mode_with_a_fixed_range() {
+    let r = 0.8;
+    let q = Quadric::sphere(DVec3::ZERO, r);
+    let complex = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 2);
+    let geo = Geometry::new(&complex).unwrap();
+    let (_, mut s) = setup(Mode::Curvature, 0);
+    s.spp = 1;
+    s.options.curvature_range = Some(5.0);
+    let f = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
+    assert_eq!(f.range, 5.0);
+    let want = trace::shade::diverging(1.0 / r / 5.0);
+    let mut covered = 0;
+    for p in f.pixels.iter().filter(|p| p.alpha == 1.0) {
+        // f32 storage of the colour; the map is linear in H / range (H to 1e-5, above).
+        for (got, w) in p.rgb.iter().zip(want.to_array()) {
+            assert!((f64::from(*got) - w).abs() < 1e-5, "{:?} vs {want}", p.rgb);
+        }
+        covered += 1;
+    }
+    assert!(covered > 100, "{covered}");
+    // The image's own range would have made the same sphere the map's full red.
+    assert!((want - trace::shade::diverging(1.0)).length() > 0.1, "{want}");
+
+    let dir = scratch("curvature-range");
+    let rest = |v: &str| format!("[render]\nmode = \"curvature\"\ncurvature_range = {v}\n");
+    let path = dir.join("s.toml");
+    std::fs::write(&path, sphere_scene("s.json", 8, 6, &rest("2.5"))).unwrap();
+    let sc = scene::load(&path).unwrap();
+    assert_eq!(sc.settings.options.curvature_range, Some(2.5));
+    for bad in ["0.0", "-1.0", "inf"] {
+        std::fs::write(&path, sphere_scene("s.json", 8, 6, &rest(bad))).unwrap();
+        let e = format!("{:#}", scene::load(&path).unwrap_err());
+        assert!(e.contains("render.curvature_range") && e.contains("s.toml"), "{bad}: {e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn shaded_matches_lambert_without_shadows() {
     // One directional light, convex surface, the pixel centre hit: L = ρ/π·E·n·l exactly.

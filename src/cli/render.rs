@@ -23,12 +23,22 @@ pub struct RenderArgs {
     /// Shading mode: shaded, normal, depth, patch, isophote, zebra, curvature.
     #[arg(long)]
     pub mode: Option<String>,
+    /// Curvature mode: colour span ±this (default: the image's 99th percentile of |curvature|);
+    /// the same value for two renders puts them on one scale.
+    #[arg(long, value_parser = range)]
+    pub curvature_range: Option<f64>,
     /// Worker threads (0 = all cores).
     #[arg(long)]
     pub threads: Option<usize>,
     /// Replay one pixel "x,y": print its samples' result instead of rendering.
     #[arg(long)]
     pub pixel: Option<String>,
+}
+
+/// `--curvature-range`: a number that [`scene::curvature_range`] accepts.
+fn range(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    scene::curvature_range(v)
 }
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
@@ -43,6 +53,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     }
     if let Some(t) = args.threads {
         s.threads = t;
+    }
+    if let Some(r) = args.curvature_range {
+        s.options.curvature_range = Some(r);
     }
     if let Some(o) = args.output {
         scene::check_output(&o).map_err(|e| anyhow!("--output: {e}"))?;
@@ -116,13 +129,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     );
     if s.mode == Mode::Curvature {
         eprintln!(
-            "{} curvature colour range: ±{:.6}",
+            "{} curvature colour range: ±{:.6}{}",
             if s.options.gaussian {
                 "Gaussian"
             } else {
                 "mean"
             },
-            frame.range
+            frame.range,
+            if s.options.curvature_range.is_some() {
+                " (fixed)"
+            } else {
+                ""
+            }
         );
     }
     Ok(ExitCode::SUCCESS)

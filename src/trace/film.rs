@@ -245,6 +245,8 @@ fn finish(frame: &mut Frame, opts: &ModeOptions) {
                 .copied()
                 .unwrap_or(0.0);
             let range = if range > 0.0 { range } else { 1.0 };
+            #[allow(clippy::cast_possible_truncation)]
+            let range = opts.curvature_range.map_or(range, |r| r as f32);
             for p in frame.pixels.iter_mut().filter(|p| p.alpha > 0.0) {
                 let c = shade::diverging(f64::from(p.value[k] / range));
                 p.rgb = [

@@ -116,6 +116,10 @@ pub struct ModeOptions {
     pub gaussian: bool,
     /// Draw patch-boundary lines in `patch` mode.
     pub patch_boundaries: bool,
+    /// The curvature colour map's span ±range; `None`: the image's own 99th percentile of
+    /// |curvature|. A fixed range puts renders of different surfaces on one scale (the cubic
+    /// and quintic panels of one model).
+    pub curvature_range: Option<f64>,
 }
 
 impl Default for ModeOptions {
@@ -127,6 +131,7 @@ impl Default for ModeOptions {
             over_shaded: true,
             gaussian: false,
             patch_boundaries: true,
+            curvature_range: None,
         }
     }
 }
