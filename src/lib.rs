@@ -28,6 +28,7 @@ pub mod export;
 pub mod fixtures;
 pub mod hull;
 pub mod mesh;
+pub mod progress;
 pub mod scene;
 pub mod scheme;
 pub mod trace;

@@ -813,9 +813,11 @@ fn build_1994(
 )> {
     use crate::scheme::{cubic_c1, quintic_c2};
     let at = || format!("{}", scene.display());
+    crate::progress::report(|| "building the inner hull".into());
     if ty == "cubic-c1" {
         let (options, inner) = cubic_c1::options_from_toml(scheme, scene)?;
         let hull = crate::hull::inner::build(m, vn, &inner).with_context(at)?;
+        crate::progress::report(|| format!("cubic-c1: {} triangles of T", hull.triangles.len()));
         let (complex, hull) = cubic_on_prepared(&hull, &options).with_context(at)?;
         Ok((complex, hull, None))
     } else {

@@ -180,7 +180,10 @@ fn curvature_mode_with_a_fixed_range() {
     }
     assert!(covered > 100, "{covered}");
     // The image's own range would have made the same sphere the map's full red.
-    assert!((want - trace::shade::diverging(1.0)).length() > 0.1, "{want}");
+    assert!(
+        (want - trace::shade::diverging(1.0)).length() > 0.1,
+        "{want}"
+    );
 
     let dir = scratch("curvature-range");
     let rest = |v: &str| format!("[render]\nmode = \"curvature\"\ncurvature_range = {v}\n");
@@ -191,7 +194,10 @@ fn curvature_mode_with_a_fixed_range() {
     for bad in ["0.0", "-1.0", "inf"] {
         std::fs::write(&path, sphere_scene("s.json", 8, 6, &rest(bad))).unwrap();
         let e = format!("{:#}", scene::load(&path).unwrap_err());
-        assert!(e.contains("render.curvature_range") && e.contains("s.toml"), "{bad}: {e}");
+        assert!(
+            e.contains("render.curvature_range") && e.contains("s.toml"),
+            "{bad}: {e}"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -94,7 +94,7 @@ pub fn load_built(
             if let apatch::scene::Model::Patches(json) = &scene.model {
                 return Ok((only(apatch::complex_io::read_json_file(json)?), Some(scene)));
             }
-            let built = apatch::scene::build_scene(&scene)?;
+            let built = super::with_progress(|| apatch::scene::build_scene(&scene))?;
             apatch::complex_io::validate(&built.complex)
                 .map_err(|m| anyhow::anyhow!("{}: {m}", path.display()))?;
             Ok((built, Some(scene)))

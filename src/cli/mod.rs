@@ -8,6 +8,22 @@ pub mod info;
 pub mod render;
 pub mod tessellate;
 
+/// Runs `build` (a scene's patch build) with a spinner on stderr naming the library's current
+/// step ([`apatch::progress`]); on a terminal only (indicatif hides it otherwise), and gone,
+/// with its sink, when `build` returns.
+pub fn with_progress<T>(build: impl FnOnce() -> T) -> T {
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let shown = bar.clone();
+    apatch::progress::set_sink(Some(Box::new(move |msg: &str| {
+        shown.set_message(msg.to_string());
+    })));
+    let out = build();
+    apatch::progress::set_sink(None);
+    bar.finish_and_clear();
+    out
+}
+
 /// The `--width`, `--height` and `--spp` flags shared by `render` and `export mitsuba`: each
 /// replaces the scene's value when given.
 #[derive(clap::Args, Debug)]

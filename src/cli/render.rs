@@ -63,7 +63,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     }
 
     let start = Instant::now();
-    let complex = scene::build_complex(&scene)?;
+    let complex = super::with_progress(|| scene::build_complex(&scene))?;
     let geo = Geometry::new(&complex).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
     let built = start.elapsed();
 

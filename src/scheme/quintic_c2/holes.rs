@@ -325,6 +325,18 @@ pub fn repair(
             .filter(|&&d| is_open(d, value))
             .filter_map(|&d| neighbourhood(sys, tets, d, &index, reach))
             .collect();
+        crate::progress::report(|| {
+            format!(
+                "quintic-c2 hole repair: {} defects open ({} rings{})",
+                open.len(),
+                reach.rings,
+                if reach.hessians {
+                    ", Hessians free"
+                } else {
+                    ""
+                }
+            )
+        });
         let reads: Vec<Vec<u32>> = open.par_iter().map(|l| l.reads(sys)).collect();
         // Waves: in defect order, a defect joins the wave unless it writes what a defect
         // before it (in the wave, or left for a later wave) reads, or reads what one writes.

@@ -806,7 +806,15 @@ impl System {
         let mut near_asked = false;
         // Two more passes with near-null conditions: one to find them, one to impose them.
         let passes = if near_off { 6 } else { 8 };
-        for _pass in 0..passes {
+        for pass in 0..passes {
+            crate::progress::report(|| {
+                format!(
+                    "quintic-c2 solve: pass {} ({} conditions, {} points relaxed)",
+                    pass + 1,
+                    extra.len(),
+                    level.len()
+                )
+            });
             let imposed = near_start.is_some();
             let want_near = !near_off && !imposed && !prev_failed;
             near_asked |= want_near;
@@ -937,6 +945,7 @@ impl System {
         if let Some(start) = near_start {
             extra.truncate(start);
         }
+        crate::progress::report(|| "quintic-c2 solve: every weight at once".into());
         let (value, mut stats, mut failures) =
             self.solve_pass(tets, jets, nt, target, level, true, pin, &extra, false);
         failures.retain(|f| f.stage != NEAR_NULL);
@@ -1107,6 +1116,17 @@ impl System {
             }
             let mut glist: Vec<(Vec<u32>, Vec<usize>)> = groups.into_values().collect();
             glist.sort_unstable_by_key(|g| g.0[0]);
+            crate::progress::report(|| {
+                let what = [
+                    "edge middles",
+                    "relaxed stars",
+                    "vertex stars",
+                    "far face weights",
+                    "face middles",
+                    "edge tetrahedra",
+                ][usize::from(st - 1)];
+                format!("quintic-c2 solve: {what} ({} groups)", glist.len())
+            });
             // Set up every group (serially: the targets come from a caller's closure). They read
             // only weights of earlier stages: an equation's unknowns of this stage are all in its
             // group.
