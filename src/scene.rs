@@ -648,6 +648,9 @@ pub struct BuiltScene {
     /// relaxed stars, consistency conditions, whether it fell back to solving every weight at
     /// once, the weights' signs and the hole repair.
     pub solve: Option<crate::scheme::quintic_c2::BuildStats>,
+    /// What the inner hull's builder changed on the way (`cubic-c1`, `quintic-c2`; `None`
+    /// otherwise): normals made above face, folds flipped, apexes lifted or moved by the search.
+    pub hull_report: Option<crate::hull::inner::InnerReport>,
 }
 
 /// [`build_complex`], returning the loaded mesh and the hull beside the complex
@@ -663,6 +666,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
             mesh: None,
             hull: None,
             solve: None,
+            hull_report: None,
         }),
         Model::Mesh {
             file,
@@ -726,6 +730,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                         mesh: Some(m),
                         hull: None,
                         solve: None,
+                        hull_report: None,
                     })
                 }
                 "cubic-c1" | "quintic-c2" => {
@@ -735,14 +740,16 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                     let (m, report) = mesh::load(file)?;
                     crate::hull::inner::closed::require_closed(&m, &report)?;
                     let vn = mesh::vertex_normals(&m, method)?;
-                    let (complex, hull, solve) = build_1994(ty, &m, &vn, scheme, &scene.path)
-                        .with_context(|| format!("{}", file.display()))?;
+                    let (complex, hull, solve, report) =
+                        build_1994(ty, &m, &vn, scheme, &scene.path)
+                            .with_context(|| format!("{}", file.display()))?;
                     Ok(BuiltScene {
                         complex,
                         info: None,
                         mesh: Some(m),
                         hull: Some(hull),
                         solve,
+                        hull_report: Some(report),
                     })
                 }
                 _ => bail!(
@@ -799,7 +806,8 @@ pub fn inner_hull(
 }
 
 /// Builds a `cubic-c1` or `quintic-c2` complex as the schemes' `build_from_scene` do (same
-/// options, hull, patches and errors), returning the hull the patches fill and (quintic) what its solve did beside it.
+/// options, hull, patches and errors), returning the hull the patches fill, (quintic) what its solve did and what the hull's
+/// builder changed beside it.
 fn build_1994(
     ty: &str,
     m: &mesh::Mesh,
@@ -810,22 +818,24 @@ fn build_1994(
     PatchComplex,
     crate::hull::simplicial::SimplicialHull,
     Option<crate::scheme::quintic_c2::BuildStats>,
+    crate::hull::inner::InnerReport,
 )> {
     use crate::scheme::{cubic_c1, quintic_c2};
     let at = || format!("{}", scene.display());
     crate::progress::report(|| "building the inner hull".into());
     if ty == "cubic-c1" {
         let (options, inner) = cubic_c1::options_from_toml(scheme, scene)?;
-        let hull = crate::hull::inner::build(m, vn, &inner).with_context(at)?;
+        let (hull, report) =
+            crate::hull::inner::build_with_report(m, vn, &inner).with_context(at)?;
         crate::progress::report(|| format!("cubic-c1: {} triangles of T", hull.triangles.len()));
         let (complex, hull) = cubic_on_prepared(&hull, &options).with_context(at)?;
-        Ok((complex, hull, None))
+        Ok((complex, hull, None, report))
     } else {
         let options = quintic_c2::QuinticOptions::from_toml(scheme, scene)?;
         let inner = crate::hull::inner::InnerOptions::from_toml(scheme, scene)?;
-        let hull = crate::hull::inner::build(m, vn, &inner)?;
+        let (hull, report) = crate::hull::inner::build_with_report(m, vn, &inner)?;
         let (complex, stats) = quintic_c2::build_with_stats(&hull, &options)?;
-        Ok((complex, hull, Some(stats)))
+        Ok((complex, hull, Some(stats), report))
     }
 }
 

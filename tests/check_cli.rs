@@ -425,3 +425,60 @@ fn quintic_scene_reports_its_solve() {
     let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert!(v.get("solve").is_none(), "{v}");
 }
+
+/// A 1994 scene: `check` reports what the inner hull's builder changed (`hull_steps`), the
+/// same counts as the library's `hull::inner::build_with_report` on the scene's mesh, normals
+/// and options; the text line names the nonzero ones, and a hull built without repairs (the
+/// octahedron) prints none.
+#[test]
+fn inner_hull_scene_reports_its_hull_steps() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("scenes/paper1994/torus_quad.toml");
+    let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let steps = &v["hull_steps"];
+    let loaded = apatch::scene::load(&scene).unwrap();
+    let apatch::scene::Model::Mesh {
+        file,
+        normals,
+        scheme,
+        ..
+    } = &loaded.model
+    else {
+        panic!("a mesh scene");
+    };
+    let (m, _) = apatch::mesh::load(file).unwrap();
+    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+    let options = apatch::hull::inner::InnerOptions::from_toml(scheme, &scene).unwrap();
+    let (_, r) = apatch::hull::inner::build_with_report(&m, &vn, &options).unwrap();
+    assert!(
+        r.flipped_folds > 0 && r.lifted_apexes > 0,
+        "the torus needs both"
+    );
+    assert_eq!(
+        steps["folds_flipped"].as_u64(),
+        Some(r.flipped_folds as u64),
+        "{steps}"
+    );
+    assert_eq!(
+        steps["apexes_lifted"].as_u64(),
+        Some(r.lifted_apexes as u64),
+        "{steps}"
+    );
+    assert_eq!(
+        steps["normals_above_face"].as_u64(),
+        Some(r.adjusted_normals.len() as u64)
+    );
+    let text = stdout(&apatch(&["check", scene.to_str().unwrap()]));
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("hull steps"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        line.contains(&format!("folds flipped {}", r.flipped_folds)),
+        "{line}"
+    );
+    let plain = root.join("scenes/paper1994/octahedron.toml");
+    let text = stdout(&apatch(&["check", plain.to_str().unwrap()]));
+    assert!(!text.contains("hull steps"), "{text}");
+}

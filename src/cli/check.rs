@@ -86,6 +86,7 @@ pub fn load_built(
         mesh: None,
         hull: None,
         solve: None,
+        hull_report: None,
     };
     match ext.as_str() {
         "json" => Ok((only(apatch::complex_io::read_json_file(path)?), None)),
@@ -202,6 +203,28 @@ fn hull_repairs(scene: &apatch::scene::Scene) -> anyhow::Result<HullRepairs> {
     Ok((merged.map(|c| (options.merge_close, c)), split))
 }
 
+/// What the inner hull's builder changed, by step (counts; the `hull_steps` of `--json`, the
+/// nonzero ones in the text line): its order is the builder's.
+fn hull_steps(r: &apatch::hull::inner::InnerReport) -> Vec<(&'static str, usize)> {
+    vec![
+        ("normals_above_face", r.adjusted_normals.len()),
+        ("corners_remeshed", r.remeshed.len()),
+        ("polygons_split_convex", r.split_faces.len()),
+        ("star_polygons", r.star_faces.len()),
+        ("flat_nets", r.flat_nets),
+        ("unseparable_corners", r.unseparable.len()),
+        ("degenerate_apexes_rebuilt", r.degenerate_repaired),
+        ("ring_normals_turned", r.ring_normals),
+        ("umbrella_normals", r.umbrella_normals.len()),
+        ("folds_flipped", r.flipped_folds),
+        ("apexes_wedged", r.wedged),
+        ("apexes_lifted", r.lifted_apexes),
+        ("apex_search_moves", r.reapex.moved.len()),
+        ("apex_search_overlaps_before", r.reapex.before),
+        ("apex_search_overlaps_after", r.reapex.after),
+    ]
+}
+
 /// The quintic scheme's solve in one `info` line: its size, what it relaxed or conditioned,
 /// whether it fell back to solving every weight at once, the weights off Theorem 2.1's signs
 /// (sufficient for one sheet, not necessary: the `sheets`, `j-sheets` and `holes` lines test
@@ -299,6 +322,13 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let Some(stats) = &built.solve {
             out.insert("solve".into(), serde_json::to_value(stats)?);
         }
+        if let Some(r) = &built.hull_report {
+            let steps: serde_json::Map<String, serde_json::Value> = hull_steps(r)
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v.into()))
+                .collect();
+            out.insert("hull_steps".into(), steps.into());
+        }
         if let Some((t, c)) = &merged {
             out.insert(
                 "merge_close".into(),
@@ -361,6 +391,28 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 },
                 info.refined_edges
             );
+        }
+        if let Some(r) = &built.hull_report {
+            let mut done: Vec<String> = hull_steps(r)
+                .into_iter()
+                .filter(|(k, n)| *n > 0 && !k.starts_with("apex_search"))
+                .map(|(k, n)| format!("{} {n}", k.replace('_', " ")))
+                .collect();
+            let s = &r.reapex;
+            if s.before > 0 || !s.moved.is_empty() {
+                done.push(format!(
+                    "apex search {} moves (overlapping pairs {} -> {})",
+                    s.moved.len(),
+                    s.before,
+                    s.after
+                ));
+            }
+            if !done.is_empty() {
+                println!(
+                    "hull steps       {} (the inner hull's repairs, `hull::inner::InnerReport`)  info",
+                    done.join(", ")
+                );
+            }
         }
         if let Some(stats) = &built.solve {
             println!("{}", solve_line(stats));
