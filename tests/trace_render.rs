@@ -125,15 +125,20 @@ fn every_mode_is_finite_and_covers_the_surface() {
     }
 }
 
+/// A sphere of radius `r` (an exact quadric complex) and curvature-mode settings at 1 spp.
+fn sphere_curvature(r: f64) -> (Geometry, RenderSettings) {
+    let q = Quadric::sphere(DVec3::ZERO, r);
+    let complex = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 2);
+    let (_, mut s) = setup(Mode::Curvature, 0);
+    s.spp = 1;
+    (Geometry::new(&complex).unwrap(), s)
+}
+
 #[test]
 fn curvature_mode_reports_the_sphere_curvature() {
     // A sphere of radius r: mean curvature 1/r and Gaussian 1/r² at every hit.
     let r = 0.8;
-    let q = Quadric::sphere(DVec3::ZERO, r);
-    let complex = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 2);
-    let geo = Geometry::new(&complex).unwrap();
-    let (_, mut s) = setup(Mode::Curvature, 0);
-    s.spp = 1;
+    let (geo, s) = sphere_curvature(r);
     let f = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
     for p in f.pixels.iter().filter(|p| p.alpha > 0.0) {
         // f32 storage: relative 1e-6.
@@ -161,11 +166,7 @@ fn curvature_mode_reports_the_sphere_curvature() {
 #[test]
 fn curvature_mode_with_a_fixed_range() {
     let r = 0.8;
-    let q = Quadric::sphere(DVec3::ZERO, r);
-    let complex = quadric_complex(&q, DVec3::splat(-1.0), DVec3::splat(1.0), 2, 2);
-    let geo = Geometry::new(&complex).unwrap();
-    let (_, mut s) = setup(Mode::Curvature, 0);
-    s.spp = 1;
+    let (geo, mut s) = sphere_curvature(r);
     s.options.curvature_range = Some(5.0);
     let f = trace::render(&geo, &s, &|| {}, &AtomicBool::new(false)).unwrap();
     assert_eq!(f.range, 5.0);
