@@ -806,8 +806,8 @@ pub fn inner_hull(
 }
 
 /// Builds a `cubic-c1` or `quintic-c2` complex as the schemes' `build_from_scene` do (same
-/// options, hull, patches and errors), returning the hull the patches fill, (quintic) what its solve did and what the hull's
-/// builder changed beside it.
+/// options, hull, patches and errors), returning beside it the hull the patches fill, what the
+/// hull's builder changed and (quintic) what its solve did.
 fn build_1994(
     ty: &str,
     m: &mesh::Mesh,

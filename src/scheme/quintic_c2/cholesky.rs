@@ -168,6 +168,22 @@ impl Ordering {
         self.pattern.iter().map(Vec::len).sum()
     }
 
+    /// [`Ordering::of`] when the group is within `(max rows, max factor entries)`
+    /// ([`MAX_FACTOR_ROWS`], [`MAX_FACTOR_ENTRIES`]): the rows are counted before the ordering
+    /// (which itself grows faster than them), the factor's entries after it. `None` beyond
+    /// either: a factor that does not fit in memory would end the process instead of the scene.
+    #[must_use]
+    pub fn within(
+        rows: &[Row],
+        n: usize,
+        (max_rows, max_entries): (usize, usize),
+    ) -> Option<Ordering> {
+        if rows.len() > max_rows {
+            return None;
+        }
+        Some(Ordering::of(rows, n)).filter(|o| o.entries() <= max_entries)
+    }
+
     /// The ordering for the rows' structure (`n` unknowns): rows sharing a column are
     /// neighbours, whatever their values (an entry that cancels in one solve may not in the
     /// next).

@@ -14,6 +14,19 @@ pub struct Solution {
     pub residual: f64,
 }
 
+impl Solution {
+    /// A solve that was not made (a group too large to factor): `x` as given (the targets),
+    /// rank 0 and an infinite residual, which no consistency test accepts.
+    #[must_use]
+    pub fn unsolved(x: &[f64]) -> Solution {
+        Solution {
+            x: x.to_vec(),
+            rank: 0,
+            residual: f64::INFINITY,
+        }
+    }
+}
+
 /// Householder QR with column pivoting of M = Aᵀ (A is `m`×`n`, row-major), shared by
 /// [`solve_near`] and [`dependencies`]: Πᵀ A = Rᵀ Qᵀ.
 struct PivotedQr {

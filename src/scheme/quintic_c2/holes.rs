@@ -937,7 +937,7 @@ fn solve(
     if n > super::system::DENSE_LIMIT {
         return match pinned_solves(rows, c, n, x0, sparse) {
             Some(p) => p.solve(rows, c, pins, None),
-            None => unsolved(x0),
+            None => dense::Solution::unsolved(x0),
         };
     }
     let m = rows.len() + pins.len();
@@ -993,23 +993,10 @@ fn factored(
     c: &[f64],
     n: usize,
     x0: &[f64],
-    (max_rows, max_entries): (usize, usize),
+    limits: (usize, usize),
 ) -> Option<PinnedSolves> {
-    if rows.len() > max_rows {
-        return None;
-    }
-    let ordering = cholesky::Ordering::of(rows, n);
-    (ordering.entries() <= max_entries).then(|| PinnedSolves::new(rows, c, n, x0, &ordering))
-}
-
-/// What a solve that was not made returns: the targets, with an infinite residual (which no
-/// repair accepts).
-fn unsolved(x0: &[f64]) -> dense::Solution {
-    dense::Solution {
-        x: x0.to_vec(),
-        rank: 0,
-        residual: f64::INFINITY,
-    }
+    cholesky::Ordering::within(rows, n, limits)
+        .map(|ordering| PinnedSolves::new(rows, c, n, x0, &ordering))
 }
 
 /// [`solve`] with the pins as targets weighted by `weight` ([`SOFT`] first) instead of
@@ -1028,7 +1015,7 @@ fn solve_soft(
     if n > super::system::DENSE_LIMIT {
         return match pinned_solves(rows, c, n, x0, sparse) {
             Some(p) => p.solve(rows, c, pins, Some(weight)),
-            None => unsolved(x0),
+            None => dense::Solution::unsolved(x0),
         };
     }
     let mut w = vec![1.0; n];
@@ -1185,7 +1172,7 @@ mod tests {
         let s = p.solve(&rows, &c, &[], None);
         // Unit coefficients, values up to n/2: rounding of the factor's refined solve.
         assert!(s.residual < 1e-9, "{}", s.residual);
-        let left = unsolved(&x0);
+        let left = dense::Solution::unsolved(&x0);
         assert!(left.residual.is_infinite() && left.x == x0);
     }
 }

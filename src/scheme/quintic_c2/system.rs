@@ -1675,16 +1675,11 @@ fn solve_sparse(
     c: &[f64],
     tgt: &[f64],
     tol: f64,
-    (max_rows, max_entries): (usize, usize),
+    limits: (usize, usize),
 ) -> dense::Solution {
-    let ordering = (rows.len() <= max_rows).then(|| cholesky::Ordering::of(rows, n));
-    match ordering.filter(|o| o.entries() <= max_entries) {
+    match cholesky::Ordering::within(rows, n, limits) {
         Some(ordering) => cholesky::solve_near_ordered(rows, n, c, tgt, tol, &ordering),
-        None => dense::Solution {
-            x: tgt.to_vec(),
-            rank: 0,
-            residual: f64::INFINITY,
-        },
+        None => dense::Solution::unsolved(tgt),
     }
 }
 
