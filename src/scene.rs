@@ -263,10 +263,15 @@ struct RenderSection {
 /// # Errors
 /// What is wrong with `v`.
 pub fn curvature_range(v: f64) -> Result<f64, String> {
-    if v.is_finite() && v > 0.0 && v <= f64::from(f32::MAX) && v >= f64::from(f32::MIN_POSITIVE) {
-        Ok(v)
-    } else {
+    let (lo, hi) = (f64::from(f32::MIN_POSITIVE), f64::from(f32::MAX));
+    if !(v.is_finite() && v > 0.0) {
         Err(format!("`{v}` is not a positive finite number"))
+    } else if !(lo..=hi).contains(&v) {
+        Err(format!(
+            "`{v}` is outside the range the frame's f32 curvature can hold ({lo:e} to {hi:e})"
+        ))
+    } else {
+        Ok(v)
     }
 }
 

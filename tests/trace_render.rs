@@ -200,6 +200,15 @@ fn curvature_mode_with_a_fixed_range() {
             "{bad}: {e}"
         );
     }
+    // Positive and finite but beyond f32 (the frame's curvature channel): the message says so.
+    for far in ["1e39", "1e-39"] {
+        std::fs::write(&path, sphere_scene("s.json", 8, 6, &rest(far))).unwrap();
+        let e = format!("{:#}", scene::load(&path).unwrap_err());
+        assert!(
+            e.contains("render.curvature_range") && e.contains("f32"),
+            "{far}: {e}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
