@@ -656,6 +656,9 @@ pub struct BuiltScene {
     /// What the inner hull's builder changed on the way (`cubic-c1`, `quintic-c2`; `None`
     /// otherwise): normals made above face, folds flipped, apexes lifted or moved by the search.
     pub hull_report: Option<crate::hull::inner::InnerReport>,
+    /// What the cubic scheme changed on the hull before filling it (`cubic-c1` scenes; `None`
+    /// otherwise): L-U partners, apexes moved over tangent planes, its own apex search.
+    pub cubic_steps: Option<crate::scheme::cubic_c1::PrepareSteps>,
 }
 
 /// [`build_complex`], returning the loaded mesh and the hull beside the complex
@@ -672,6 +675,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
             hull: None,
             solve: None,
             hull_report: None,
+            cubic_steps: None,
         }),
         Model::Mesh {
             file,
@@ -736,6 +740,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                         hull: None,
                         solve: None,
                         hull_report: None,
+                        cubic_steps: None,
                     })
                 }
                 "cubic-c1" | "quintic-c2" => {
@@ -745,16 +750,16 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                     let (m, report) = mesh::load(file)?;
                     crate::hull::inner::closed::require_closed(&m, &report)?;
                     let vn = mesh::vertex_normals(&m, method)?;
-                    let (complex, hull, solve, report) =
-                        build_1994(ty, &m, &vn, scheme, &scene.path)
-                            .with_context(|| format!("{}", file.display()))?;
+                    let built = build_1994(ty, &m, &vn, scheme, &scene.path)
+                        .with_context(|| format!("{}", file.display()))?;
                     Ok(BuiltScene {
-                        complex,
+                        complex: built.complex,
                         info: None,
                         mesh: Some(m),
-                        hull: Some(hull),
-                        solve,
-                        hull_report: Some(report),
+                        hull: Some(built.hull),
+                        solve: built.solve,
+                        hull_report: Some(built.report),
+                        cubic_steps: built.cubic_steps,
                     })
                 }
                 _ => bail!(
@@ -819,12 +824,7 @@ fn build_1994(
     vn: &[DVec3],
     scheme: &toml::Table,
     scene: &Path,
-) -> anyhow::Result<(
-    PatchComplex,
-    crate::hull::simplicial::SimplicialHull,
-    Option<crate::scheme::quintic_c2::BuildStats>,
-    crate::hull::inner::InnerReport,
-)> {
+) -> anyhow::Result<Built1994> {
     use crate::scheme::{cubic_c1, quintic_c2};
     let at = || format!("{}", scene.display());
     crate::progress::report(|| "building the inner hull".into());
@@ -833,15 +833,37 @@ fn build_1994(
         let (hull, report) =
             crate::hull::inner::build_with_report(m, vn, &inner).with_context(at)?;
         crate::progress::report(|| format!("cubic-c1: {} triangles of T", hull.triangles.len()));
-        let (complex, hull) = cubic_on_prepared(&hull, &options).with_context(at)?;
-        Ok((complex, hull, None, report))
+        let (complex, prepared) = cubic_on_prepared(&hull, &options).with_context(at)?;
+        let cubic_steps = Some(prepared.steps());
+        Ok(Built1994 {
+            complex,
+            hull: prepared.hull,
+            solve: None,
+            report,
+            cubic_steps,
+        })
     } else {
         let options = quintic_c2::QuinticOptions::from_toml(scheme, scene)?;
         let inner = crate::hull::inner::InnerOptions::from_toml(scheme, scene)?;
         let (hull, report) = crate::hull::inner::build_with_report(m, vn, &inner)?;
         let (complex, stats) = quintic_c2::build_with_stats(&hull, &options)?;
-        Ok((complex, hull, Some(stats), report))
+        Ok(Built1994 {
+            complex,
+            hull,
+            solve: Some(stats),
+            report,
+            cubic_steps: None,
+        })
     }
+}
+
+/// A 1994 scene's patches, the hull they fill and what each step changed ([`BuiltScene`]).
+struct Built1994 {
+    complex: PatchComplex,
+    hull: crate::hull::simplicial::SimplicialHull,
+    solve: Option<crate::scheme::quintic_c2::BuildStats>,
+    report: crate::hull::inner::InnerReport,
+    cubic_steps: Option<crate::scheme::cubic_c1::PrepareSteps>,
 }
 
 /// [`crate::scheme::cubic_c1::build`] on `hull`, returning the hull its patches fill: the
@@ -850,16 +872,16 @@ fn build_1994(
 fn cubic_on_prepared(
     hull: &crate::hull::simplicial::SimplicialHull,
     options: &crate::scheme::cubic_c1::CubicOptions,
-) -> crate::error::Result<(PatchComplex, crate::hull::simplicial::SimplicialHull)> {
+) -> crate::error::Result<(PatchComplex, crate::scheme::cubic_c1::PreparedHull)> {
     use crate::scheme::cubic_c1;
-    let prepared = cubic_c1::prepare_hull(hull, options).hull;
+    let prepared = cubic_c1::prepare_hull(hull, options);
     let once = cubic_c1::CubicOptions {
         complete_lu_pairs: false,
         contain_tangents: false,
         search_apexes: false,
         ..options.clone()
     };
-    Ok((cubic_c1::build(&prepared, &once)?, prepared))
+    Ok((cubic_c1::build(&prepared.hull, &once)?, prepared))
 }
 
 /// Reads a patch complex JSON file (as written by `apatch export patches`) with the validating
@@ -1147,6 +1169,8 @@ irradiance = 2.0
         // The premise: the changes add tetrahedra.
         assert!(!prepared.lu_completed.is_empty());
         let (complex, filled) = cubic_on_prepared(&hull, &options).unwrap();
+        assert_eq!(filled.steps(), prepared.steps());
+        let filled = filled.hull;
         assert!(same_hull(&filled, &prepared.hull));
         assert_eq!(patch_tets(&complex), hull_tets(&filled));
         assert_ne!(patch_tets(&complex), hull_tets(&hull));

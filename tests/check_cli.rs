@@ -482,3 +482,57 @@ fn inner_hull_scene_reports_its_hull_steps() {
     let text = stdout(&apatch(&["check", plain.to_str().unwrap()]));
     assert!(!text.contains("hull steps"), "{text}");
 }
+
+/// `check` reports what the cubic scheme changed on the hull before filling it
+/// (`cubic_c1::prepare_hull`: apexes moved over tangent planes, its own apex search), which the
+/// `hull steps` line (the builder's report) leaves out: the CLI's figures are the library's
+/// `prepare_hull` on the builder's hull (mpi_poly: moves and a second apex search; a scene
+/// that fails `check` otherwise, so the exit status is not asserted); a scene whose hull the
+/// scheme leaves alone prints no such line.
+#[test]
+fn cubic_scene_reports_the_schemes_apex_changes() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("scenes/pending/paper1994/mpi_poly.toml");
+    let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let steps = &v["cubic_steps"];
+    let loaded = apatch::scene::load(&scene).unwrap();
+    let apatch::scene::Model::Mesh {
+        file,
+        normals,
+        scheme,
+        ..
+    } = &loaded.model
+    else {
+        panic!("a mesh scene");
+    };
+    let (m, _) = apatch::mesh::load(file).unwrap();
+    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+    let (options, inner) = apatch::scheme::cubic_c1::options_from_toml(scheme, &scene).unwrap();
+    let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
+    let s = apatch::scheme::cubic_c1::prepare_hull(&hull, &options).steps();
+    assert!(s.tangent_moved > 0 && !s.reapex.moved.is_empty(), "{s:?}");
+    let count = |k: &str| steps[k].as_u64().map(|n| n as usize);
+    assert_eq!(count("tangent_moved"), Some(s.tangent_moved), "{steps}");
+    assert_eq!(count("tangent_stuck"), Some(s.tangent_stuck), "{steps}");
+    assert_eq!(count("lu_completed"), Some(s.lu_completed), "{steps}");
+    assert_eq!(count("apex_search_moves"), Some(s.reapex.moved.len()));
+    assert_eq!(count("apex_search_overlaps_after"), Some(s.reapex.after));
+    let text = stdout(&apatch(&["check", scene.to_str().unwrap()]));
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("cubic steps"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        line.contains(&format!(
+            "apex search {} moves (overlapping pairs {} -> {})",
+            s.reapex.moved.len(),
+            s.reapex.before,
+            s.reapex.after
+        )),
+        "{line}"
+    );
+    let plain = root.join("scenes/paper1994/octahedron.toml");
+    let text = stdout(&apatch(&["check", plain.to_str().unwrap()]));
+    assert!(!text.contains("cubic steps"), "{text}");
+}

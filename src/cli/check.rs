@@ -87,6 +87,7 @@ pub fn load_built(
         hull: None,
         solve: None,
         hull_report: None,
+        cubic_steps: None,
     };
     match ext.as_str() {
         "json" => Ok((only(apatch::complex_io::read_json_file(path)?), None)),
@@ -225,6 +226,36 @@ fn hull_steps(r: &apatch::hull::inner::InnerReport) -> Vec<(&'static str, usize)
     ]
 }
 
+/// What the cubic scheme changed on the hull before filling it
+/// (`scheme::cubic_c1::prepare_hull`), the nonzero counts in one `info` line; `None` when it
+/// changed nothing.
+fn cubic_steps_line(c: &apatch::scheme::cubic_c1::PrepareSteps) -> Option<String> {
+    let mut done: Vec<String> = [
+        ("L-U partners added", c.lu_completed),
+        ("apexes moved over tangent planes", c.tangent_moved),
+        ("apexes stuck beyond one", c.tangent_stuck),
+    ]
+    .iter()
+    .filter(|(_, n)| *n > 0)
+    .map(|(k, n)| format!("{k} {n}"))
+    .collect();
+    let s = &c.reapex;
+    if s.before > 0 || !s.moved.is_empty() {
+        done.push(format!(
+            "apex search {} moves (overlapping pairs {} -> {})",
+            s.moved.len(),
+            s.before,
+            s.after
+        ));
+    }
+    (!done.is_empty()).then(|| {
+        format!(
+            "cubic steps      {} (the cubic scheme's apex changes, `cubic_c1::prepare_hull`)  info",
+            done.join(", ")
+        )
+    })
+}
+
 /// The quintic scheme's solve in one `info` line: its size, what it relaxed or conditioned,
 /// whether it fell back to solving every weight at once, the weights off Theorem 2.1's signs
 /// (sufficient for one sheet, not necessary: the `sheets`, `j-sheets` and `holes` lines test
@@ -315,6 +346,19 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         if let Some(w) = welded {
             out.insert("weld".into(), w.into());
+        }
+        if let Some(c) = &built.cubic_steps {
+            out.insert(
+                "cubic_steps".into(),
+                serde_json::json!({
+                    "lu_completed": c.lu_completed,
+                    "tangent_moved": c.tangent_moved,
+                    "tangent_stuck": c.tangent_stuck,
+                    "apex_search_moves": c.reapex.moved.len(),
+                    "apex_search_overlaps_before": c.reapex.before,
+                    "apex_search_overlaps_after": c.reapex.after,
+                }),
+            );
         }
         if let Some(info) = &build_info {
             out.insert("mesh_build".into(), serde_json::to_value(info)?);
@@ -413,6 +457,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                     done.join(", ")
                 );
             }
+        }
+        if let Some(line) = built.cubic_steps.as_ref().and_then(cubic_steps_line) {
+            println!("{line}");
         }
         if let Some(stats) = &built.solve {
             println!("{}", solve_line(stats));

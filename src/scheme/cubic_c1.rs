@@ -160,6 +160,33 @@ pub struct PreparedHull {
     pub reapex: crate::hull::inner::reapex::Search,
 }
 
+/// What [`prepare_hull`] changed, by step (counts; the hull itself left out), for reports:
+/// `apatch check`'s `cubic steps` line.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PrepareSteps {
+    /// Triangles given a partner apex ([`sided::complete_lu_pairs`]).
+    pub lu_completed: usize,
+    /// Apexes moved to their side of the tangent planes ([`tangent::contain_tangents`]).
+    pub tangent_moved: usize,
+    /// Apexes beyond a tangent plane that could not be moved.
+    pub tangent_stuck: usize,
+    /// The second apex search's log, on the apexes these moves made overlap.
+    pub reapex: crate::hull::inner::reapex::Search,
+}
+
+impl PreparedHull {
+    /// The counts of [`PrepareSteps`].
+    #[must_use]
+    pub fn steps(&self) -> PrepareSteps {
+        PrepareSteps {
+            lu_completed: self.lu_completed.len(),
+            tangent_moved: self.tangent_moved.len(),
+            tangent_stuck: self.tangent_stuck,
+            reapex: self.reapex.clone(),
+        }
+    }
+}
+
 /// The changes the cubic scheme makes to a hull's apexes before building (as `options` ask):
 /// L-U partners for single-sided triangles not convex for their side ([`sided`]), then apexes
 /// moved to their side of their triangle's tangent planes ([`tangent`]), then, with
