@@ -437,18 +437,8 @@ fn inner_hull_scene_reports_its_hull_steps() {
     let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
     let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let steps = &v["hull_steps"];
-    let loaded = apatch::scene::load(&scene).unwrap();
-    let apatch::scene::Model::Mesh {
-        file,
-        normals,
-        scheme,
-        ..
-    } = &loaded.model
-    else {
-        panic!("a mesh scene");
-    };
-    let (m, _) = apatch::mesh::load(file).unwrap();
-    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+    let (m, vn, scheme) = scene_mesh(&scene);
+    let scheme = &scheme;
     let options = apatch::hull::inner::InnerOptions::from_toml(scheme, &scene).unwrap();
     let (_, r) = apatch::hull::inner::build_with_report(&m, &vn, &options).unwrap();
     assert!(
@@ -496,18 +486,8 @@ fn cubic_scene_reports_the_schemes_apex_changes() {
     let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
     let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let steps = &v["cubic_steps"];
-    let loaded = apatch::scene::load(&scene).unwrap();
-    let apatch::scene::Model::Mesh {
-        file,
-        normals,
-        scheme,
-        ..
-    } = &loaded.model
-    else {
-        panic!("a mesh scene");
-    };
-    let (m, _) = apatch::mesh::load(file).unwrap();
-    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+    let (m, vn, scheme) = scene_mesh(&scene);
+    let scheme = &scheme;
     let (options, inner) = apatch::scheme::cubic_c1::options_from_toml(scheme, &scene).unwrap();
     let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
     let s = apatch::scheme::cubic_c1::prepare_hull(&hull, &options).steps();
@@ -535,4 +515,21 @@ fn cubic_scene_reports_the_schemes_apex_changes() {
     let plain = root.join("scenes/paper1994/octahedron.toml");
     let text = stdout(&apatch(&["check", plain.to_str().unwrap()]));
     assert!(!text.contains("cubic steps"), "{text}");
+}
+
+/// A mesh scene's mesh, vertex normals (its `model.normals`) and `[scheme]` table.
+fn scene_mesh(scene: &Path) -> (apatch::mesh::Mesh, Vec<DVec3>, toml::Table) {
+    let loaded = apatch::scene::load(scene).unwrap();
+    let apatch::scene::Model::Mesh {
+        file,
+        normals,
+        scheme,
+        ..
+    } = &loaded.model
+    else {
+        panic!("a mesh scene");
+    };
+    let (m, _) = apatch::mesh::load(file).unwrap();
+    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+    (m, vn, scheme.clone())
 }

@@ -226,6 +226,19 @@ fn hull_steps(r: &apatch::hull::inner::InnerReport) -> Vec<(&'static str, usize)
     ]
 }
 
+/// An apex search's moves and overlapping pairs before → after, for the steps lines; `None`
+/// when it did not run or found nothing to do.
+fn apex_search_text(s: &apatch::hull::inner::reapex::Search) -> Option<String> {
+    (s.before > 0 || !s.moved.is_empty()).then(|| {
+        format!(
+            "apex search {} moves (overlapping pairs {} -> {})",
+            s.moved.len(),
+            s.before,
+            s.after
+        )
+    })
+}
+
 /// What the cubic scheme changed on the hull before filling it
 /// (`scheme::cubic_c1::prepare_hull`), the nonzero counts in one `info` line; `None` when it
 /// changed nothing.
@@ -239,15 +252,7 @@ fn cubic_steps_line(c: &apatch::scheme::cubic_c1::PrepareSteps) -> Option<String
     .filter(|(_, n)| *n > 0)
     .map(|(k, n)| format!("{k} {n}"))
     .collect();
-    let s = &c.reapex;
-    if s.before > 0 || !s.moved.is_empty() {
-        done.push(format!(
-            "apex search {} moves (overlapping pairs {} -> {})",
-            s.moved.len(),
-            s.before,
-            s.after
-        ));
-    }
+    done.extend(apex_search_text(&c.reapex));
     (!done.is_empty()).then(|| {
         format!(
             "cubic steps      {} (the cubic scheme's apex changes, `cubic_c1::prepare_hull`)  info",
@@ -442,15 +447,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 .filter(|(k, n)| *n > 0 && !k.starts_with("apex_search"))
                 .map(|(k, n)| format!("{} {n}", k.replace('_', " ")))
                 .collect();
-            let s = &r.reapex;
-            if s.before > 0 || !s.moved.is_empty() {
-                done.push(format!(
-                    "apex search {} moves (overlapping pairs {} -> {})",
-                    s.moved.len(),
-                    s.before,
-                    s.after
-                ));
-            }
+            done.extend(apex_search_text(&r.reapex));
             if !done.is_empty() {
                 println!(
                     "hull steps       {} (the inner hull's repairs, `hull::inner::InnerReport`)  info",
