@@ -213,6 +213,28 @@ pub fn render_pixel(geo: &Geometry, settings: &RenderSettings, x: u32, y: u32) -
     }
 }
 
+/// The curvature map's span when none is fixed: the 99th percentile of |curvature| (component
+/// `k`) over the covered pixels, so that a few near-singular pixels do not wash out the map;
+/// 1 when that is zero.
+fn image_curvature_range(frame: &Frame, k: usize) -> f32 {
+    let mut mags: Vec<f32> = frame
+        .pixels
+        .iter()
+        .filter(|p| p.alpha > 0.0)
+        .map(|p| p.value[k].abs())
+        .collect();
+    mags.sort_by(f32::total_cmp);
+    let range = mags
+        .get(mags.len().saturating_sub(1) * 99 / 100)
+        .copied()
+        .unwrap_or(0.0);
+    if range > 0.0 {
+        range
+    } else {
+        1.0
+    }
+}
+
 /// Applies the whole-image step of each mode.
 fn finish(frame: &mut Frame, opts: &ModeOptions) {
     let (w, h) = (frame.width as usize, frame.height as usize);
@@ -232,21 +254,11 @@ fn finish(frame: &mut Frame, opts: &ModeOptions) {
         }
         Mode::Curvature => {
             let k = usize::from(opts.gaussian);
-            let mut mags: Vec<f32> = frame
-                .pixels
-                .iter()
-                .filter(|p| p.alpha > 0.0)
-                .map(|p| p.value[k].abs())
-                .collect();
-            mags.sort_by(f32::total_cmp);
-            // The 99th percentile: a few near-singular pixels must not wash out the map.
-            let range = mags
-                .get(mags.len().saturating_sub(1) * 99 / 100)
-                .copied()
-                .unwrap_or(0.0);
-            let range = if range > 0.0 { range } else { 1.0 };
+            // A fixed range needs no look at the image.
             #[allow(clippy::cast_possible_truncation)]
-            let range = opts.curvature_range.map_or(range, |r| r as f32);
+            let range = opts
+                .curvature_range
+                .map_or_else(|| image_curvature_range(frame, k), |r| r as f32);
             for p in frame.pixels.iter_mut().filter(|p| p.alpha > 0.0) {
                 let c = shade::diverging(f64::from(p.value[k] / range));
                 p.rgb = [
