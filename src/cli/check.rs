@@ -218,6 +218,7 @@ fn hull_steps(r: &apatch::hull::inner::InnerReport) -> Vec<(&'static str, usize)
         ("ring_normals_turned", r.ring_normals),
         ("umbrella_normals", r.umbrella_normals.len()),
         ("folds_flipped", r.flipped_folds),
+        ("slits_flipped", r.flipped_slits),
         ("apexes_wedged", r.wedged),
         ("apexes_lifted", r.lifted_apexes),
         ("apex_search_moves", r.reapex.moved.len()),

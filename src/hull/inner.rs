@@ -94,6 +94,7 @@ pub mod recut;
 pub mod remesh;
 pub mod retriangulate;
 pub mod sides;
+pub mod slit;
 pub mod umbrella;
 pub mod unfold;
 pub mod unused;
@@ -331,6 +332,9 @@ pub struct InnerReport {
     /// Folded-back edges of T between pseudo-centroid pairs replaced by the other diagonal
     /// ([`unfold`]).
     pub flipped_folds: usize,
+    /// Edges of T across a slit of the polyhedron flipped to run along its bottom
+    /// ([`slit::flip_slits`]).
+    pub flipped_slits: usize,
     /// Apexes lifted over their base vertices' tangent planes ([`clearance`]).
     pub lifted_apexes: usize,
     /// Clusters of near-duplicate vertices merged into one corner of T ([`close`],
@@ -819,6 +823,7 @@ fn build_with(
     report.ring_normals = normals::flatten_ring_normals(&mut hull, options.ring_normals);
     report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
     report.umbrella_normals = umbrella::face_fans(&mut hull);
+    report.flipped_slits = slit::flip_slits(&mut hull, &mesh.positions);
     report.sides = sides::settle(&mut hull);
     report.wedged = wedge::keep_in_wedges(&mut hull);
     report.lifted_apexes = clearance::lift_apexes(&mut hull);

@@ -417,6 +417,123 @@ fn candidates(q: DVec3, p: [DVec3; 3], n: [DVec3; 3]) -> Vec<DVec3> {
     out
 }
 
+/// Height cap of [`deepest`]'s region over the base, relative to its longest edge (the
+/// construction's apexes rise 0.08 of it; [`super::sides::MAX_HEIGHT`] allows 1).
+const DEEPEST_HEIGHT: f64 = 0.5;
+
+/// Most blocking triangles whose planes bound [`deepest`]'s region (the nearest): with the
+/// eleven other half-spaces, C(23, 4) = 8855 small solves per apex.
+const DEEPEST_BLOCKERS: usize = 12;
+
+/// The point deepest inside the region an apex of triangle `t` on side slot `s` may take
+/// without leaving what the hull's nearby tetrahedra leave free (the Chebyshev centre of a
+/// polytope): on its side of the base, beyond each base vertex's tangent plane (where the
+/// other two base vertices lie strictly on one side of it), at most [`DEEPEST_HEIGHT`] over
+/// the base and within that distance of its centroid along each axis, and on the free side of
+/// each of the nearest [`DEEPEST_BLOCKERS`] triangles of `blockers` (those whose tetrahedra
+/// the apex's overlap now) that shares no point with the base and has a face tetrahedron on
+/// one side only, where the base's centroid is on that free side too. Where T is thin (the
+/// cage's upper lip over its mouth slit, 0.02 thick) the fixed moves of [`candidates`] all
+/// leave the region; this one is in it when it is not empty. `None` when it is empty or
+/// degenerate.
+fn deepest(hull: &SimplicialHull, t: usize, s: usize, blockers: &[usize]) -> Option<DVec3> {
+    let tri = hull.triangles[t];
+    let p = tri.map(|i| hull.points[i as usize]);
+    let n = tri.map(|i| hull.normals[i as usize]);
+    let nn = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
+    let up = if s == Side::Outer as usize { nn } else { -nn };
+    let g = (p[0] + p[1] + p[2]) / 3.0;
+    let len = longest_side(p);
+    // Half-spaces a · q ≤ b.
+    let mut half: Vec<(DVec3, f64)> =
+        vec![(-up, -up.dot(p[0])), (up, up.dot(g) + DEEPEST_HEIGHT * len)];
+    // Within a box round the centroid: the region is often a cone opening away from the base.
+    for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+        half.push((axis, axis.dot(g) + DEEPEST_HEIGHT * len));
+        half.push((-axis, -axis.dot(g) + DEEPEST_HEIGHT * len));
+    }
+    for k in 0..3 {
+        let v = [
+            n[k].dot(p[(k + 1) % 3] - p[k]),
+            n[k].dot(p[(k + 2) % 3] - p[k]),
+        ];
+        let tol = 1e-9 * len;
+        if v.iter().all(|&x| x > tol) {
+            half.push((n[k], n[k].dot(p[k])));
+        } else if v.iter().all(|&x| x < -tol) {
+            half.push((-n[k], -n[k].dot(p[k])));
+        }
+    }
+    // The nearest blockers only: every further half-space multiplies the centre's cost.
+    let mut near: Vec<(f64, usize)> = blockers
+        .iter()
+        .map(|&u| {
+            let c = hull.triangles[u]
+                .iter()
+                .map(|&i| hull.points[i as usize])
+                .sum::<DVec3>()
+                / 3.0;
+            ((c - g).length(), u)
+        })
+        .collect();
+    near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for &(_, u) in near.iter().take(DEEPEST_BLOCKERS) {
+        let other = hull.triangles[u];
+        if u == t || other.iter().any(|i| tri.contains(i)) {
+            continue;
+        }
+        let sides = hull.apexes[u].map(|a| a.is_some());
+        if sides[0] == sides[1] {
+            continue;
+        }
+        let q = other.map(|i| hull.points[i as usize]);
+        let Some(m) = (q[1] - q[0]).cross(q[2] - q[0]).try_normalize() else {
+            continue;
+        };
+        // Its tetrahedron's side: outer along m.
+        let occupied = if sides[0] { m } else { -m };
+        if occupied.dot(g - q[0]) >= 0.0 {
+            continue;
+        }
+        half.push((occupied, occupied.dot(q[0])));
+    }
+    chebyshev_centre(&half).map(|(c, _)| c)
+}
+
+/// The centre and radius of the largest ball inside {q : a · q ≤ b for every (a, b)} (unit a),
+/// by trying every vertex of the lifted polytope in (q, r) (few half-spaces here: a handful of
+/// planes). `None` when the region is empty or unbounded in every vertex found.
+fn chebyshev_centre(half: &[(DVec3, f64)]) -> Option<(DVec3, f64)> {
+    use glam::{DMat4, DVec4};
+    let m = half.len();
+    let row = |i: usize| DVec4::new(half[i].0.x, half[i].0.y, half[i].0.z, half[i].0.length());
+    let mut best: Option<(DVec3, f64)> = None;
+    for a in 0..m {
+        for b in a + 1..m {
+            for c in b + 1..m {
+                for d in c + 1..m {
+                    let mat = DMat4::from_cols(row(a), row(b), row(c), row(d)).transpose();
+                    if mat.determinant().abs() < 1e-14 {
+                        continue;
+                    }
+                    let x = mat.inverse() * DVec4::new(half[a].1, half[b].1, half[c].1, half[d].1);
+                    let (q, r) = (x.truncate(), x.w);
+                    if r.is_nan() || r <= 0.0 || best.is_some_and(|(_, br)| r <= br) {
+                        continue;
+                    }
+                    let inside = half
+                        .iter()
+                        .all(|&(n, h)| n.dot(q) + n.length() * r <= h + 1e-12 * (1.0 + h.abs()));
+                    if inside {
+                        best = Some((q, r));
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
 /// The hull with its edges, and which conditions a move keeps.
 struct Site<'a> {
     hull: &'a SimplicialHull,
@@ -564,8 +681,10 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
                 edges_of: &edges_of,
                 keep_slopes,
             };
+            let blockers = blockers_of(&tets, &moved);
             let cands: Vec<DVec3> = candidates(old, p, normals)
                 .into_iter()
+                .chain(deepest(hull, t, s, &blockers))
                 .filter(|&q| admissible(&site, t, s, old, q))
                 .collect();
             if cands.is_empty() {
@@ -624,6 +743,42 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
     search
 }
 
+/// The triangles of T whose tetrahedra overlap one of the tetrahedra `moved` as they are now
+/// (for an edge tetrahedron, the triangle it is glued to).
+fn blockers_of(tets: &Tets, moved: &[usize]) -> Vec<usize> {
+    let geoms: Vec<[DVec3; 4]> = moved.iter().map(|&i| tets.tets[i]).collect();
+    let near = near_of(tets, &geoms);
+    let mut out = Vec::new();
+    for (&i, g) in moved.iter().zip(&geoms) {
+        for &j in &near {
+            if moved.contains(&j) || j == i {
+                continue;
+            }
+            if pair_depth(g, tets.longest[i], &tets.tets[j], tets.longest[j]).is_some() {
+                out.push(match tets.owners[j] {
+                    Owner::Face(u, _) | Owner::Edge(u, ..) => u,
+                });
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// The tetrahedra whose boxes meet any of `geoms`' boxes.
+fn near_of(tets: &Tets, geoms: &[[DVec3; 4]]) -> Vec<usize> {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for g in geoms {
+        let (a, b) = bounds(g);
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    (0..tets.tets.len())
+        .filter(|&j| boxes_meet((lo, hi), tets.boxes[j]))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -675,6 +830,41 @@ mod tests {
             apexes,
             element: vec![0, 1, 2],
         }
+    }
+
+    /// The Chebyshev centre against closed forms: the unit cube's is its centre with radius
+    /// 1/2; the corner tetrahedron x, y, z ≥ 0, x + y + z ≤ 1 has its inscribed sphere at
+    /// (r, r, r), r = 1 / (3 + √3); crossed half-spaces leave nothing.
+    #[test]
+    fn chebyshev_centre_matches_closed_forms() {
+        let mut cube = Vec::new();
+        for a in [DVec3::X, DVec3::Y, DVec3::Z] {
+            cube.push((a, 1.0));
+            cube.push((-a, 0.0));
+        }
+        let (c, r) = chebyshev_centre(&cube).unwrap();
+        // Rounding of a 4×4 solve on unit data.
+        assert!((c - DVec3::splat(0.5)).length() < 1e-12 && (r - 0.5).abs() < 1e-12);
+        let third = DVec3::ONE.normalize();
+        let tet = vec![
+            (-DVec3::X, 0.0),
+            (-DVec3::Y, 0.0),
+            (-DVec3::Z, 0.0),
+            (third, 1.0 / 3f64.sqrt()),
+        ];
+        let (c, r) = chebyshev_centre(&tet).unwrap();
+        let want = 1.0 / (3.0 + 3f64.sqrt());
+        assert!((r - want).abs() < 1e-12, "{r} vs {want}");
+        assert!((c - DVec3::splat(want)).length() < 1e-12, "{c}");
+        let empty = vec![
+            (DVec3::X, 0.0),
+            (-DVec3::X, -1.0),
+            (DVec3::Y, 1.0),
+            (-DVec3::Y, 0.0),
+            (DVec3::Z, 1.0),
+            (-DVec3::Z, 0.0),
+        ];
+        assert!(chebyshev_centre(&empty).is_none());
     }
 
     /// `verify`'s messages other than overlaps.

@@ -178,7 +178,7 @@ pub fn apexes_over_base(
 }
 
 /// [`apexes_over_base`] along the unit direction `up` (with up · N > 0).
-fn apexes_along(
+pub(super) fn apexes_along(
     base: [DVec3; 3],
     normals: [DVec3; 3],
     required: [bool; 2],

@@ -29,20 +29,20 @@ use std::collections::HashSet;
 pub const FOLD_COS: f64 = 0.0;
 
 /// Unit normal of the triangle `tri` of `hull`, or `None` when it is degenerate.
-fn unit_normal(hull: &SimplicialHull, tri: [u32; 3]) -> Option<DVec3> {
+pub(super) fn unit_normal(hull: &SimplicialHull, tri: [u32; 3]) -> Option<DVec3> {
     let [a, b, c] = tri.map(|i| hull.points[i as usize]);
     (b - a).cross(c - a).try_normalize()
 }
 
 /// `tri` rotated so that it starts with the directed edge (a, b), with its third point.
-fn third(tri: [u32; 3], a: u32, b: u32) -> Option<u32> {
+pub(super) fn third(tri: [u32; 3], a: u32, b: u32) -> Option<u32> {
     (0..3)
         .find(|&k| tri[k] == a && tri[(k + 1) % 3] == b)
         .map(|k| tri[(k + 2) % 3])
 }
 
 /// Sides (`[outer, inner]`) the edges of `tri` ask for (Definition 3.1).
-fn required_sides(hull: &SimplicialHull, tri: [u32; 3]) -> [bool; 2] {
+pub(super) fn required_sides(hull: &SimplicialHull, tri: [u32; 3]) -> [bool; 2] {
     let mut req = [false; 2];
     for k in 0..3 {
         let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
@@ -100,7 +100,12 @@ pub fn flip_folds(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
 }
 
 /// The triangles holding the undirected edge (a, b).
-fn faces_of(incident: &[Vec<usize>], hull: &SimplicialHull, a: u32, b: u32) -> Vec<usize> {
+pub(super) fn faces_of(
+    incident: &[Vec<usize>],
+    hull: &SimplicialHull,
+    a: u32,
+    b: u32,
+) -> Vec<usize> {
     incident[a as usize]
         .iter()
         .copied()
@@ -111,7 +116,7 @@ fn faces_of(incident: &[Vec<usize>], hull: &SimplicialHull, a: u32, b: u32) -> V
 /// Over the edges of every triangle that uses one of `pts`: the smallest cosine between the
 /// normals of an edge's two triangles, the number of edges folded back (that cosine below
 /// [`FOLD_COS`]) and the number of nonconvex edges (Definition 3.1).
-fn local_quality(
+pub(super) fn local_quality(
     hull: &SimplicialHull,
     incident: &[Vec<usize>],
     pts: [u32; 2],
@@ -155,7 +160,7 @@ fn local_quality(
 }
 
 /// The vertex V of a pseudo-centroid point, if `i` is one.
-fn corner_of(hull: &SimplicialHull, positions: &[DVec3], i: u32) -> Option<DVec3> {
+pub(super) fn corner_of(hull: &SimplicialHull, positions: &[DVec3], i: u32) -> Option<DVec3> {
     match hull.origins[i as usize] {
         PointOrigin::PseudoCentroid { vertex } => positions.get(vertex as usize).copied(),
         _ => None,
@@ -163,7 +168,12 @@ fn corner_of(hull: &SimplicialHull, positions: &[DVec3], i: u32) -> Option<DVec3
 }
 
 /// Replaces triangle `t` by `new`, keeping `incident` up to date.
-fn set_triangle(hull: &mut SimplicialHull, incident: &mut [Vec<usize>], t: usize, new: [u32; 3]) {
+pub(super) fn set_triangle(
+    hull: &mut SimplicialHull,
+    incident: &mut [Vec<usize>],
+    t: usize,
+    new: [u32; 3],
+) {
     for &i in &hull.triangles[t] {
         incident[i as usize].retain(|&x| x != t);
     }
@@ -273,7 +283,7 @@ fn flip_pass(hull: &mut SimplicialHull, positions: &[DVec3], incident: &mut [Vec
 /// `pts` (where they exist; [`sides::settle`] revisits those) face tetrahedra over their bases
 /// on the sides their edges ask for (the outer side when they ask for none). `None`, changing
 /// nothing, when one of `new` has no such apexes.
-fn place_apexes(
+pub(super) fn place_apexes(
     hull: &mut SimplicialHull,
     incident: &[Vec<usize>],
     pts: [u32; 2],
