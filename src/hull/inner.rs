@@ -43,8 +43,9 @@
 //!    until their midpoints clear both triangles. (Dense triangle meshes: the paper's T_0/T_1
 //!    choice gives one-sided edges, slivers over the chord C_1C_2 and overlaps there.)
 //!    Before that, [`unfold`] flips edges of T that fold back between two pseudo-centroids
-//!    (short polyhedron edges between non-trihedral vertices), and [`umbrella`] turns the
-//!    normals of pseudo-centroids whose fan triangles stand almost edge-on to them.
+//!    (short polyhedron edges between non-trihedral vertices), [`umbrella`] turns the
+//!    normals of pseudo-centroids whose fan triangles stand almost edge-on to them, and
+//!    [`slit`] flips edges of T across a thin slit of the polyhedron to run along its bottom.
 //! 6. [`wedge`]: where T folds, apexes of step (5) triangles that lean across the plane
 //!    bisecting the fold (into the neighbour's tetrahedra) are moved the least distance back
 //!    inside their wedge, keeping tangent containment and the least height (beyond the paper;

@@ -22,7 +22,9 @@
 //! ([`candidates`]): its height over the base scaled (0.1 to 8 times), its foot pulled towards
 //! the centroid or shifted towards a base vertex or an edge midpoint, a standard height over the
 //! centroid, and, for an apex lying on base vertices' tangent planes, moves within those planes
-//! and straight off them to its side. A position is admissible when the triangle keeps what
+//! and straight off them to its side; and one position found from the hull round it: the
+//! deepest point of the region the apex may take beside the tetrahedra its own overlap
+//! ([`deepest`]; the cage's thin upper lip, where every fixed move left 32 overlaps). A position is admissible when the triangle keeps what
 //! `verify` checks of it and what the earlier steps gave it ([`admissible`]): the apex's side; a
 //! volume not below [`VOLUME_MARGIN`] × [`DEGENERATE_VOLUME`] or what it was (the edge
 //! tetrahedra's too); tangent containment at every base vertex where it held; the height over
