@@ -22,7 +22,7 @@
 use super::sides::{apexes_along, apexes_over_base};
 use super::unfold::required_sides;
 use super::unfold::{
-    corner_of, faces_of, local_quality, place_apexes, set_triangle, third, unit_normal,
+    local_quality, place_apexes, pseudo_centroid_quad, set_triangle, unit_normal, Quad,
 };
 use crate::hull::simplicial::{PointOrigin, SimplicialHull};
 use glam::DVec3;
@@ -142,27 +142,16 @@ pub fn flip_slits(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
     slits.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut flips = 0;
     for (_, [v0, v1]) in slits {
-        let [fa, fb] = faces_of(&incident, hull, v0, v1)[..] else {
-            continue;
-        };
-        let (f0, f1) = if third(hull.triangles[fa], v0, v1).is_some() {
-            (fa, fb)
-        } else {
-            (fb, fa)
-        };
-        let (Some(c), Some(d)) = (
-            third(hull.triangles[f0], v0, v1),
-            third(hull.triangles[f1], v1, v0),
-        ) else {
-            continue;
-        };
-        let (Some(vc), Some(vd)) = (corner_of(hull, positions, c), corner_of(hull, positions, d))
+        let Some(Quad {
+            f: [f0, f1],
+            c,
+            d,
+            vc,
+            vd,
+        }) = pseudo_centroid_quad(hull, &incident, positions, [v0, v1])
         else {
             continue;
         };
-        if c == d || !faces_of(&incident, hull, c, d).is_empty() {
-            continue; // the other diagonal is an edge already
-        }
         let old_tris = [hull.triangles[f0], hull.triangles[f1]];
         // Both triangles lie across the slit: each faces against one of the edge's ends.
         let across = |t: [u32; 3]| {

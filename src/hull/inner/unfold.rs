@@ -35,7 +35,7 @@ pub(super) fn unit_normal(hull: &SimplicialHull, tri: [u32; 3]) -> Option<DVec3>
 }
 
 /// `tri` rotated so that it starts with the directed edge (a, b), with its third point.
-pub(super) fn third(tri: [u32; 3], a: u32, b: u32) -> Option<u32> {
+fn third(tri: [u32; 3], a: u32, b: u32) -> Option<u32> {
     (0..3)
         .find(|&k| tri[k] == a && tri[(k + 1) % 3] == b)
         .map(|k| tri[(k + 2) % 3])
@@ -100,7 +100,7 @@ pub fn flip_folds(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
 }
 
 /// The triangles holding the undirected edge (a, b).
-pub(super) fn faces_of(
+fn faces_of(
     incident: &[Vec<usize>],
     hull: &SimplicialHull,
     a: u32,
@@ -160,11 +160,59 @@ pub(super) fn local_quality(
 }
 
 /// The vertex V of a pseudo-centroid point, if `i` is one.
-pub(super) fn corner_of(hull: &SimplicialHull, positions: &[DVec3], i: u32) -> Option<DVec3> {
+fn corner_of(hull: &SimplicialHull, positions: &[DVec3], i: u32) -> Option<DVec3> {
     match hull.origins[i as usize] {
         PointOrigin::PseudoCentroid { vertex } => positions.get(vertex as usize).copied(),
         _ => None,
     }
+}
+
+/// The quad of T round an edge whose flip would join two pseudo-centroids.
+pub(super) struct Quad {
+    /// The triangle holding the directed edge (v0, v1), then the one holding (v1, v0).
+    pub f: [usize; 2],
+    /// The third point of `f[0]` (a pseudo-centroid).
+    pub c: u32,
+    /// The third point of `f[1]` (a pseudo-centroid).
+    pub d: u32,
+    /// The polyhedron's vertex V of c.
+    pub vc: DVec3,
+    /// The polyhedron's vertex V of d.
+    pub vd: DVec3,
+}
+
+/// The quad round the edge `[v0, v1]` of T as it is now, when both its other corners are
+/// pseudo-centroids not yet joined by an edge; `None` otherwise.
+pub(super) fn pseudo_centroid_quad(
+    hull: &SimplicialHull,
+    incident: &[Vec<usize>],
+    positions: &[DVec3],
+    [v0, v1]: [u32; 2],
+) -> Option<Quad> {
+    let [fa, fb] = faces_of(incident, hull, v0, v1)[..] else {
+        return None;
+    };
+    let (f0, f1) = if third(hull.triangles[fa], v0, v1).is_some() {
+        (fa, fb)
+    } else {
+        (fb, fa)
+    };
+    let c = third(hull.triangles[f0], v0, v1)?;
+    let d = third(hull.triangles[f1], v1, v0)?;
+    let (vc, vd) = (
+        corner_of(hull, positions, c)?,
+        corner_of(hull, positions, d)?,
+    );
+    if c == d || !faces_of(incident, hull, c, d).is_empty() {
+        return None; // the other diagonal is an edge already
+    }
+    Some(Quad {
+        f: [f0, f1],
+        c,
+        d,
+        vc,
+        vd,
+    })
 }
 
 /// Replaces triangle `t` by `new`, keeping `incident` up to date.
@@ -210,28 +258,16 @@ fn flip_pass(hull: &mut SimplicialHull, positions: &[DVec3], incident: &mut [Vec
     let mut flips = 0;
     for (_, [v0, v1]) in folds {
         // The edge as it is now (earlier flips may have removed it).
-        let faces = faces_of(incident, hull, v0, v1);
-        let [fa, fb] = faces[..] else {
-            continue;
-        };
-        let (f0, f1) = if third(hull.triangles[fa], v0, v1).is_some() {
-            (fa, fb)
-        } else {
-            (fb, fa)
-        };
-        let (Some(c), Some(d)) = (
-            third(hull.triangles[f0], v0, v1),
-            third(hull.triangles[f1], v1, v0),
-        ) else {
-            continue;
-        };
-        let (Some(vc), Some(vd)) = (corner_of(hull, positions, c), corner_of(hull, positions, d))
+        let Some(Quad {
+            f: [f0, f1],
+            c,
+            d,
+            vc,
+            vd,
+        }) = pseudo_centroid_quad(hull, incident, positions, [v0, v1])
         else {
             continue;
         };
-        if c == d || !faces_of(incident, hull, c, d).is_empty() {
-            continue; // the other diagonal is an edge already
-        }
         let (Some(n0), Some(n1)) = (
             unit_normal(hull, hull.triangles[f0]),
             unit_normal(hull, hull.triangles[f1]),
