@@ -100,12 +100,7 @@ pub fn flip_folds(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
 }
 
 /// The triangles holding the undirected edge (a, b).
-fn faces_of(
-    incident: &[Vec<usize>],
-    hull: &SimplicialHull,
-    a: u32,
-    b: u32,
-) -> Vec<usize> {
+fn faces_of(incident: &[Vec<usize>], hull: &SimplicialHull, a: u32, b: u32) -> Vec<usize> {
     incident[a as usize]
         .iter()
         .copied()
