@@ -24,8 +24,9 @@
 //! centroid, and, for an apex lying on base vertices' tangent planes, moves within those planes
 //! and straight off them to its side; and one position found from the hull round it: the
 //! deepest point of the region the apex may take beside the tetrahedra its own overlap
-//! ([`deepest`]; the cage's thin upper lip, where every fixed move left 32 overlaps). A position is admissible when the triangle keeps what
-//! `verify` checks of it and what the earlier steps gave it ([`admissible`]): the apex's side; a
+//! ([`deepest`]; the cage's thin upper lip, where every fixed move left 32 overlaps). A
+//! position is admissible when the triangle keeps what `verify` checks of it and what the
+//! earlier steps gave it ([`admissible`]): the apex's side; a
 //! volume not below [`VOLUME_MARGIN`] × [`DEGENERATE_VOLUME`] or what it was (the edge
 //! tetrahedra's too); tangent containment at every base vertex where it held; the height over
 //! each base vertex's tangent plane not below [`CLEARANCE`] × the longest edge or what it was

@@ -14,10 +14,10 @@
 //! The other diagonal C_0C_0' runs along e, the slit's bottom: [C_0 C_1 C_0'] lies on C_1's
 //! wall and [C_0' C_2 C_0] on C_2's, each facing all its vertex normals, and the surface turns
 //! round the slit's bottom between them (T folds there by the slit's own angle, as the
-//! polyhedron does). [`flip_slits`] makes that flip where the old triangles face against a
-//! vertex normal and the new ones face all of theirs, with the new edge not nonconvex
-//! (Definition 3.1, Lemma 4.1; the pseudo-centroids are moved towards V for it as
-//! [`super::unfold`] does) and face tetrahedra over both new bases.
+//! polyhedron does). [`flip_slits`] makes that flip where both old triangles face against one
+//! of the edge's end normals and the new ones face all of theirs, with no edge round the
+//! pseudo-centroids turned nonconvex (Definition 3.1, Lemma 4.1; they may move along their cut
+//! line for it, `cuts`) and face tetrahedra on both new bases (`slit_apexes`).
 
 use super::sides::{apexes_along, apexes_over_base};
 use super::unfold::required_sides;
@@ -62,9 +62,9 @@ fn facing_all(hull: &SimplicialHull, tris: &[[u32; 3]]) -> bool {
 /// Moves tried for the pseudo-centroids at the new edge's ends, C_0 = V + λ (C_0 − V), nearest
 /// to where they are first. Across a slit's bottom the new edge is almost perpendicular to
 /// both end normals (the cage's P_102P_104: a = 0.0036, b = −0.0005), so its class turns on
-/// a few thousandths of the edge's length: λ in eighths from 1/4 to 3/2 (a deeper cut than the
-/// corner's own moves C_0 further from V along the same line, still between V and V̄ for
-/// α ≤ 2/3).
+/// a few thousandths of the edge's length: λ in eighths from 1/4 to 3/2 (λ > 1 cuts deeper,
+/// along the same line; C_0 stays between V and V̄ while λ (1 − α) ≤ 1, for every λ here when
+/// α ≥ 1/3).
 fn cuts() -> Vec<(f64, f64)> {
     let steps: Vec<f64> = (2..=12).map(|k| f64::from(k) / 8.0).collect();
     let mut pairs: Vec<(f64, f64)> = steps
