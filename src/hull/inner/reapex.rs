@@ -870,6 +870,50 @@ mod tests {
         assert!(chebyshev_centre(&empty).is_none());
     }
 
+    /// [`deepest`] on a base triangle in z = 0 (normals +z, so no tangent plane bounds it)
+    /// under a one-sided blocking triangle in z = 0.2 whose tetrahedron lies above it: the
+    /// region is the slab 0 < z < 0.2 inside the box, and its deepest point lies halfway up.
+    /// A blocker with tetrahedra on both sides, or sharing a point with the base, is ignored
+    /// (the slab's cap is then the height cap, 0.5 of the base's longest edge √2).
+    #[test]
+    fn deepest_point_lies_halfway_under_a_blocker() {
+        let points = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::new(-1.0, -1.0, 0.2),
+            DVec3::new(2.0, -1.0, 0.2),
+            DVec3::new(-1.0, 2.0, 0.2),
+        ];
+        let mut hull = SimplicialHull {
+            normals: vec![DVec3::Z; points.len()],
+            origins: vec![PointOrigin::Other; points.len()],
+            points,
+            triangles: vec![[0, 1, 2], [3, 4, 5]],
+            apexes: vec![
+                [Some(DVec3::new(0.3, 0.3, 0.5)), None],
+                [Some(DVec3::new(0.0, 0.0, 0.5)), None],
+            ],
+            element: vec![0, 1],
+        };
+        let q = deepest(&hull, 0, 0, &[1]).expect("the slab is not empty");
+        // Rounding of the 4×4 solves on data of size 1.
+        assert!((q.z - 0.1).abs() < 1e-12, "{q}");
+        let g = DVec3::new(1.0 / 3.0, 1.0 / 3.0, 0.0);
+        let reach = 0.5 * 2f64.sqrt() - 0.1;
+        assert!((q.x - g.x).abs() <= reach + 1e-12 && (q.y - g.y).abs() <= reach + 1e-12);
+        // Not blocking: two-sided.
+        hull.apexes[1][1] = Some(DVec3::new(0.0, 0.0, -0.5));
+        let q = deepest(&hull, 0, 0, &[1]).unwrap();
+        let cap = 0.5 * 2f64.sqrt();
+        assert!((q.z - 0.5 * cap).abs() < 1e-12, "{q}");
+        // Not blocking: shares a point with the base.
+        hull.apexes[1][1] = None;
+        hull.triangles[1] = [0, 4, 5];
+        let q = deepest(&hull, 0, 0, &[1]).unwrap();
+        assert!((q.z - 0.5 * cap).abs() < 1e-12, "{q}");
+    }
+
     /// `verify`'s messages other than overlaps.
     fn others(hull: &SimplicialHull) -> Vec<String> {
         verify(hull)
