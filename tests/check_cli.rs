@@ -459,6 +459,12 @@ fn inner_hull_scene_reports_its_hull_steps() {
         steps["normals_above_face"].as_u64(),
         Some(r.adjusted_normals.len() as u64)
     );
+    // Every step has its key, including those that did nothing here (the torus has no slit).
+    assert_eq!(
+        steps["slits_flipped"].as_u64(),
+        Some(r.flipped_slits as u64),
+        "{steps}"
+    );
     let text = stdout(&apatch(&["check", scene.to_str().unwrap()]));
     let line = text
         .lines()
