@@ -21,9 +21,7 @@
 
 use super::sides::{apexes_along, apexes_over_base};
 use super::unfold::required_sides;
-use super::unfold::{
-    local_quality, place_apexes, pseudo_centroid_quad, set_triangle, unit_normal, Quad,
-};
+use super::unfold::{incidence, local_quality, place_apexes, pseudo_centroid_quad, unit_normal};
 use crate::hull::simplicial::{PointOrigin, SimplicialHull};
 use glam::DVec3;
 
@@ -122,12 +120,7 @@ pub fn flip_slits(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
     let Ok(edges) = hull.edges() else {
         return 0;
     };
-    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); hull.points.len()];
-    for (t, tri) in hull.triangles.iter().enumerate() {
-        for &i in tri {
-            incident[i as usize].push(t);
-        }
-    }
+    let mut incident = incidence(hull);
     // Candidates, most opposed end normals first.
     let mut slits: Vec<(f64, [u32; 2])> = edges
         .iter()
@@ -142,16 +135,10 @@ pub fn flip_slits(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
     slits.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut flips = 0;
     for (_, [v0, v1]) in slits {
-        let Some(Quad {
-            f: [f0, f1],
-            c,
-            d,
-            vc,
-            vd,
-        }) = pseudo_centroid_quad(hull, &incident, positions, [v0, v1])
-        else {
+        let Some(quad) = pseudo_centroid_quad(hull, &incident, positions, [v0, v1]) else {
             continue;
         };
+        let ([f0, f1], c, d) = (quad.f, quad.c, quad.d);
         let old_tris = [hull.triangles[f0], hull.triangles[f1]];
         // Both triangles lie across the slit: each faces against one of the edge's ends.
         let across = |t: [u32; 3]| {
@@ -176,46 +163,31 @@ pub fn flip_slits(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
             ts.iter().map(|&t| hull.triangles[t]).collect()
         };
         let before_against = against(hull, &around(hull, &incident));
-        let old = (hull.points[c as usize], hull.points[d as usize]);
-        // The quad runs v1, c, v0, d; the new triangles share the diagonal (c, d).
-        let new_tris = [[c, v0, d], [d, v1, c]];
-        set_triangle(hull, &mut incident, f0, new_tris[0]);
-        set_triangle(hull, &mut incident, f1, new_tris[1]);
-        let mut done = false;
-        for (lc, ld) in cuts() {
-            hull.points[c as usize] = vc + lc * (old.0 - vc);
-            hull.points[d as usize] = vd + ld * (old.1 - vd);
-            let (_, _, bad) = local_quality(hull, &incident, [c, d]);
+        let flipped = quad.try_flip(hull, &mut incident, cuts(), |hull, incident| {
+            let new_tris = [hull.triangles[f0], hull.triangles[f1]];
+            let (_, _, bad) = local_quality(hull, incident, [c, d]);
             // No new nonconvex edge (Lemma 4.1), every new triangle facing all its normals,
             // and no triangle round c or d turned against one of its normals by the move.
             if bad > before_bad
                 || !facing_all(hull, &new_tris)
-                || against(hull, &around(hull, &incident)) > before_against
+                || against(hull, &around(hull, incident)) > before_against
             {
-                continue;
+                return false;
             }
             let Some(new_apexes) = new_tris
                 .iter()
                 .map(|&t| slit_apexes(hull, t))
                 .collect::<Option<Vec<_>>>()
             else {
-                continue;
+                return false;
             };
             hull.apexes[f0] = new_apexes[0];
             hull.apexes[f1] = new_apexes[1];
             // Every other triangle at c or d gets apexes over its moved base where it can.
-            let _ = place_apexes(hull, &incident, [c, d], [usize::MAX; 2]);
-            done = true;
-            break;
-        }
-        if done {
-            flips += 1;
-        } else {
-            hull.points[c as usize] = old.0;
-            hull.points[d as usize] = old.1;
-            set_triangle(hull, &mut incident, f0, old_tris[0]);
-            set_triangle(hull, &mut incident, f1, old_tris[1]);
-        }
+            let _ = place_apexes(hull, incident, [c, d], [usize::MAX; 2]);
+            true
+        });
+        flips += usize::from(flipped);
     }
     flips
 }

@@ -78,14 +78,7 @@ pub const CUTS: [(f64, f64); 9] = [
 /// first, in passes until one flips nothing. `positions` are the polyhedron's vertices (the V
 /// of every pseudo-centroid). Returns the number of flips.
 pub fn flip_folds(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
-    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); hull.points.len()];
-    for (t, tri) in hull.triangles.iter().enumerate() {
-        for &i in tri {
-            if let Some(list) = incident.get_mut(i as usize) {
-                list.push(t);
-            }
-        }
-    }
+    let mut incident = incidence(hull);
     let mut flips = 0;
     // Each flip lowers the folds round its quad, so passes end; the bound only guards against
     // cycling through equal folds.
@@ -97,6 +90,19 @@ pub fn flip_folds(hull: &mut SimplicialHull, positions: &[DVec3]) -> usize {
         }
     }
     flips
+}
+
+/// For each point of T, the triangles that use it.
+pub(super) fn incidence(hull: &SimplicialHull) -> Vec<Vec<usize>> {
+    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); hull.points.len()];
+    for (t, tri) in hull.triangles.iter().enumerate() {
+        for &i in tri {
+            if let Some(list) = incident.get_mut(i as usize) {
+                list.push(t);
+            }
+        }
+    }
+    incident
 }
 
 /// The triangles holding the undirected edge (a, b).
@@ -163,7 +169,10 @@ fn corner_of(hull: &SimplicialHull, positions: &[DVec3], i: u32) -> Option<DVec3
 }
 
 /// The quad of T round an edge whose flip would join two pseudo-centroids.
+#[derive(Clone, Copy, Debug)]
 pub(super) struct Quad {
+    /// The edge's points (v0, v1).
+    pub v: [u32; 2],
     /// The triangle holding the directed edge (v0, v1), then the one holding (v1, v0).
     pub f: [usize; 2],
     /// The third point of `f[0]` (a pseudo-centroid).
@@ -202,6 +211,7 @@ pub(super) fn pseudo_centroid_quad(
         return None; // the other diagonal is an edge already
     }
     Some(Quad {
+        v: [v0, v1],
         f: [f0, f1],
         c,
         d,
@@ -210,13 +220,52 @@ pub(super) fn pseudo_centroid_quad(
     })
 }
 
+impl Quad {
+    /// Flips the quad's diagonal to (c, d) and moves c and d along their cut lines, C_0 = V +
+    /// λ (C_0 − V) for each (λ_c, λ_d) of `cuts` in order, until `accept` takes the hull as it
+    /// then is (placing apexes as it needs). Where none is taken, the points and triangles are
+    /// put back as they were. Returns whether the flip was made.
+    pub(super) fn try_flip(
+        &self,
+        hull: &mut SimplicialHull,
+        incident: &mut [Vec<usize>],
+        cuts: impl IntoIterator<Item = (f64, f64)>,
+        mut accept: impl FnMut(&mut SimplicialHull, &[Vec<usize>]) -> bool,
+    ) -> bool {
+        let Quad {
+            v: [v0, v1],
+            f: [f0, f1],
+            c,
+            d,
+            vc,
+            vd,
+        } = *self;
+        let old = (
+            hull.points[c as usize],
+            hull.points[d as usize],
+            hull.triangles[f0],
+            hull.triangles[f1],
+        );
+        // The quad runs v1, c, v0, d; the new triangles share the diagonal (c, d).
+        set_triangle(hull, incident, f0, [c, v0, d]);
+        set_triangle(hull, incident, f1, [d, v1, c]);
+        for (lc, ld) in cuts {
+            hull.points[c as usize] = vc + lc * (old.0 - vc);
+            hull.points[d as usize] = vd + ld * (old.1 - vd);
+            if accept(hull, incident) {
+                return true;
+            }
+        }
+        hull.points[c as usize] = old.0;
+        hull.points[d as usize] = old.1;
+        set_triangle(hull, incident, f0, old.2);
+        set_triangle(hull, incident, f1, old.3);
+        false
+    }
+}
+
 /// Replaces triangle `t` by `new`, keeping `incident` up to date.
-pub(super) fn set_triangle(
-    hull: &mut SimplicialHull,
-    incident: &mut [Vec<usize>],
-    t: usize,
-    new: [u32; 3],
-) {
+fn set_triangle(hull: &mut SimplicialHull, incident: &mut [Vec<usize>], t: usize, new: [u32; 3]) {
     for &i in &hull.triangles[t] {
         incident[i as usize].retain(|&x| x != t);
     }
@@ -253,16 +302,10 @@ fn flip_pass(hull: &mut SimplicialHull, positions: &[DVec3], incident: &mut [Vec
     let mut flips = 0;
     for (_, [v0, v1]) in folds {
         // The edge as it is now (earlier flips may have removed it).
-        let Some(Quad {
-            f: [f0, f1],
-            c,
-            d,
-            vc,
-            vd,
-        }) = pseudo_centroid_quad(hull, incident, positions, [v0, v1])
-        else {
+        let Some(quad) = pseudo_centroid_quad(hull, incident, positions, [v0, v1]) else {
             continue;
         };
+        let [f0, f1] = quad.f;
         let (Some(n0), Some(n1)) = (
             unit_normal(hull, hull.triangles[f0]),
             unit_normal(hull, hull.triangles[f1]),
@@ -272,40 +315,16 @@ fn flip_pass(hull: &mut SimplicialHull, positions: &[DVec3], incident: &mut [Vec
         if n0.dot(n1) >= FOLD_COS {
             continue;
         }
+        let (c, d) = (quad.c, quad.d);
         let (before_worst, before_folded, before_bad) = local_quality(hull, incident, [c, d]);
-        let old = (
-            hull.points[c as usize],
-            hull.points[d as usize],
-            hull.triangles[f0],
-            hull.triangles[f1],
-        );
-        // The quad runs v1, c, v0, d; the new triangles share the diagonal (c, d).
-        set_triangle(hull, incident, f0, [c, v0, d]);
-        set_triangle(hull, incident, f1, [d, v1, c]);
-        let mut done = false;
-        for (lc, ld) in CUTS {
-            hull.points[c as usize] = vc + lc * (old.0 - vc);
-            hull.points[d as usize] = vd + ld * (old.1 - vd);
+        let flipped = quad.try_flip(hull, incident, CUTS, |hull, incident| {
             let (worst, folded, bad) = local_quality(hull, incident, [c, d]);
             // No new nonconvex edge (Lemma 4.1); fewer folds round c and d, or as many and
             // the worst one milder.
             let better = folded < before_folded || folded == before_folded && worst > before_worst;
-            if bad > before_bad || !better {
-                continue;
-            }
-            if let Some(()) = place_apexes(hull, incident, [c, d], [f0, f1]) {
-                done = true;
-                break;
-            }
-        }
-        if done {
-            flips += 1;
-        } else {
-            hull.points[c as usize] = old.0;
-            hull.points[d as usize] = old.1;
-            set_triangle(hull, incident, f0, old.2);
-            set_triangle(hull, incident, f1, old.3);
-        }
+            bad <= before_bad && better && place_apexes(hull, incident, [c, d], [f0, f1]).is_some()
+        });
+        flips += usize::from(flipped);
     }
     flips
 }
