@@ -703,15 +703,7 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
                         .collect()
                 })
                 .collect();
-            let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-            for g in geoms.iter().flatten() {
-                let (a, b) = bounds(g);
-                lo = lo.min(a);
-                hi = hi.max(b);
-            }
-            let near: Vec<usize> = (0..tets.tets.len())
-                .filter(|&j| boxes_meet((lo, hi), tets.boxes[j]))
-                .collect();
+            let near = near_of(&tets, geoms.iter().flatten());
             let current = local_score(hull, &tets, &moved, &geoms[0], &near);
             if current.is_clean() {
                 continue;
@@ -754,7 +746,7 @@ fn blockers_of(tets: &Tets, moved: &[usize]) -> Vec<usize> {
     let mut out = Vec::new();
     for (&i, g) in moved.iter().zip(&geoms) {
         for &j in &near {
-            if moved.contains(&j) || j == i {
+            if moved.contains(&j) {
                 continue;
             }
             if pair_depth(g, tets.longest[i], &tets.tets[j], tets.longest[j]).is_some() {
@@ -769,8 +761,8 @@ fn blockers_of(tets: &Tets, moved: &[usize]) -> Vec<usize> {
     out
 }
 
-/// The tetrahedra whose boxes meet any of `geoms`' boxes.
-fn near_of(tets: &Tets, geoms: &[[DVec3; 4]]) -> Vec<usize> {
+/// The tetrahedra whose boxes meet the box round all of `geoms`.
+fn near_of<'a>(tets: &Tets, geoms: impl IntoIterator<Item = &'a [DVec3; 4]>) -> Vec<usize> {
     let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for g in geoms {
         let (a, b) = bounds(g);
