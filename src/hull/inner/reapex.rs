@@ -24,7 +24,9 @@
 //! centroid, and, for an apex lying on base vertices' tangent planes, moves within those planes
 //! and straight off them to its side; and one position found from the hull round it: the
 //! deepest point of the region the apex may take beside the tetrahedra its own overlap
-//! ([`deepest`]; the cage's thin upper lip, where every fixed move left 32 overlaps). A
+//! ([`deepest`]; the cage's thin upper lip, where every fixed move left 32 overlaps), and, at a
+//! sharp ridge of T whose two apexes lie more than a half turn apart round the edge, the
+//! deepest points beyond [`ridge_halves`] (mpi_poly's rims of T). A
 //! position is admissible when the triangle keeps what `verify` checks of it and what the
 //! earlier steps gave it ([`admissible`]): the apex's side; a
 //! volume not below [`VOLUME_MARGIN`] × [`DEGENERATE_VOLUME`] or what it was (the edge
@@ -431,7 +433,9 @@ const DEEPEST_BLOCKERS: usize = 12;
 /// The point deepest inside the region an apex of triangle `t` on side slot `s` may take
 /// without leaving what the hull's nearby tetrahedra leave free (the Chebyshev centre of a
 /// polytope): on its side of the base, beyond each base vertex's tangent plane (where the
-/// other two base vertices lie strictly on one side of it), at most [`DEEPEST_HEIGHT`] over
+/// other two base vertices lie strictly on one side of it) and clear of it as [`admissible`]
+/// asks ([`clearance_halves`]; without them the point found at mpi_poly's 150° rim lay below a
+/// tangent plane and was refused), within `extra`, at most [`DEEPEST_HEIGHT`] over
 /// the base and within that distance of its centroid along each axis, and on the free side of
 /// each of the nearest [`DEEPEST_BLOCKERS`] triangles of `blockers` (those whose tetrahedra
 /// the apex's overlap now) that shares no point with the base and has a face tetrahedron on
@@ -439,7 +443,13 @@ const DEEPEST_BLOCKERS: usize = 12;
 /// cage's upper lip over its mouth slit, 0.02 thick) the fixed moves of [`candidates`] all
 /// leave the region; this one is in it when it is not empty. `None` when it is empty or
 /// degenerate.
-fn deepest(hull: &SimplicialHull, t: usize, s: usize, blockers: &[usize]) -> Option<DVec3> {
+fn deepest(
+    hull: &SimplicialHull,
+    t: usize,
+    s: usize,
+    blockers: &[usize],
+    extra: &[(DVec3, f64)],
+) -> Option<DVec3> {
     let tri = hull.triangles[t];
     let p = tri.map(|i| hull.points[i as usize]);
     let n = tri.map(|i| hull.normals[i as usize]);
@@ -500,7 +510,123 @@ fn deepest(hull: &SimplicialHull, t: usize, s: usize, blockers: &[usize]) -> Opt
         }
         half.push((occupied, occupied.dot(q[0])));
     }
+    half.extend(clearance_halves(hull, t, s));
+    half.extend_from_slice(extra);
     chebyshev_centre(&half).map(|(c, _)| c)
+}
+
+/// Angle (radians, 5°) by which [`ridge_halves`] asks an apex to clear its limit round the
+/// edge: enough that the edge tetrahedra between the two apexes keep a volume (at the limit
+/// they are flat), small beside the 70–75° each apex must rise at mpi_poly's 147–150° folds.
+const RIDGE_MARGIN: f64 = 0.087;
+
+/// Where T folds into a sharp ridge on side slot `s` at an edge of triangle `t` (the side's
+/// opening Φ round the edge more than a half turn), the apexes q of `t` and q' of the
+/// neighbour must be less than a half turn apart round the edge, measured through that side,
+/// or the edge tetrahedra [p_i p_j q s'] (s' their midpoint) reach through the other side of T
+/// (mpi_poly's two rims of T, 147° and 150° folds, whose low apexes over guard-net triangles
+/// left 14 overlaps). For every such edge whose pair is (within [`RIDGE_MARGIN`]) that far
+/// apart now, the half-space of positions whose angle from `t`'s plane is at least β +
+/// [`RIDGE_MARGIN`]: with `alone`, β = angle(q') − π, so that q alone clears it; otherwise
+/// β = min((Φ − π)/2, angle(q') − π), its half of the excess, for when q' moves too. As
+/// half-spaces a · q ≤ b, for [`deepest`].
+fn ridge_halves(site: &Site, t: usize, s: usize, alone: bool) -> Vec<(DVec3, f64)> {
+    let hull = site.hull;
+    let tri = hull.triangles[t];
+    let p = tri.map(|i| hull.points[i as usize]);
+    let (Some(q), Some(nn)) = (
+        hull.apexes[t][s],
+        (p[1] - p[0]).cross(p[2] - p[0]).try_normalize(),
+    ) else {
+        return Vec::new();
+    };
+    let up = if s == Side::Outer as usize { nn } else { -nn };
+    let mut out = Vec::new();
+    for &e in &site.edges_of[t] {
+        let edge = &site.edges[e];
+        let u = if edge.faces[0] as usize == t {
+            edge.faces[1]
+        } else {
+            edge.faces[0]
+        };
+        if u == u32::MAX {
+            continue;
+        }
+        let Some(qu) = hull.apexes[u as usize][s] else {
+            continue;
+        };
+        let [pi, pj] = edge.v.map(|i| hull.points[i as usize]);
+        let Some(dir) = (pj - pi).try_normalize() else {
+            continue;
+        };
+        let third = |tr: [u32; 3]| {
+            tr.iter()
+                .find(|&&i| i != edge.v[0] && i != edge.v[1])
+                .map(|&i| hull.points[i as usize])
+        };
+        let (Some(ot), Some(ou)) = (third(tri), third(hull.triangles[u as usize])) else {
+            continue;
+        };
+        let perp = |v: DVec3| v - v.dot(dir) * dir;
+        let Some(x) = perp(ot - pi).try_normalize() else {
+            continue;
+        };
+        let y = up - up.dot(dir) * dir;
+        let angle = |v: DVec3| {
+            let a = perp(v - pi);
+            let r = a.dot(y).atan2(a.dot(x));
+            if r < 0.0 {
+                r + std::f64::consts::TAU
+            } else {
+                r
+            }
+        };
+        let phi = angle(ou);
+        let pi_ = std::f64::consts::PI;
+        if phi <= pi_ {
+            continue;
+        }
+        let (at, au) = (angle(q), angle(qu));
+        if au - at < pi_ - RIDGE_MARGIN {
+            continue;
+        }
+        let beta = if alone {
+            au - pi_
+        } else {
+            (0.5 * (phi - pi_)).min(au - pi_)
+        }
+        .max(0.0)
+            + RIDGE_MARGIN;
+        // Apexes at angles in [β, β + π]: a · (q − p_i) ≥ 0.
+        let a = -beta.sin() * x + beta.cos() * y;
+        out.push((-a, -a.dot(pi)));
+    }
+    out
+}
+
+/// The clearance [`admissible`] asks of a moved apex of triangle `t` on side slot `s`, as
+/// half-spaces a · q ≤ b: over each base vertex's tangent plane (on the side the normals agree
+/// with) by at least [`CLEARANCE`] × the longest edge, or what the apex has now.
+fn clearance_halves(hull: &SimplicialHull, t: usize, s: usize) -> Vec<(DVec3, f64)> {
+    let tri = hull.triangles[t];
+    let p = tri.map(|i| hull.points[i as usize]);
+    let n = tri.map(|i| hull.normals[i as usize]);
+    let (Some(old), Some(nn)) = (
+        hull.apexes[t][s],
+        (p[1] - p[0]).cross(p[2] - p[0]).try_normalize(),
+    ) else {
+        return Vec::new();
+    };
+    let up = if s == Side::Outer as usize { nn } else { -nn };
+    let side = up.dot(n[0] + n[1] + n[2]).signum();
+    let len = longest_side(p);
+    (0..3)
+        .map(|k| {
+            let a = side * n[k];
+            let need = a.dot(old - p[k]).min(CLEARANCE * len);
+            (-a, -a.dot(p[k]) - need)
+        })
+        .collect()
 }
 
 /// The centre and radius of the largest ball inside {q : a · q ≤ b for every (a, b)} (unit a),
@@ -687,7 +813,18 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
             let blockers = blockers_of(&tets, &moved);
             let cands: Vec<DVec3> = candidates(old, p, normals)
                 .into_iter()
-                .chain(deepest(hull, t, s, &blockers))
+                .chain(deepest(
+                    hull,
+                    t,
+                    s,
+                    &blockers,
+                    &ridge_halves(&site, t, s, false),
+                ))
+                .chain(
+                    Some(ridge_halves(&site, t, s, true))
+                        .filter(|h| !h.is_empty())
+                        .and_then(|h| deepest(hull, t, s, &blockers, &h)),
+                )
                 .filter(|&q| admissible(&site, t, s, old, q))
                 .collect();
             if cands.is_empty() {
@@ -862,11 +999,12 @@ mod tests {
         assert!(chebyshev_centre(&empty).is_none());
     }
 
-    /// [`deepest`] on a base triangle in z = 0 (normals +z, so no tangent plane bounds it)
-    /// under a one-sided blocking triangle in z = 0.2 whose tetrahedron lies above it: the
-    /// region is the slab 0 < z < 0.2 inside the box, and its deepest point lies halfway up.
-    /// A blocker with tetrahedra on both sides, or sharing a point with the base, is ignored
-    /// (the slab's cap is then the height cap, 0.5 of the base's longest edge √2).
+    /// [`deepest`] on a base triangle in z = 0 (normals +z: its tangent planes are the base's,
+    /// so they bound the region only through the clearance, z ≥ [`CLEARANCE`] × √2, the base's
+    /// longest edge) under a one-sided blocking triangle in z = 0.2 whose tetrahedron lies
+    /// above it: the region is the slab between the clearance and 0.2 inside the box, and its
+    /// deepest point lies halfway up. A blocker with tetrahedra on both sides, or sharing a
+    /// point with the base, is ignored (the slab's cap is then the height cap, 0.5 of √2).
     #[test]
     fn deepest_point_lies_halfway_under_a_blocker() {
         let points = vec![
@@ -888,22 +1026,24 @@ mod tests {
             ],
             element: vec![0, 1],
         };
-        let q = deepest(&hull, 0, 0, &[1]).expect("the slab is not empty");
+        let q = deepest(&hull, 0, 0, &[1], &[]).expect("the slab is not empty");
+        let floor = CLEARANCE * 2f64.sqrt();
+        let mid = 0.5 * (floor + 0.2);
         // Rounding of the 4×4 solves on data of size 1.
-        assert!((q.z - 0.1).abs() < 1e-12, "{q}");
+        assert!((q.z - mid).abs() < 1e-12, "{q}");
         let g = DVec3::new(1.0 / 3.0, 1.0 / 3.0, 0.0);
-        let reach = 0.5 * 2f64.sqrt() - 0.1;
+        let reach = 0.5 * 2f64.sqrt() - (mid - floor);
         assert!((q.x - g.x).abs() <= reach + 1e-12 && (q.y - g.y).abs() <= reach + 1e-12);
         // Not blocking: two-sided.
         hull.apexes[1][1] = Some(DVec3::new(0.0, 0.0, -0.5));
-        let q = deepest(&hull, 0, 0, &[1]).unwrap();
+        let q = deepest(&hull, 0, 0, &[1], &[]).unwrap();
         let cap = 0.5 * 2f64.sqrt();
-        assert!((q.z - 0.5 * cap).abs() < 1e-12, "{q}");
+        assert!((q.z - 0.5 * (floor + cap)).abs() < 1e-12, "{q}");
         // Not blocking: shares a point with the base.
         hull.apexes[1][1] = None;
         hull.triangles[1] = [0, 4, 5];
-        let q = deepest(&hull, 0, 0, &[1]).unwrap();
-        assert!((q.z - 0.5 * cap).abs() < 1e-12, "{q}");
+        let q = deepest(&hull, 0, 0, &[1], &[]).unwrap();
+        assert!((q.z - 0.5 * (floor + cap)).abs() < 1e-12, "{q}");
     }
 
     /// `verify`'s messages other than overlaps.
@@ -1009,6 +1149,66 @@ mod tests {
         assert!(signed(&hull));
         assert_eq!(overlaps(&hull), 0);
         // T is open here: verify names its boundary edges, the same before and after.
+        assert_eq!(others(&hull), others(&before));
+    }
+
+    /// A sharp ridge of T (two triangles folded by 150° at the edge on the x axis, the
+    /// outer side's opening Φ = 330° round it) with low outer apexes over the centroids, 8.5°
+    /// above each triangle as seen from the edge: the apexes lie 313° apart round the edge
+    /// through the outer side, so the edge tetrahedra [p_i p_j q s] reach through the inner
+    /// side (mpi_poly's rims of T). The search, with the ridge half-spaces, moves them until
+    /// they are less than a half turn apart (their angles round the edge, recomputed here from
+    /// the coordinates), and `verify` counts no
+    /// overlap (its other findings, the tangent planes of the edge's ends, which the low
+    /// apexes miss, and T's open edges, are what they were).
+    #[test]
+    fn sharp_ridge_apexes_end_less_than_a_half_turn_apart() {
+        let (c, s) = (330f64.to_radians().cos(), 330f64.to_radians().sin());
+        let points = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 1.0, 0.0),
+            DVec3::new(0.5, c, s),
+        ];
+        let triangles = [[0usize, 1, 2], [1, 0, 3]];
+        let tri_normal = |t: [usize; 3]| {
+            (points[t[1]] - points[t[0]])
+                .cross(points[t[2]] - points[t[0]])
+                .normalize()
+        };
+        let (a, b) = (tri_normal(triangles[0]), tri_normal(triangles[1]));
+        let normals = vec![(a + b).normalize(), (a + b).normalize(), a, b];
+        let apexes = triangles
+            .iter()
+            .map(|&t| {
+                let g = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0;
+                [Some(g + 0.05 * tri_normal(t)), None]
+            })
+            .collect();
+        let before = SimplicialHull {
+            points,
+            normals,
+            origins: vec![PointOrigin::Other; 4],
+            triangles: triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
+            apexes,
+            element: vec![0, 1],
+        };
+        // Angles round the edge (the x axis) from the first triangle's inward direction +y
+        // towards its outer normal +z.
+        let apart_less_than_half_turn = |h: &SimplicialHull| {
+            let angle = |q: DVec3| q.z.atan2(q.y).rem_euclid(std::f64::consts::TAU);
+            let q = [0, 1].map(|t| h.apexes[t][0].unwrap());
+            angle(q[1]) - angle(q[0]) < std::f64::consts::PI
+        };
+        assert!(!apart_less_than_half_turn(&before), "premise");
+        assert!(
+            overlaps(&before) > 0,
+            "premise: the edge tetrahedra overlap"
+        );
+        let mut hull = before.clone();
+        improve(&mut hull, false);
+        assert!(apart_less_than_half_turn(&hull));
+        assert_eq!(overlaps(&hull), 0);
         assert_eq!(others(&hull), others(&before));
     }
 
