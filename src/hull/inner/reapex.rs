@@ -31,7 +31,8 @@
 //! deepest point of the region the apex may take beside the tetrahedra its own overlap
 //! ([`deepest`]; the cage's thin upper lip, where every fixed move left 32 overlaps), and, at a
 //! sharp ridge of T whose two apexes lie more than a half turn apart round the edge, the
-//! deepest points beyond [`ridge_halves`] (mpi_poly's rims of T). A
+//! deepest points beyond [`ridge_halves`] (mpi_poly's rims of T), and, at an unsigned edge
+//! tetrahedron, the deepest point that signs it ([`midpoint_halves`]). A
 //! position is admissible when the triangle keeps what `verify` checks of it and what the
 //! earlier steps gave it ([`admissible`]): the apex's side; a
 //! volume not below [`VOLUME_MARGIN`] × [`DEGENERATE_VOLUME`] or what it was (the edge
@@ -665,6 +666,64 @@ fn clearance_halves(hull: &SimplicialHull, t: usize, s: usize) -> Vec<(DVec3, f6
         .collect()
 }
 
+/// Height of an edge-tetrahedron pair's shared point over each of its two triangles, on its
+/// apex's side, relative to the triangle's longest edge, that [`midpoint_halves`] asks for
+/// (as [`super::sides::MIDPOINT_CLEARANCE`] asks of rebuilt apexes).
+const MIDPOINT_MARGIN: f64 = 0.02;
+
+/// For every edge of triangle `t` whose edge-tetrahedron pair on side slot `s` is unsigned now
+/// (the apexes' midpoint on the far side of either triangle from its apex, [`unsigned`]), the
+/// half-spaces of positions of `t`'s apex that put the midpoint [`MIDPOINT_MARGIN`] over both
+/// triangles on their apexes' sides, the neighbour's apex q' as it is: linear in the apex,
+/// since the midpoint is (q + q')/2. mpi_poly's edge (1, 70) on its x = −10 face: a guard-net
+/// cell's apex 0.002 over its base and a trihedral corner's apex 1.6 over the other triangle,
+/// whose midpoint lay 0.11 below the corner's triangle; the fixed candidates (at most 8 × the
+/// height) and the deepest point do not reach over it. As half-spaces a · q ≤ b.
+fn midpoint_halves(site: &Site, t: usize, s: usize) -> Vec<(DVec3, f64)> {
+    let hull = site.hull;
+    let Some(q) = hull.apexes[t][s] else {
+        return Vec::new();
+    };
+    // (unit normal towards the apex's side, a base point, longest edge) of a triangle.
+    let frame = |u: usize, apex: DVec3| -> Option<(DVec3, DVec3, f64)> {
+        let p = hull.triangles[u].map(|i| hull.points[i as usize]);
+        let nn = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
+        Some((nn * nn.dot(apex - p[0]).signum(), p[0], longest_side(p)))
+    };
+    let Some(own) = frame(t, q) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for &e in &site.edges_of[t] {
+        let edge = &site.edges[e];
+        let u = if edge.faces[0] as usize == t {
+            edge.faces[1]
+        } else {
+            edge.faces[0]
+        };
+        if u == u32::MAX {
+            continue;
+        }
+        let Some(qu) = hull.apexes[u as usize][s] else {
+            continue;
+        };
+        let Some(other) = frame(u as usize, qu) else {
+            continue;
+        };
+        let m = 0.5 * (q + qu);
+        let below = |(up, p0, len): (DVec3, DVec3, f64)| up.dot(m - p0) <= UNSIGNED_TOL * len;
+        if !below(own) && !below(other) {
+            continue;
+        }
+        // up · (q + q')/2 ≥ up · p0 + margin · len, for both planes.
+        for (up, p0, len) in [own, other] {
+            let b = 2.0 * (up.dot(p0) + MIDPOINT_MARGIN * len) - up.dot(qu);
+            out.push((-up, -b));
+        }
+    }
+    out
+}
+
 /// The centre and radius of the largest ball inside {q : a · q ≤ b for every (a, b)} (unit a),
 /// by trying every vertex of the lifted polytope in (q, r) (few half-spaces here: a handful of
 /// planes). `None` when the region is empty or unbounded in every vertex found.
@@ -864,6 +923,11 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
                 ))
                 .chain(
                     Some(ridge_halves(&site, t, s, true))
+                        .filter(|h| !h.is_empty())
+                        .and_then(|h| deepest(hull, t, s, &blockers, &h)),
+                )
+                .chain(
+                    Some(midpoint_halves(&site, t, s))
                         .filter(|h| !h.is_empty())
                         .and_then(|h| deepest(hull, t, s, &blockers, &h)),
                 )
@@ -1297,6 +1361,87 @@ mod tests {
         // On its side, and over p_0's plane as seen from the coordinates.
         let q = hull.apexes[0][0].unwrap();
         assert!(q.z > 0.0 && n0.dot(q) > 0.0, "{q}");
+    }
+
+    /// [`midpoint_halves`] against the midpoint measured from coordinates: at a 37° ridge of T
+    /// (edge on the x axis, the second triangle falling to z = −0.6) with the first apex 0.002
+    /// over its base and the second 0.1 over its own, the pair's midpoint lies below both
+    /// triangles (mpi_poly's edge (1, 70)). For positions of the first apex on a grid round
+    /// its base, lying in the half-spaces is the same as putting the midpoint
+    /// [`MIDPOINT_MARGIN`] × the longest edge over both triangles, and the search ends with
+    /// the pair signed.
+    #[test]
+    fn midpoint_half_spaces_are_the_positions_that_sign_the_pair() {
+        let points = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 1.0, 0.0),
+            DVec3::new(0.5, -0.8, -0.6),
+        ];
+        let triangles: Vec<[u32; 3]> = vec![[0, 1, 2], [1, 0, 3]];
+        let unit = |t: [u32; 3]| {
+            let p = t.map(|i| points[i as usize]);
+            (
+                (p[1] - p[0]).cross(p[2] - p[0]).normalize(),
+                p,
+                longest_side(p),
+            )
+        };
+        let (na, pa, la) = unit(triangles[0]);
+        let (nb, pb, lb) = unit(triangles[1]);
+        let centroid = |p: [DVec3; 3]| (p[0] + p[1] + p[2]) / 3.0;
+        let qb = centroid(pb) + 0.1 * nb;
+        let hull = SimplicialHull {
+            normals: vec![(na + nb).normalize(), (na + nb).normalize(), na, nb],
+            origins: vec![PointOrigin::Other; 4],
+            points: points.clone(),
+            triangles,
+            apexes: vec![[Some(centroid(pa) + 0.002 * na), None], [Some(qb), None]],
+            element: vec![0, 1],
+        };
+        let edges = hull.edges().unwrap();
+        let edges_of: Vec<Vec<usize>> = (0..2)
+            .map(|t| {
+                (0..edges.len())
+                    .filter(|&e| edges[e].faces.contains(&(t as u32)))
+                    .collect()
+            })
+            .collect();
+        let site = Site {
+            hull: &hull,
+            edges: &edges,
+            edges_of: &edges_of,
+            keep_slopes: false,
+        };
+        let half = midpoint_halves(&site, 0, 0);
+        assert_eq!(half.len(), 2, "premise: the pair is unsigned");
+        let mut inside = 0;
+        for i in -10..=10 {
+            for j in -10..=10 {
+                for k in 1..=10 {
+                    let x = DVec3::new(
+                        0.5 + 0.1 * f64::from(i),
+                        0.1 * f64::from(j),
+                        0.1 * f64::from(k),
+                    );
+                    let m = 0.5 * (x + qb);
+                    let signed = na.dot(m - pa[0]) >= MIDPOINT_MARGIN * la
+                        && nb.dot(m - pb[0]) >= MIDPOINT_MARGIN * lb;
+                    let lies = half.iter().all(|&(a, b)| a.dot(x) <= b);
+                    // Points within rounding of a plane (1e-9 on data of size 1) may go
+                    // either way.
+                    if half.iter().any(|&(a, b)| (a.dot(x) - b).abs() < 1e-9) {
+                        continue;
+                    }
+                    assert_eq!(signed, lies, "{x}");
+                    inside += usize::from(lies);
+                }
+            }
+        }
+        assert!(inside > 0, "some grid positions sign the pair");
+        let mut moved = hull.clone();
+        improve(&mut moved, false);
+        assert_eq!(unsigned_count(&moved), 0);
     }
 
     /// Low apexes that do not overlap, and no tangent plane missed: nothing moves. (The
