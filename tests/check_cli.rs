@@ -482,7 +482,8 @@ fn inner_hull_scene_reports_its_hull_steps() {
 /// `check` reports what the cubic scheme changed on the hull before filling it
 /// (`cubic_c1::prepare_hull`: apexes moved over tangent planes, its own apex search), which the
 /// `hull steps` line (the builder's report) leaves out: the CLI's figures are the library's
-/// `prepare_hull` on the builder's hull (mpi_poly: moves and a second apex search; a scene
+/// `prepare_hull` on the builder's hull (mpi_poly: moves, and a second apex search when it
+/// has something to do; a scene
 /// that fails `check` otherwise, so the exit status is not asserted); a scene whose hull the
 /// scheme leaves alone prints no such line.
 #[test]
@@ -497,7 +498,9 @@ fn cubic_scene_reports_the_schemes_apex_changes() {
     let (options, inner) = apatch::scheme::cubic_c1::options_from_toml(scheme, &scene).unwrap();
     let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
     let s = apatch::scheme::cubic_c1::prepare_hull(&hull, &options).steps();
-    assert!(s.tangent_moved > 0 && !s.reapex.moved.is_empty(), "{s:?}");
+    // mpi_poly's scheme moves apexes over tangent planes; its own apex search finds nothing
+    // left to do since session 25 (the hull's search clears every overlap first).
+    assert!(s.tangent_moved > 0, "{s:?}");
     let count = |k: &str| steps[k].as_u64().map(|n| n as usize);
     assert_eq!(count("tangent_moved"), Some(s.tangent_moved), "{steps}");
     assert_eq!(count("tangent_stuck"), Some(s.tangent_stuck), "{steps}");
@@ -509,15 +512,17 @@ fn cubic_scene_reports_the_schemes_apex_changes() {
         .lines()
         .find(|l| l.starts_with("cubic steps"))
         .unwrap_or_else(|| panic!("{text}"));
-    assert!(
-        line.contains(&format!(
-            "apex search {} moves (overlapping pairs {} -> {})",
-            s.reapex.moved.len(),
-            s.reapex.before,
-            s.reapex.after
-        )),
-        "{line}"
+    let searched = format!(
+        "apex search {} moves (overlapping pairs {} -> {})",
+        s.reapex.moved.len(),
+        s.reapex.before,
+        s.reapex.after
     );
+    if s.reapex.before > 0 || !s.reapex.moved.is_empty() {
+        assert!(line.contains(&searched), "{line}");
+    } else {
+        assert!(!line.contains("apex search"), "{line}");
+    }
     let plain = root.join("scenes/paper1994/octahedron.toml");
     let text = stdout(&apatch(&["check", plain.to_str().unwrap()]));
     assert!(!text.contains("cubic steps"), "{text}");
