@@ -445,13 +445,20 @@ fn classify_holes(
             _ => format!("face[{}] opp{opp}", kind(p.element as usize)),
         };
         if std::env::var("VERBOSE").is_ok() {
-            let e = &edges[p.element as usize];
+            // A face patch's element is its triangle of T, an edge patch's its edge.
+            let (pts, tris): (Vec<u32>, Vec<u32>) = match p.role {
+                apatch::complex::Role::Edge => {
+                    let e = &edges[p.element as usize];
+                    (e.v.to_vec(), e.faces.to_vec())
+                }
+                _ => (hull.triangles[p.element as usize].to_vec(), vec![p.element]),
+            };
             eprintln!(
-                "{label} patch {k} edge {:?} tris {:?} pts {:?} apexes {:?}",
-                e.v,
-                e.faces,
-                e.v.map(|i| hull.points[i as usize]),
-                e.faces.map(|f| hull.apexes.get(f as usize).copied())
+                "{label} patch {k} points {pts:?} tris {tris:?} apexes {:?}",
+                tris.iter()
+                    .filter(|&&f| f != u32::MAX)
+                    .map(|&f| hull.apexes[f as usize])
+                    .collect::<Vec<_>>()
             );
             // The crossed face's weights (multi-indices without the opposite vertex).
             let face: Vec<String> = apatch::bb::multi_indices(p.degree as usize)
@@ -461,13 +468,13 @@ fn classify_holes(
                 .map(|(k, m)| format!("{m:?}={:.3e}", p.weights[k]))
                 .collect();
             eprintln!("    tet {:?}\n    face {}", p.tet, face.join(" "));
-            for &v in &e.v {
+            for &v in &pts {
                 eprintln!(
                     "    point {v} {:?} normal {:?} origin {:?}",
                     hull.points[v as usize], hull.normals[v as usize], hull.origins[v as usize]
                 );
             }
-            for &f in e.faces.iter().filter(|&&f| f != u32::MAX) {
+            for &f in tris.iter().filter(|&&f| f != u32::MAX) {
                 let t = hull.triangles[f as usize];
                 let q = t.map(|i| hull.points[i as usize]);
                 let n = (q[1] - q[0]).cross(q[2] - q[0]).normalize();

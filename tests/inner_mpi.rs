@@ -321,9 +321,13 @@ fn mpi_poly_corner_74_gets_its_own_guard_of_face_8() {
     // The raw hull: 331 violations before, 295 with the guard, 282 with `clearance`'s nudge,
     // 211 since `clearance` lifts by the shortest move (the step (5') cell over edge 73–83
     // rose 4.5 along its normal; the rest are the needles', bucket (b)); at most 10 name a
-    // triangle of corner 74 (44 before). The bound leaves the count no room to grow back.
+    // triangle of corner 74 (44 before). Since session 25 the raw hull has 300: zero-convex
+    // edges between two corner guards ask their triangles for both sides too
+    // (`sides::join_across_zero_edges`), and the apexes rebuilt over their bases overlap
+    // until the apex search (which the scene sets) moves them; the scene's hull below has 2.
+    // The bounds leave the counts no room to grow back.
     let v = inner::verify(&hull);
-    assert!(v.len() <= 215, "{} violations", v.len());
+    assert!(v.len() <= 300, "{} violations", v.len());
     let named74 = v
         .iter()
         .filter(|x| {
@@ -339,11 +343,12 @@ fn mpi_poly_corner_74_gets_its_own_guard_of_face_8() {
     // in the hull (`clearance`), the scheme moves only those whose nudge would flatten an edge
     // tetrahedron (`clearance::keeps_edge_tets`: needle face 44's edge (66, 60)), which adds
     // 8 violations (211 raw, 219 after the scheme's moves) but no degenerate tetrahedron; the
-    // bound is the count's (219; 288 before the shortest lift, 396 before the nudges).
+    // bound is the count's (2 since session 25's apex search: ridge and midpoint planes,
+    // missed tangent planes; 219 before, 288 before the shortest lift, 396 before the nudges).
     let scene = apatch::scene::load(Path::new("scenes/pending/paper1994/mpi_poly.toml")).unwrap();
     let prepared = apatch::scene::inner_hull(&scene).unwrap().unwrap();
     let w = inner::verify(&prepared);
-    assert!(w.len() <= 219, "{} against {}", w.len(), v.len());
+    assert!(w.len() <= 2, "{} against {}", w.len(), v.len());
     assert!(
         w.iter().all(|x| x.kind != inner::ViolationKind::Degenerate),
         "{:?}",

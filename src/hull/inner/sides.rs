@@ -90,7 +90,8 @@ fn join_across_zero_edges(
         // neighbours (mpi_poly: 387 hull violations became 447), which the apex search
         // (`reapex`) now clears; left out, mpi_poly kept 3 of these edges without edge
         // tetrahedra (6 hull violations instead of 3; every other 1994 scene but the nut is
-        // byte-identical, and the nut still verifies).
+        // byte-identical, and the nut still verifies). Without the search the overlaps stay:
+        // mpi_poly's raw hull has 300 violations instead of 211.
         .map(|e| (e.faces[0] as usize, e.faces[1] as usize))
         .filter(|&(f, g)| f < required.len() && g < required.len())
         .collect();
