@@ -1073,6 +1073,36 @@ mod tests {
         }
     }
 
+    /// Two triangles of T on the edge from the origin to (1, 0, 0): [0 1 2] in z = 0 with
+    /// p_2 = (0.5, 1, 0), and [1 0 3] folding to `third`; the edge's normals the triangles'
+    /// mean, the others their triangle's; outer apexes 0.05 over each centroid.
+    fn folded_pair(third: DVec3) -> SimplicialHull {
+        let points = vec![DVec3::ZERO, DVec3::X, DVec3::new(0.5, 1.0, 0.0), third];
+        let triangles = [[0usize, 1, 2], [1, 0, 3]];
+        let tri_normal = |t: [usize; 3]| {
+            (points[t[1]] - points[t[0]])
+                .cross(points[t[2]] - points[t[0]])
+                .normalize()
+        };
+        let (a, b) = (tri_normal(triangles[0]), tri_normal(triangles[1]));
+        let normals = vec![(a + b).normalize(), (a + b).normalize(), a, b];
+        let apexes = triangles
+            .iter()
+            .map(|&t| {
+                let g = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0;
+                [Some(g + 0.05 * tri_normal(t)), None]
+            })
+            .collect();
+        SimplicialHull {
+            points,
+            normals,
+            origins: vec![PointOrigin::Other; 4],
+            triangles: triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
+            apexes,
+            element: vec![0, 1],
+        }
+    }
+
     /// The Chebyshev centre against closed forms: the unit cube's is its centre with radius
     /// 1/2; the corner tetrahedron x, y, z ≥ 0, x + y + z ≤ 1 has its inscribed sphere at
     /// (r, r, r), r = 1 / (3 + √3); crossed half-spaces leave nothing.
@@ -1208,35 +1238,7 @@ mod tests {
     /// module's own test), nothing overlaps, and no other violation `verify` sees comes.
     #[test]
     fn ridge_edge_tetrahedra_get_their_shared_point_on_the_apex_side() {
-        let points = vec![
-            DVec3::new(0.0, 0.0, 0.0),
-            DVec3::new(1.0, 0.0, 0.0),
-            DVec3::new(0.5, 1.0, 0.0),
-            DVec3::new(0.5, -1.0, -0.8),
-        ];
-        let triangles = [[0usize, 1, 2], [1, 0, 3]];
-        let tri_normal = |t: [usize; 3]| {
-            (points[t[1]] - points[t[0]])
-                .cross(points[t[2]] - points[t[0]])
-                .normalize()
-        };
-        let (a, b) = (tri_normal(triangles[0]), tri_normal(triangles[1]));
-        let normals = vec![(a + b).normalize(), (a + b).normalize(), a, b];
-        let apexes = triangles
-            .iter()
-            .map(|&t| {
-                let g = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0;
-                [Some(g + 0.05 * tri_normal(t)), None]
-            })
-            .collect();
-        let before = SimplicialHull {
-            points,
-            normals,
-            origins: vec![PointOrigin::Other; 4],
-            triangles: triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
-            apexes,
-            element: vec![0, 1],
-        };
+        let before = folded_pair(DVec3::new(0.5, -1.0, -0.8));
         // s on the apex's side of each triangle's plane, from the coordinates.
         let signed = |h: &SimplicialHull| {
             let q = [0, 1].map(|t| h.apexes[t][0].unwrap());
@@ -1273,35 +1275,7 @@ mod tests {
     #[test]
     fn sharp_ridge_apexes_end_less_than_a_half_turn_apart() {
         let (c, s) = (330f64.to_radians().cos(), 330f64.to_radians().sin());
-        let points = vec![
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::new(0.5, 1.0, 0.0),
-            DVec3::new(0.5, c, s),
-        ];
-        let triangles = [[0usize, 1, 2], [1, 0, 3]];
-        let tri_normal = |t: [usize; 3]| {
-            (points[t[1]] - points[t[0]])
-                .cross(points[t[2]] - points[t[0]])
-                .normalize()
-        };
-        let (a, b) = (tri_normal(triangles[0]), tri_normal(triangles[1]));
-        let normals = vec![(a + b).normalize(), (a + b).normalize(), a, b];
-        let apexes = triangles
-            .iter()
-            .map(|&t| {
-                let g = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0;
-                [Some(g + 0.05 * tri_normal(t)), None]
-            })
-            .collect();
-        let before = SimplicialHull {
-            points,
-            normals,
-            origins: vec![PointOrigin::Other; 4],
-            triangles: triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
-            apexes,
-            element: vec![0, 1],
-        };
+        let before = folded_pair(DVec3::new(0.5, c, s));
         // Angles round the edge (the x axis) from the first triangle's inward direction +y
         // towards its outer normal +z.
         let apart_less_than_half_turn = |h: &SimplicialHull| {
