@@ -552,6 +552,28 @@ fn deepest(
     chebyshev_centre(&half).map(|(c, _)| c)
 }
 
+/// The edges of triangle `t` whose other triangle u has an apex q' on side slot `s`, as
+/// (edge, u, q').
+fn neighbours_on_side<'a>(
+    site: &'a Site,
+    t: usize,
+    s: usize,
+) -> impl Iterator<Item = (&'a HullEdge, usize, DVec3)> + 'a {
+    site.edges_of[t].iter().filter_map(move |&e| {
+        let edge = &site.edges[e];
+        let u = if edge.faces[0] as usize == t {
+            edge.faces[1]
+        } else {
+            edge.faces[0]
+        };
+        if u == u32::MAX {
+            return None;
+        }
+        let qu = site.hull.apexes[u as usize][s]?;
+        Some((edge, u as usize, qu))
+    })
+}
+
 /// Angle (radians, 5°) by which [`ridge_halves`] asks an apex to clear its limit round the
 /// edge: enough that the edge tetrahedra between the two apexes keep a volume (at the limit
 /// they are flat), small beside the 70–75° each apex must rise at mpi_poly's 147–150° folds.
@@ -579,19 +601,7 @@ fn ridge_halves(site: &Site, t: usize, s: usize, alone: bool) -> Vec<(DVec3, f64
     };
     let up = if s == Side::Outer as usize { nn } else { -nn };
     let mut out = Vec::new();
-    for &e in &site.edges_of[t] {
-        let edge = &site.edges[e];
-        let u = if edge.faces[0] as usize == t {
-            edge.faces[1]
-        } else {
-            edge.faces[0]
-        };
-        if u == u32::MAX {
-            continue;
-        }
-        let Some(qu) = hull.apexes[u as usize][s] else {
-            continue;
-        };
+    for (edge, u, qu) in neighbours_on_side(site, t, s) {
         let [pi, pj] = edge.v.map(|i| hull.points[i as usize]);
         let Some(dir) = (pj - pi).try_normalize() else {
             continue;
@@ -601,7 +611,7 @@ fn ridge_halves(site: &Site, t: usize, s: usize, alone: bool) -> Vec<(DVec3, f64
                 .find(|&&i| i != edge.v[0] && i != edge.v[1])
                 .map(|&i| hull.points[i as usize])
         };
-        let (Some(ot), Some(ou)) = (third(tri), third(hull.triangles[u as usize])) else {
+        let (Some(ot), Some(ou)) = (third(tri), third(hull.triangles[u])) else {
             continue;
         };
         let perp = |v: DVec3| v - v.dot(dir) * dir;
@@ -694,20 +704,8 @@ fn midpoint_halves(site: &Site, t: usize, s: usize) -> Vec<(DVec3, f64)> {
         return Vec::new();
     };
     let mut out = Vec::new();
-    for &e in &site.edges_of[t] {
-        let edge = &site.edges[e];
-        let u = if edge.faces[0] as usize == t {
-            edge.faces[1]
-        } else {
-            edge.faces[0]
-        };
-        if u == u32::MAX {
-            continue;
-        }
-        let Some(qu) = hull.apexes[u as usize][s] else {
-            continue;
-        };
-        let Some(other) = frame(u as usize, qu) else {
+    for (_, u, qu) in neighbours_on_side(site, t, s) {
+        let Some(other) = frame(u, qu) else {
             continue;
         };
         let m = 0.5 * (q + qu);
@@ -771,7 +769,7 @@ struct Site<'a> {
 /// True when the apex `q` of triangle `t` on side slot `s` keeps what `verify` checks of the
 /// triangle and what [`super::clearance`] gave it, compared with the apex `old` (module docs).
 fn admissible(site: &Site, t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
-    let (hull, edges, keep_slopes) = (site.hull, site.edges, site.keep_slopes);
+    let (hull, keep_slopes) = (site.hull, site.keep_slopes);
     let tri = hull.triangles[t];
     let p = tri.map(|i| hull.points[i as usize]);
     let n = tri.map(|i| hull.normals[i as usize]);
@@ -822,19 +820,7 @@ fn admissible(site: &Site, t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
         return false;
     }
     // The edge tetrahedra glued at the triangle's edges keep their volume.
-    site.edges_of[t].iter().all(|&e| {
-        let edge = &edges[e];
-        let u = if edge.faces[0] as usize == t {
-            edge.faces[1]
-        } else {
-            edge.faces[0]
-        };
-        if u == u32::MAX {
-            return true;
-        }
-        let Some(q1) = hull.apexes[u as usize][s] else {
-            return true;
-        };
+    neighbours_on_side(site, t, s).all(|(edge, _, q1)| {
         let [pi, pj] = edge.v.map(|i| hull.points[i as usize]);
         let (m, was) = (0.5 * (q + q1), 0.5 * (old + q1));
         [(q, old), (q1, q1)].iter().all(|&(x, y)| {
