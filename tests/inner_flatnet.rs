@@ -426,6 +426,18 @@ fn classify_holes(
         let same = faces.iter().all(|f| f.is_some() && *f == faces[0]);
         format!("g{g}p{p}{}", if same { "flat" } else { "" })
     };
+    // An edge patch's element is its edge of T; a face patch's is an input vertex, so its
+    // triangle is the one whose points are the tetrahedron's base.
+    let base_triangle = |p: &apatch::complex::Patch| -> usize {
+        (0..hull.triangles.len())
+            .find(|&t| {
+                hull.triangles[t]
+                    .iter()
+                    .zip(&p.tet)
+                    .all(|(&i, &q)| hull.points[i as usize] == DVec3::from(q))
+            })
+            .expect("a face patch's base is a triangle of T")
+    };
     let mut by = std::collections::BTreeMap::new();
     // Per-patch scale 1e-9: signs beyond rounding of each patch's own weights.
     let (crossed, _) = fixtures::crossed_boundary_faces(c, 15, 1e-9, fixtures::SignScale::Patch);
@@ -442,16 +454,18 @@ fn classify_holes(
                     .collect();
                 format!("edge[{}] opp{opp}", ks.join("|"))
             }
-            _ => format!("face[{}] opp{opp}", kind(p.element as usize)),
+            _ => format!("face[{}] opp{opp}", kind(base_triangle(p))),
         };
         if std::env::var("VERBOSE").is_ok() {
-            // A face patch's element is its triangle of T, an edge patch's its edge.
             let (pts, tris): (Vec<u32>, Vec<u32>) = match p.role {
                 apatch::complex::Role::Edge => {
                     let e = &edges[p.element as usize];
                     (e.v.to_vec(), e.faces.to_vec())
                 }
-                _ => (hull.triangles[p.element as usize].to_vec(), vec![p.element]),
+                _ => {
+                    let t = base_triangle(p);
+                    (hull.triangles[t].to_vec(), vec![t as u32])
+                }
             };
             eprintln!(
                 "{label} patch {k} points {pts:?} tris {tris:?} apexes {:?}",
