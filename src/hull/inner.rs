@@ -152,9 +152,11 @@ pub struct InnerOptions {
     /// [`recut::MAX_TRIALS`] rebuilds). For strongly folded control cages (spot_control_cage).
     pub corner_search: bool,
     /// Where the hull (after the searches above, if on) still has overlapping tetrahedra,
-    /// move the apexes they depend on: lower, towards the centroid or sideways, chosen by the
-    /// overlap test itself ([`reapex`]; default false: opt-in). For strongly folded control
-    /// cages (spot_control_cage).
+    /// unsigned edge tetrahedra or tangent planes that miss their face tetrahedra, move the
+    /// apexes they depend on: lower, towards the centroid or sideways, or to the deepest point
+    /// of the region they may take, chosen by the overlap test itself ([`reapex`]; default
+    /// false: opt-in). For strongly folded control cages (spot_control_cage) and models with
+    /// sharp ridges of T (fandisk, mpi_poly).
     pub apex_search: bool,
 }
 
