@@ -248,14 +248,15 @@ impl Score {
 }
 
 /// The score of the tetrahedra `moved` (indices, with their geometry `geom`): the overlapping
-/// pairs they take part in against the tetrahedra in `near`, and how many of them are unsigned
-/// edge tetrahedra.
+/// pairs they take part in against the tetrahedra in `near`, how many of them are unsigned
+/// edge tetrahedra, and the moved apex's triangle's `uncontained` count ([`uncontained`]).
 fn local_score(
     hull: &SimplicialHull,
     tets: &Tets,
     moved: &[usize],
     geom: &[[DVec3; 4]],
     near: &[usize],
+    uncontained: usize,
 ) -> Score {
     let (mut count, mut depth) = (0, 0.0);
     for (k, ti) in geom.iter().enumerate() {
@@ -291,7 +292,7 @@ fn local_score(
     }
     Score {
         overlaps: count,
-        uncontained: 0,
+        uncontained,
         unsigned: unsigned_here,
         depth,
     }
@@ -490,8 +491,7 @@ fn deepest(
     let tri = hull.triangles[t];
     let p = tri.map(|i| hull.points[i as usize]);
     let n = tri.map(|i| hull.normals[i as usize]);
-    let nn = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
-    let up = if s == Side::Outer as usize { nn } else { -nn };
+    let up = side_normal(hull, t, s)?;
     let g = (p[0] + p[1] + p[2]) / 3.0;
     let len = longest_side(p);
     // Half-spaces a · q ≤ b.
@@ -592,14 +592,9 @@ const RIDGE_MARGIN: f64 = 0.087;
 fn ridge_halves(site: &Site, t: usize, s: usize, alone: bool) -> Vec<(DVec3, f64)> {
     let hull = site.hull;
     let tri = hull.triangles[t];
-    let p = tri.map(|i| hull.points[i as usize]);
-    let (Some(q), Some(nn)) = (
-        hull.apexes[t][s],
-        (p[1] - p[0]).cross(p[2] - p[0]).try_normalize(),
-    ) else {
+    let (Some(q), Some(up)) = (hull.apexes[t][s], side_normal(hull, t, s)) else {
         return Vec::new();
     };
-    let up = if s == Side::Outer as usize { nn } else { -nn };
     let mut out = Vec::new();
     for (edge, u, qu) in neighbours_on_side(site, t, s) {
         let [pi, pj] = edge.v.map(|i| hull.points[i as usize]);
@@ -621,12 +616,7 @@ fn ridge_halves(site: &Site, t: usize, s: usize, alone: bool) -> Vec<(DVec3, f64
         let y = up - up.dot(dir) * dir;
         let angle = |v: DVec3| {
             let a = perp(v - pi);
-            let r = a.dot(y).atan2(a.dot(x));
-            if r < 0.0 {
-                r + std::f64::consts::TAU
-            } else {
-                r
-            }
+            a.dot(y).atan2(a.dot(x)).rem_euclid(std::f64::consts::TAU)
         };
         let phi = angle(ou);
         let pi_ = std::f64::consts::PI;
@@ -651,28 +641,43 @@ fn ridge_halves(site: &Site, t: usize, s: usize, alone: bool) -> Vec<(DVec3, f64
     out
 }
 
-/// The clearance [`admissible`] asks of a moved apex of triangle `t` on side slot `s`, as
-/// half-spaces a · q ≤ b: over each base vertex's tangent plane (on the side the normals agree
-/// with) by at least [`CLEARANCE`] × the longest edge, or what the apex has now.
-fn clearance_halves(hull: &SimplicialHull, t: usize, s: usize) -> Vec<(DVec3, f64)> {
+/// The unit normal of triangle `t` towards side slot `s`; `None` for a degenerate triangle.
+fn side_normal(hull: &SimplicialHull, t: usize, s: usize) -> Option<DVec3> {
+    let p = hull.triangles[t].map(|i| hull.points[i as usize]);
+    let nn = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
+    Some(if s == Side::Outer as usize { nn } else { -nn })
+}
+
+/// The clearance [`admissible`] asks of the apex of triangle `t` on side slot `s` that is now
+/// at `old`, per base vertex k as (a_k, p_k, need_k), met when a_k · (q − p_k) ≥ need_k: a_k is
+/// the vertex normal turned to the side the three normals agree with (as [`super::clearance`]
+/// measures it), need_k the smaller of what `old` has and [`CLEARANCE`] × the longest edge.
+/// `None` for a degenerate triangle.
+fn clearance_needs(
+    hull: &SimplicialHull,
+    t: usize,
+    s: usize,
+    old: DVec3,
+) -> Option<[(DVec3, DVec3, f64); 3]> {
     let tri = hull.triangles[t];
     let p = tri.map(|i| hull.points[i as usize]);
     let n = tri.map(|i| hull.normals[i as usize]);
-    let (Some(old), Some(nn)) = (
-        hull.apexes[t][s],
-        (p[1] - p[0]).cross(p[2] - p[0]).try_normalize(),
-    ) else {
+    let side = side_normal(hull, t, s)?.dot(n[0] + n[1] + n[2]).signum();
+    let len = longest_side(p);
+    Some(std::array::from_fn(|k| {
+        let a = side * n[k];
+        (a, p[k], a.dot(old - p[k]).min(CLEARANCE * len))
+    }))
+}
+
+/// [`clearance_needs`] for the apex as it is, as half-spaces a · q ≤ b for [`deepest`].
+fn clearance_halves(hull: &SimplicialHull, t: usize, s: usize) -> Vec<(DVec3, f64)> {
+    let Some(needs) = hull.apexes[t][s].and_then(|old| clearance_needs(hull, t, s, old)) else {
         return Vec::new();
     };
-    let up = if s == Side::Outer as usize { nn } else { -nn };
-    let side = up.dot(n[0] + n[1] + n[2]).signum();
-    let len = longest_side(p);
-    (0..3)
-        .map(|k| {
-            let a = side * n[k];
-            let need = a.dot(old - p[k]).min(CLEARANCE * len);
-            (-a, -a.dot(p[k]) - need)
-        })
+    needs
+        .iter()
+        .map(|&(a, pk, need)| (-a, -a.dot(pk) - need))
         .collect()
 }
 
@@ -784,16 +789,12 @@ fn admissible(site: &Site, t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
     if sign * nn.dot(q - p[0]) <= 0.0 || vol.abs() < floor(relative_volume(p[0], p[1], p[2], old)) {
         return false;
     }
-    let len = longest_side(p);
-    // Clearance over the base vertices' tangent planes, on the side the normals agree with
-    // (as `clearance` measures it).
-    let up = sign * nn;
-    let side = up.dot(n[0] + n[1] + n[2]).signum();
-    for k in 0..3 {
-        let h = |x: DVec3| side * n[k].dot(x - p[k]);
-        if h(q) < h(old).min(CLEARANCE * len) {
-            return false;
-        }
+    // Clearance over the base vertices' tangent planes.
+    let Some(needs) = clearance_needs(hull, t, s, old) else {
+        return false;
+    };
+    if needs.iter().any(|&(a, pk, need)| a.dot(q - pk) < need) {
+        return false;
     }
     // The cubic scheme's slopes toward the apex (`scheme::cubic_c1::tangent`), on a hull that
     // scheme has prepared: not below the margin it gives moved apexes, or below what they were.
@@ -933,16 +934,28 @@ pub fn improve(hull: &mut SimplicialHull, keep_slopes: bool) -> Search {
                 })
                 .collect();
             let near = near_of(&tets, geoms.iter().flatten());
-            let mut current = local_score(hull, &tets, &moved, &geoms[0], &near);
-            current.uncontained = uncontained(hull, t, s, old);
+            let current = local_score(
+                hull,
+                &tets,
+                &moved,
+                &geoms[0],
+                &near,
+                uncontained(hull, t, s, old),
+            );
             if current.is_clean() {
                 continue;
             }
             let mut best: Option<(Score, usize)> = None;
             for (c, g) in geoms.iter().enumerate().skip(1) {
                 search.trials += 1;
-                let mut score = local_score(hull, &tets, &moved, g, &near);
-                score.uncontained = uncontained(hull, t, s, cands[c - 1]);
+                let score = local_score(
+                    hull,
+                    &tets,
+                    &moved,
+                    g,
+                    &near,
+                    uncontained(hull, t, s, cands[c - 1]),
+                );
                 if score.improves_on(current) && best.is_none_or(|(b, _)| score.beats(b)) {
                     best = Some((score, c));
                 }
