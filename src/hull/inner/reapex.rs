@@ -301,6 +301,12 @@ fn local_score(
 /// How many base vertices of triangle `t` have a tangent plane that misses its face
 /// tetrahedra (Definition 3.5 as `verify` tests it) with the apex on side slot `s` at `q`.
 fn uncontained(hull: &SimplicialHull, t: usize, s: usize, q: DVec3) -> usize {
+    missed(hull, t, s, q).iter().filter(|&&m| m).count()
+}
+
+/// For each base vertex of triangle `t`, whether its tangent plane misses the triangle's face
+/// tetrahedra (Definition 3.5 as `verify` tests it) with the apex on side slot `s` at `q`.
+fn missed(hull: &SimplicialHull, t: usize, s: usize, q: DVec3) -> [bool; 3] {
     let tri = hull.triangles[t];
     let p = tri.map(|i| hull.points[i as usize]);
     let mut apexes = hull.apexes[t];
@@ -310,9 +316,7 @@ fn uncontained(hull: &SimplicialHull, t: usize, s: usize, q: DVec3) -> usize {
         .flatten()
         .map(|&a| [p[0], p[1], p[2], a])
         .collect();
-    (0..3)
-        .filter(|&k| !contains(&tets, p[k], hull.normals[tri[k] as usize]))
-        .count()
+    std::array::from_fn(|k| !contains(&tets, p[k], hull.normals[tri[k] as usize]))
 }
 
 /// The triangles of T with an apex whose tangent planes [`uncontained`] finds missed.
@@ -808,16 +812,8 @@ fn admissible(site: &Site, t: usize, s: usize, old: DVec3, q: DVec3) -> bool {
         }
     }
     // Tangent containment where it held (the pair's other apex unchanged).
-    let other = hull.apexes[t][1 - s];
-    let pair = |apex: DVec3| -> Vec<[DVec3; 4]> {
-        [Some(apex), other]
-            .into_iter()
-            .flatten()
-            .map(|a| [p[0], p[1], p[2], a])
-            .collect()
-    };
-    let (was, now) = (pair(old), pair(q));
-    if (0..3).any(|k| contains(&was, p[k], n[k]) && !contains(&now, p[k], n[k])) {
+    let (was, now) = (missed(hull, t, s, old), missed(hull, t, s, q));
+    if (0..3).any(|k| !was[k] && now[k]) {
         return false;
     }
     // The edge tetrahedra glued at the triangle's edges keep their volume.
