@@ -10,6 +10,8 @@
 //! #                               # the surface then interpolates the subdivided mesh, not the file
 //! # weld = 1e-3                   # opt-in (rational-c1 only): weld vertices closer than this ×
 //! #                               # the bounding-box diagonal (modelling slop, see mesh::weld)
+//! # clean = 1e-3                  # opt-in (cubic-c1, quintic-c2): weld at this × the diagonal,
+//! #                               # split T-junctions, merge needle tips, planarise (mesh::clean)
 //! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
 //!
 //! [scheme]
@@ -84,6 +86,10 @@ pub enum Model {
         /// Optional weld tolerance relative to the bounding-box diagonal (`model.weld`,
         /// rational-c1 only, see [`mod@crate::mesh::weld`]), applied before triangulation.
         weld: Option<f64>,
+        /// Optional cleaning tolerance relative to the bounding-box diagonal (`model.clean`,
+        /// cubic-c1 and quintic-c2 only, see [`mod@crate::mesh::clean`]): the hull is built on
+        /// the cleaned polyhedron.
+        clean: Option<f64>,
     },
     /// A patch complex JSON file (resolved).
     Patches(PathBuf),
@@ -126,6 +132,7 @@ struct ModelSection {
     patches: Option<String>,
     subdivide: Option<SubdivideSection>,
     weld: Option<f64>,
+    clean: Option<f64>,
 }
 
 /// `model.subdivide = { rule = "loop", levels = N }`.
@@ -341,9 +348,9 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
             if file.scheme.is_some() {
                 return Err(bad("scheme", "only applies with `model.file`".into()));
             }
-            if m.subdivide.is_some() || m.weld.is_some() {
+            if m.subdivide.is_some() || m.weld.is_some() || m.clean.is_some() {
                 return Err(bad(
-                    "model.subdivide/weld",
+                    "model.subdivide/weld/clean",
                     "only applies with `model.file`".into(),
                 ));
             }
@@ -414,12 +421,35 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     ));
                 }
             }
+            if let Some(c) = m.clean {
+                if !(0.0..=mesh::weld::MAX_WELD_TOLERANCE).contains(&c) {
+                    return Err(bad(
+                        "model.clean",
+                        format!(
+                            "{c} is not in [0, {}] (relative to the bounding-box diagonal)",
+                            mesh::weld::MAX_WELD_TOLERANCE
+                        ),
+                    ));
+                }
+                if !matches!(
+                    scheme.get("type").and_then(|v| v.as_str()),
+                    Some("cubic-c1" | "quintic-c2")
+                ) {
+                    return Err(bad(
+                        "model.clean",
+                        "only applies to `scheme.type = \"cubic-c1\"` or `\"quintic-c2\"` \
+                         (`rational-c1` has `model.weld`)"
+                            .into(),
+                    ));
+                }
+            }
             Model::Mesh {
                 file: dir.join(f),
                 normals,
                 scheme,
                 subdivide,
                 weld: m.weld,
+                clean: m.clean,
             }
         }
     };
@@ -659,6 +689,8 @@ pub struct BuiltScene {
     /// What the cubic scheme changed on the hull before filling it (`cubic-c1` scenes; `None`
     /// otherwise): L-U partners, apexes moved over tangent planes, its own apex search.
     pub cubic_steps: Option<crate::scheme::cubic_c1::PrepareSteps>,
+    /// What `model.clean` changed (1994 scenes that set it; `None` otherwise).
+    pub clean: Option<mesh::CleanReport>,
 }
 
 /// [`build_complex`], returning the loaded mesh and the hull beside the complex
@@ -676,6 +708,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
             solve: None,
             hull_report: None,
             cubic_steps: None,
+            clean: None,
         }),
         Model::Mesh {
             file,
@@ -683,6 +716,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
             scheme,
             subdivide,
             weld,
+            clean,
         } => {
             let ty = scheme.get("type").and_then(|v| v.as_str()).ok_or_else(|| {
                 anyhow!(
@@ -741,13 +775,14 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                         solve: None,
                         hull_report: None,
                         cubic_steps: None,
+                        clean: None,
                     })
                 }
                 "cubic-c1" | "quintic-c2" => {
                     let method: NormalMethod = normals.parse().map_err(|e: String| {
                         anyhow!("{}: `model.normals`: {e}", scene.path.display())
                     })?;
-                    let (m, report) = mesh::load(file)?;
+                    let (m, report, cleaned) = polyhedron_1994(file, *clean)?;
                     crate::hull::inner::closed::require_closed(&m, &report)?;
                     let vn = mesh::vertex_normals(&m, method)?;
                     let built = build_1994(ty, &m, &vn, scheme, &scene.path)
@@ -760,6 +795,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                         solve: built.solve,
                         hull_report: Some(built.report),
                         cubic_steps: built.cubic_steps,
+                        clean: cleaned,
                     })
                 }
                 _ => bail!(
@@ -769,6 +805,25 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
             }
         }
     }
+}
+
+/// The polyhedron a 1994 scene's hull is built on: the mesh `file`, cleaned when the scene sets
+/// `model.clean` ([`mod@crate::mesh::clean`]), with its validation report and what the clean
+/// changed.
+///
+/// # Errors
+/// Unreadable meshes and cleans that fail, naming the file.
+pub fn polyhedron_1994(
+    file: &Path,
+    clean: Option<f64>,
+) -> anyhow::Result<(mesh::Mesh, mesh::Report, Option<mesh::CleanReport>)> {
+    let (m, report) = mesh::load(file)?;
+    let Some(t) = clean else {
+        return Ok((m, report, None));
+    };
+    let (c, report, changes) =
+        mesh::clean(&m, t).with_context(|| format!("{}: `model.clean`", file.display()))?;
+    Ok((c, report, Some(changes)))
 }
 
 /// The inner simplicial hull (1994) a `cubic-c1` or `quintic-c2` scene is built on, with the
@@ -787,6 +842,7 @@ pub fn inner_hull(
         file,
         normals,
         scheme,
+        clean,
         ..
     } = &scene.model
     else {
@@ -801,7 +857,7 @@ pub fn inner_hull(
     let method: NormalMethod = normals
         .parse()
         .map_err(|e: String| anyhow!("{}: `model.normals`: {e}", scene.path.display()))?;
-    let (m, _) = mesh::load(file)?;
+    let (m, _, _) = polyhedron_1994(file, *clean)?;
     let vn = mesh::vertex_normals(&m, method)?;
     let options = crate::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
     let hull = crate::hull::inner::build(&m, &vn, &options)

@@ -88,6 +88,7 @@ pub fn load_built(
         solve: None,
         hull_report: None,
         cubic_steps: None,
+        clean: None,
     };
     match ext.as_str() {
         "json" => Ok((only(apatch::complex_io::read_json_file(path)?), None)),
@@ -166,13 +167,14 @@ fn hull_repairs(scene: &apatch::scene::Scene) -> anyhow::Result<HullRepairs> {
         file,
         scheme,
         normals,
+        clean,
         ..
     } = &scene.model
     else {
         return Ok((None, None));
     };
     let options = apatch::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
-    let (m, _) = apatch::mesh::load(file)?;
+    let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean)?;
     // The hull's normals, for the split's steep and folded corners (as `hull::inner` has them).
     let vn = normals
         .parse()
@@ -353,6 +355,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let Some(w) = welded {
             out.insert("weld".into(), w.into());
         }
+        if let Some(c) = &built.clean {
+            out.insert("clean".into(), serde_json::to_value(c)?);
+        }
         if let Some(c) = &built.cubic_steps {
             out.insert(
                 "cubic_steps".into(),
@@ -409,6 +414,20 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
+        if let Some(c) = &built.clean {
+            println!(
+                "clean            {} vertices welded, {} T-junctions split, {} coplanar face \
+                 pairs merged and {} straight vertices dropped at two-face vertices, planar to \
+                 {:.1e} of the diagonal, vertices moved ≤ {:.3e}: the surface approximates the \
+                 cleaned polyhedron (`model.clean`, `mesh::clean`)  info",
+                c.welded,
+                c.t_junctions,
+                c.merged_faces,
+                c.dropped_vertices,
+                c.planarity,
+                c.max_move
+            );
+        }
         if let Some(w) = welded {
             println!(
                 "weld             vertices closer than {w:e} of the bounding-box diagonal were \

@@ -158,6 +158,12 @@ pub struct InnerOptions {
     /// false: opt-in). For strongly folded control cages (spot_control_cage) and models with
     /// sharp ridges of T (fandisk, mpi_poly).
     pub apex_search: bool,
+    /// Give every polygon with at least [`flatnet::MIN_CORNERS`] corners a zero coplanar
+    /// corner guard net (Appendix B), not only the large merged flat regions whose points of T
+    /// lie far from a corner ([`flatnet`]; default false: opt-in). For models whose non-convex
+    /// faces are split into convex pieces with guards far from the corners they serve
+    /// (mpi_poly cleaned by `model.clean`: its U-shaped faces).
+    pub all_flat_nets: bool,
 }
 
 impl Default for InnerOptions {
@@ -173,13 +179,14 @@ impl Default for InnerOptions {
             split_search: false,
             corner_search: false,
             apex_search: false,
+            all_flat_nets: false,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 9] = [
+    pub const KEYS: [&'static str; 10] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
@@ -189,12 +196,13 @@ impl InnerOptions {
         "split_search",
         "corner_search",
         "apex_search",
+        "all_flat_nets",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
-    /// (number in [0, 1]), `merge_close` (number in [0, 0.05]), `split_search`, `corner_search`
-    /// and `apex_search` (booleans) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
+    /// (number in [0, 1]), `merge_close` (number in [0, 0.05]), `split_search`, `corner_search`,
+    /// `apex_search` and `all_flat_nets` (booleans) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -289,6 +297,7 @@ impl InnerOptions {
             ("split_search", &mut o.split_search),
             ("corner_search", &mut o.corner_search),
             ("apex_search", &mut o.apex_search),
+            ("all_flat_nets", &mut o.all_flat_nets),
         ] {
             match table.get(key) {
                 None => {}
@@ -464,7 +473,7 @@ fn build_searched(
     let none = std::collections::BTreeSet::new();
     let (hull, report, bent) = build_with(mesh, normals, options, &none, &[], &[])?;
     // Merged regions whose triangles of T overlap get flat nets too ([`overlapnet`]).
-    let (hull, report) = if report.flat_nets == 0 {
+    let (hull, report) = if report.flat_nets == 0 && !options.all_flat_nets {
         (hull, report)
     } else {
         overlapnet::force_nets(hull, report, |forced| {
@@ -675,7 +684,14 @@ fn build_with(
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.
     let mut net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
     // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
-    let flat = flatnet::spread_guards_forced(&mut net, mesh, &merged_counts, Some(normals), nets);
+    let flat = flatnet::spread_guards_forced(
+        &mut net,
+        mesh,
+        &merged_counts,
+        Some(normals),
+        nets,
+        options.all_flat_nets,
+    );
     report.flat_nets = flat.groups.len();
     report.flat_net_candidates.clone_from(&flat.eligible);
     report.overlap_nets = nets.iter().copied().collect();

@@ -44,6 +44,7 @@
 //! mesh. The 2001 rational scheme accepts boundary edges; the 1994 inner-hull schemes need a
 //! closed mesh.
 
+pub mod clean;
 pub mod convexity;
 pub mod geometry;
 mod load;
@@ -61,6 +62,7 @@ mod triangulate;
 mod validate;
 pub mod weld;
 
+pub use clean::{clean, CleanReport};
 pub use load::{from_polygons, load, load_bytes, Format};
 pub use normals::{above_face_failures, loop_limit_normal, vertex_normals, NormalMethod};
 pub use orient::signed_volume;

@@ -169,19 +169,22 @@ pub fn spread_guards_folded(
     merged: &[usize],
     normals: Option<&[DVec3]>,
 ) -> FlatNets {
-    spread_guards_forced(net, mesh, merged, normals, &BTreeSet::new())
+    spread_guards_forced(net, mesh, merged, normals, &BTreeSet::new(), false)
 }
 
 /// [`spread_guards_folded`], also giving a flat net to every merged polygon whose input face
 /// (`mesh.face_parent`) is in `forced` (the polygons whose triangles of T overlapped in an
 /// earlier build, [`super::overlapnet`]), when it has the structure a net needs (several
-/// input faces, at least [`MIN_CORNERS`] corners, one region, a guard polygon).
+/// input faces, at least [`MIN_CORNERS`] corners, one region, a guard polygon). With
+/// `everywhere` (`InnerOptions::all_flat_nets`) every polygon with that structure qualifies,
+/// merged or not, near or far.
 pub fn spread_guards_forced(
     net: &mut GuardNet,
     mesh: &Mesh,
     merged: &[usize],
     normals: Option<&[DVec3]>,
     forced: &BTreeSet<u32>,
+    everywhere: bool,
 ) -> FlatNets {
     let pos = &mesh.positions;
     let mut out = FlatNets::default();
@@ -205,7 +208,8 @@ pub fn spread_guards_forced(
             }
             let own = of_face[&f].clone();
             let face = mesh.faces[f as usize].clone();
-            if face.len() < MIN_CORNERS || merged.get(f as usize).copied().unwrap_or(1) < 2 {
+            let merged_region = merged.get(f as usize).copied().unwrap_or(1) >= 2;
+            if face.len() < MIN_CORNERS || !(merged_region || everywhere) {
                 continue;
             }
             let mut sorted = face.clone();
@@ -230,13 +234,14 @@ pub fn spread_guards_forced(
                 .collect();
             let Some(fans) = fans else { continue };
             let k = face.len();
-            let far = (0..k).any(|i| {
-                let p = |j: usize| pos[face[j % k] as usize];
-                let v = p(i);
-                let e = (p(i + 1) - v).length().max((p(i + k - 1) - v).length());
-                let g = net.pieces.center[fans[i].0.faces[fans[i].1] as usize];
-                (g - v).length() > super::decompose::GUARD_REACH * e
-            });
+            let far = everywhere
+                || (0..k).any(|i| {
+                    let p = |j: usize| pos[face[j % k] as usize];
+                    let v = p(i);
+                    let e = (p(i + 1) - v).length().max((p(i + k - 1) - v).length());
+                    let g = net.pieces.center[fans[i].0.faces[fans[i].1] as usize];
+                    (g - v).length() > super::decompose::GUARD_REACH * e
+                });
             // Only strips: convex polygons with a straight corner (a vertex of the old
             // triangulation on an edge; fandisk's folds), so no other model's hull changes.
             let corner_turn = |i: usize| {
