@@ -1062,6 +1062,19 @@ irradiance = 2.0
                 "{model}: {e}"
             );
         }
+        // `model.clean`: the 1994 schemes only, within the weld's range.
+        let s = parse(&with("clean = 1e-3", "cubic-c1"), Path::new("s.toml")).unwrap();
+        assert!(matches!(s.model, Model::Mesh { clean: Some(c), .. } if c == 1e-3));
+        for (model, scheme) in [("clean = 0.5", "cubic-c1"), ("clean = 1e-3", "rational-c1")] {
+            let e = format!(
+                "{:#}",
+                parse(&with(model, scheme), Path::new("a/b.toml")).unwrap_err()
+            );
+            assert!(
+                e.contains("a/b.toml") && e.contains("model.clean"),
+                "{model}: {e}"
+            );
+        }
         let patches = MINIMAL.replace(
             "patches = \"sphere.json\"",
             "patches = \"p.json\"\nsubdivide = { levels = 1 }",
@@ -1131,12 +1144,14 @@ irradiance = 2.0
             file,
             normals,
             scheme,
+            clean,
             ..
         } = &sc.model
         else {
             panic!("{}: a mesh scene", sc.path.display());
         };
-        let (m, _) = mesh::load(file).unwrap();
+        // The polyhedron the build uses (the pending mpi_poly scene cleans its model).
+        let (m, _, _) = polyhedron_1994(file, *clean).unwrap();
         let vn = mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
         (m, vn, scheme)
     }

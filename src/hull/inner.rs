@@ -843,7 +843,7 @@ fn build_with(
     report.flipped_folds = unfold::flip_folds(&mut hull, &mesh.positions);
     report.umbrella_normals = umbrella::face_fans(&mut hull);
     report.flipped_slits = slit::flip_slits(&mut hull, &mesh.positions);
-    report.sides = sides::settle(&mut hull);
+    report.sides = sides::settle(&mut hull, options.apex_search);
     report.wedged = wedge::keep_in_wedges(&mut hull);
     report.lifted_apexes = clearance::lift_apexes(&mut hull);
     report.degenerate_repaired =

@@ -72,6 +72,7 @@ fn join_across_zero_edges(
     hull: &SimplicialHull,
     edges: &[crate::hull::simplicial::HullEdge],
     required: &mut [[bool; 2]],
+    guard_edges: bool,
 ) -> usize {
     let zero: Vec<(usize, usize)> = edges
         .iter()
@@ -91,7 +92,17 @@ fn join_across_zero_edges(
         // (`reapex`) now clears; left out, mpi_poly kept 3 of these edges without edge
         // tetrahedra (6 hull violations instead of 3; every other 1994 scene but the nut is
         // byte-identical, and the nut still verifies). Without the search the overlaps stay:
-        // mpi_poly's raw hull has 300 violations instead of 211.
+        // mpi_poly's raw hull has 300 violations instead of 211. So they are joined only with
+        // `guard_edges` (the hull's `apex_search`): joined without the search they changed the
+        // nut's hull, whose quintic with `repair_holes` then kept 4 holes and 1 j-sheet
+        // instead of 1 and 0 (bisected in session 26).
+        .filter(|e| {
+            guard_edges
+                || !e
+                    .v
+                    .iter()
+                    .all(|&i| matches!(hull.origins[i as usize], PointOrigin::CornerGuard { .. }))
+        })
         .map(|e| (e.faces[0] as usize, e.faces[1] as usize))
         .filter(|&(f, g)| f < required.len() && g < required.len())
         .collect();
@@ -242,7 +253,9 @@ pub(super) fn apexes_along(
 /// apexes over the base where a side is missing or an apex is not over its base (module docs).
 /// Triangles all of whose edges are zero convex (coplanar groups, Appendix B) keep theirs,
 /// unless a flat neighbour shares no side with them ([`join_across_zero_edges`]).
-pub fn settle(hull: &mut SimplicialHull) -> SideCounts {
+/// Edges of T between two corner guards are joined only with `guard_edges` (the apex search
+/// clears the overlaps their rebuilt apexes make).
+pub fn settle(hull: &mut SimplicialHull, guard_edges: bool) -> SideCounts {
     let mut counts = SideCounts::default();
     let Ok(edges) = hull.edges() else {
         return counts;
@@ -263,7 +276,7 @@ pub fn settle(hull: &mut SimplicialHull) -> SideCounts {
             }
         }
     }
-    counts.coplanar_joined = join_across_zero_edges(hull, &edges, &mut required);
+    counts.coplanar_joined = join_across_zero_edges(hull, &edges, &mut required, guard_edges);
     let mut rebuilt = vec![false; hull.triangles.len()];
     for (t, &req) in required.iter().enumerate() {
         if !req[0] && !req[1] {
@@ -451,19 +464,26 @@ mod tests {
         };
         let edges = hull.edges().unwrap();
         let mut required = vec![[false; 2]; 2];
-        let joined = join_across_zero_edges(&hull, &edges, &mut required);
+        let joined = join_across_zero_edges(&hull, &edges, &mut required, false);
         assert_eq!(joined, 1);
         assert_eq!(required, vec![[true, true]; 2]);
-        // The same edge between two corner guards (a guard-net edge) is joined the same way.
+        // The same edge between two corner guards (a guard-net edge) is joined the same way
+        // with `guard_edges` (the apex search), and left to the net without.
         let mut guarded = hull.clone();
         guarded.origins[1] = PointOrigin::CornerGuard { face: 0 };
         guarded.origins[2] = PointOrigin::CornerGuard { face: 0 };
         let mut req2 = vec![[false; 2]; 2];
-        assert_eq!(join_across_zero_edges(&guarded, &edges, &mut req2), 1);
+        assert_eq!(join_across_zero_edges(&guarded, &edges, &mut req2, true), 1);
         assert_eq!(req2, vec![[true, true]; 2]);
+        let mut req3 = vec![[false; 2]; 2];
+        assert_eq!(
+            join_across_zero_edges(&guarded, &edges, &mut req3, false),
+            0
+        );
+        assert_eq!(req3, vec![[false; 2]; 2]);
         // Through settle: both triangles end with apexes on both sides, the outer one above
         // the plane z = 0 and the inner one below it.
-        let counts = settle(&mut hull);
+        let counts = settle(&mut hull, false);
         assert_eq!(counts.coplanar_joined, 1);
         for t in 0..2 {
             let [o, i] = hull.apexes[t];
