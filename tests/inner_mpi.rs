@@ -359,6 +359,21 @@ fn mpi_poly_corner_74_gets_its_own_guard_of_face_8() {
     );
 }
 
+/// The pending scene (cleaned, guard nets everywhere) checked as `apatch check` does: no
+/// boundary face crossed. Its last 4 holes were the faces of an edge tetrahedron beside a
+/// two-triangle step (5') cell over a concave edge, whose apex (the midpoint of a trihedral
+/// corner's apex at V and the edge's midpoint) lay on the edge itself, in both tangent planes;
+/// the cells over concave edges now take their apexes into the polyhedron
+/// (`guardnet::cell_lift`).
+#[test]
+fn mpi_poly_scene_has_no_holes() {
+    let scene = apatch::scene::load(Path::new("scenes/pending/paper1994/mpi_poly.toml")).unwrap();
+    let built = apatch::scene::build_scene(&scene).unwrap();
+    let report = apatch::check::check(&built.complex, &apatch::check::CheckOptions::default());
+    assert_eq!(report.holes.crossing, 0, "{:?}", report.holes);
+    assert!(inner::verify(built.hull.as_ref().unwrap()).is_empty());
+}
+
 /// `model.clean` on mpi_poly (the pending scene's tolerance, 1e-3 of the diagonal) leaves a
 /// closed polyhedron with planar faces and no needle: checked on the result directly, not on
 /// the clean's own report.

@@ -432,6 +432,15 @@ impl GuardNet {
             } else {
                 None
             };
+            // Over a concave edge the two-triangle cell's apexes go into the polyhedron as a
+            // one-triangle cell's do (`cell_lift`): the corner triangles' apexes can lie on the
+            // edge itself (a trihedral corner's apex at V), and their midpoints with M then lie
+            // in both tangent planes.
+            let inward = if cell_concave(hull, positions, cell) {
+                cell_lift(hull, positions, cell, g2)
+            } else {
+                DVec3::ZERO
+            };
             let mut push = |tri: [u32; 3], apexes: Vec<DVec3>| {
                 let [a, b, c] = tri.map(|i| hull.points[i as usize]);
                 let mut slot = [None, None];
@@ -444,9 +453,11 @@ impl GuardNet {
                 hull.apexes.push(slot);
                 hull.element.push(cell.v[0]);
             };
-            let half = |qs: &[DVec3]| -> Vec<DVec3> { qs.iter().map(|&q| 0.5 * (q + m)).collect() };
+            let half = |qs: &[DVec3]| -> Vec<DVec3> {
+                qs.iter().map(|&q| 0.5 * (q + m) + inward).collect()
+            };
             // One triangle: apex on V_1V_2 (M, or where `cell_slides` puts it), moved out of
-            // the polyhedron along the bisector of the two faces' normals by CELL_LIFT of the
+            // (over a concave edge: into) the polyhedron along the bisector of the two faces' normals by CELL_LIFT of the
             // single guard's distance from the edge (at most CELL_LIFT_REACH edge lengths).
             // The edge lies in both face planes (the guards' tangent planes); moved outwards the apex stays tangent-containing (the triangle's points are on the planes' inner sides or on
             // them). With M itself, the edge tetrahedra between two such cells over one net
@@ -653,7 +664,23 @@ fn cell_lift(hull: &SimplicialHull, positions: &[DVec3], cell: &EdgeCell, g: u32
         (hull.normals[cell.g[0] as usize] + hull.normals[cell.g[2] as usize]).normalize_or_zero();
     let d = hull.points[g as usize] - v1;
     let reach = (d - d.dot(e) * e).length();
-    CELL_LIFT * reach.min(CELL_LIFT_REACH * (v2 - v1).length()) * out
+    // Over a concave edge (f_2's guard above f_1's plane) out of the polyhedron is above both
+    // tangent planes, where the cell's apex, on the inner side of its triangle, is not tangent
+    // containing, and `clearance` then pulls it back onto the edge itself (mpi_poly cleaned: a
+    // cell beside a flat net, whose edge tetrahedron's face was crossed); such an apex goes
+    // into the polyhedron, below both planes.
+    let sign = if cell_concave(hull, positions, cell) {
+        -1.0
+    } else {
+        1.0
+    };
+    sign * CELL_LIFT * reach.min(CELL_LIFT_REACH * (v2 - v1).length()) * out
+}
+
+/// True when the cell's edge V_1V_2 is concave: f_2's guard G_3 lies above f_1's plane.
+fn cell_concave(hull: &SimplicialHull, positions: &[DVec3], cell: &EdgeCell) -> bool {
+    let v1 = positions[cell.v[0] as usize];
+    hull.normals[cell.g[0] as usize].dot(hull.points[cell.g[2] as usize] - v1) > 0.0
 }
 
 /// Cap on the guard distance [`cell_lift`] scales by, in units of the cell's edge V_1V_2: the
