@@ -371,6 +371,11 @@ fn mpi_poly_scene_has_no_holes() {
     let built = apatch::scene::build_scene(&scene).unwrap();
     let report = apatch::check::check(&built.complex, &apatch::check::CheckOptions::default());
     assert_eq!(report.holes.crossing, 0, "{:?}", report.holes);
+    // And single sheeted along every j-line: its last one crossed twice at corner 71, an L-U
+    // pair's outer apex on all three tangent planes over a base with a concave edge, now
+    // moved off the planes (`cubic_c1::tangent`). So the scene passes `check`.
+    assert_eq!(report.sheets.j_multi_lines, 0, "{:?}", report.sheets);
+    assert!(report.passed(), "{:?}", report.failures());
     assert!(inner::verify(built.hull.as_ref().unwrap()).is_empty());
 }
 

@@ -62,8 +62,11 @@ pub fn worst_slope(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> f64
 }
 
 /// The apex `q` of triangle `t` on `side`, moved along σ·m until every slope is at least
-/// [`TANGENT_MARGIN`] (up to 1e-6 relative); `None` when a vertex normal is too close to the
-/// triangle's plane ([`MIN_RATE`]) or the move would exceed [`MAX_LIFT`].
+/// [`TANGENT_MARGIN`] (up to 1e-6 relative). Where σ·m raises some slope by less than
+/// [`MIN_RATE`] (a vertex normal nearly in the triangle's plane, or tilted away from m), it
+/// moves instead along the direction d with d·n_k = σ at all three points (every slope rises
+/// alike), when d points to the apex's side; `None` when neither direction has the rate or the
+/// move would exceed [`MAX_LIFT`].
 #[must_use]
 pub fn contained_apex(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> Option<DVec3> {
     let tri = hull.triangles[t].map(|v| hull.points[v as usize]);
@@ -73,14 +76,27 @@ pub fn contained_apex(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> 
         .map(|k| (tri[k] - tri[(k + 1) % 3]).length())
         .fold(0.0, f64::max);
     let s = sign(side);
-    let away = s * m;
+    let mut away = s * m;
+    if normals.iter().any(|n| away.dot(*n) * s <= MIN_RATE) {
+        // The direction raising every slope alike: d · n_k = σ for all three points (mpi_poly
+        // cleaned, corner 71: a normal at −0.05 to the triangle's).
+        let nm = glam::DMat3::from_cols(normals[0], normals[1], normals[2]).transpose();
+        if nm.determinant().abs() > 1e-6 {
+            let d = nm.inverse() * DVec3::splat(s);
+            if let Some(d) = d.try_normalize() {
+                if d.dot(s * m) > 0.0 {
+                    away = d;
+                }
+            }
+        }
+    }
     let mut p = q;
     // The margin grows with |p − p_k| as p moves: a few rounds reach it (each round's shortfall
     // shrinks by the factor TANGENT_MARGIN / rate ≤ 1/2).
     for _ in 0..30 {
         let mut step = 0.0f64;
         for (pk, nk) in tri.iter().zip(&normals) {
-            let rate = m.dot(*nk);
+            let rate = s * away.dot(*nk);
             let need = TANGENT_MARGIN * (p - *pk).length() - s * (p - *pk).dot(*nk);
             if need <= 0.0 {
                 // Met; the final check sees it if later steps (rate < 0) undo it.
@@ -102,6 +118,29 @@ pub fn contained_apex(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> 
     (worst_slope(hull, t, side, p) >= TANGENT_MARGIN - 1e-6).then_some(p)
 }
 
+/// True when triangle `t`'s base is not one-signed for `side` and the apex is an L-U pair's:
+/// some base point p_l lies beyond another's tangent plane on the side's sign,
+/// σ(p_l − p_k)·n_k > 0 (a concave edge of T under the apex: number 1 weights of the base with
+/// the apex's sign). With the apex on all three tangent planes (Algorithm 1's step (3) apex V
+/// of a trihedral corner) the face tetrahedron's level-1 weights toward the apex are only the
+/// edge blossoms, and where those have the other sign the lines from the apex to the base
+/// points near the surface cross it twice whatever the apex weights (mpi_poly cleaned: corner
+/// 71, whose faces 6 and 7 meet at a 41° groove).
+fn mixed_base(hull: &SimplicialHull, t: usize, side: Side) -> bool {
+    if hull.apexes[t].iter().any(Option::is_none) {
+        return false;
+    }
+    let s = sign(side);
+    let tri = hull.triangles[t];
+    (0..3).any(|k| {
+        let (pk, nk) = (hull.points[tri[k] as usize], hull.normals[tri[k] as usize]);
+        (0..3).filter(|&l| l != k).any(|l| {
+            let d = hull.points[tri[l] as usize] - pk;
+            s * d.dot(nk) > TANGENT_TOL * d.length()
+        })
+    })
+}
+
 /// `hull` with every apex that lies beyond one of its triangle's tangent planes (slope below
 /// −[`TANGENT_TOL`]) moved by [`contained_apex`], the (triangle, side) pairs moved, and how many
 /// such apexes could not be moved.
@@ -115,7 +154,8 @@ pub fn contain_tangents(hull: &SimplicialHull) -> (SimplicialHull, Vec<(usize, S
             let Some(q) = hull.apexes[t][side as usize] else {
                 continue;
             };
-            if worst_slope(hull, t, side, q) >= -TANGENT_TOL {
+            let slope = worst_slope(hull, t, side, q);
+            if slope >= -TANGENT_TOL && !(slope <= TANGENT_TOL && mixed_base(hull, t, side)) {
                 continue;
             }
             match contained_apex(hull, t, side, q) {
@@ -177,6 +217,41 @@ mod tests {
         let (out, moved, stuck) = contain_tangents(&h);
         assert!(moved.is_empty() && stuck == 1);
         assert_eq!(out.apexes, h.apexes);
+    }
+
+    /// An L-U pair's outer apex on all three tangent planes (as Algorithm 1's apex V of a
+    /// trihedral corner is) over a base with a concave edge (p_1 beyond p_0's tangent plane on
+    /// the outer side): moved off the planes to the margin (slopes checked by the dot products).
+    /// The same apex over a single-sided triangle stays where it is.
+    #[test]
+    fn on_plane_apex_over_a_mixed_base_is_moved() {
+        let q = DVec3::new(0.3, 0.3, 0.5);
+        let mut h = hull(DVec3::new(0.3, 0.3, -2.0));
+        h.apexes[0][0] = Some(q);
+        // Each normal orthogonal to q − p_k.
+        h.normals = vec![
+            DVec3::new(1.0, -5.0 / 3.0, 0.4).normalize(),
+            DVec3::new(0.0, -5.0, 3.0).normalize(),
+            DVec3::new(-0.5, 0.0, 0.3).normalize(),
+        ];
+        for k in 0..3 {
+            assert!((q - h.points[k]).dot(h.normals[k]).abs() < 1e-12);
+        }
+        assert!((h.points[1] - h.points[0]).dot(h.normals[0]) > 0.0);
+        let (out, moved, stuck) = contain_tangents(&h);
+        assert_eq!((moved, stuck), (vec![(0, Side::Outer)], 0));
+        assert_eq!(out.apexes[0][1], h.apexes[0][1]);
+        let p = out.apexes[0][0].expect("apex");
+        for (pk, nk) in h.points.iter().zip(&h.normals) {
+            let slope = (p - *pk).dot(*nk) / (p - *pk).length();
+            // The margin, up to the last round's growth of |p − p_k| (1e-6 relative).
+            assert!(slope >= TANGENT_MARGIN - 1e-6, "{slope}");
+        }
+        let mut single = h.clone();
+        single.apexes[0][1] = None;
+        let (out, moved, stuck) = contain_tangents(&single);
+        assert!(moved.is_empty() && stuck == 0);
+        assert_eq!(out.apexes, single.apexes);
     }
 
     /// A deep inner apex already on its side of every tangent plane is left alone.
