@@ -1150,7 +1150,7 @@ irradiance = 2.0
         else {
             panic!("{}: a mesh scene", sc.path.display());
         };
-        // The polyhedron the build uses (the pending mpi_poly scene cleans its model).
+        // The polyhedron the build uses (mpi_poly's scene cleans its model).
         let (m, _, _) = polyhedron_1994(file, *clean).unwrap();
         let vn = mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
         (m, vn, scheme)
@@ -1175,14 +1175,17 @@ irradiance = 2.0
             .unwrap()
             .unwrap();
         let mut scenes = vec![shaped];
-        for name in ["cube", "hallway_corner", "cube_quintic", "l_prism_quintic"] {
+        // mpi_poly: the apex search moves apexes again after the cubic's own changes, and its
+        // model is cleaned (`model.clean`): every path to the cubic's patches must do both.
+        for name in [
+            "cube",
+            "hallway_corner",
+            "cube_quintic",
+            "l_prism_quintic",
+            "mpi_poly",
+        ] {
             scenes.push(load(&paper1994(name)).unwrap());
         }
-        // The apex search moves apexes again after the cubic's own changes (one on mpi_poly):
-        // every path to the cubic's patches must make that move.
-        let mpi =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/pending/paper1994/mpi_poly.toml");
-        scenes.push(load(&mpi).unwrap());
         for (k, sc) in scenes.iter().enumerate() {
             let name = sc.path.display();
             let built = build_scene(sc).unwrap();

@@ -345,9 +345,24 @@ fn convex_triangles_stay_single_sided() {
         let (_, changed) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
         assert!(changed.is_empty(), "{name}: {changed:?}");
         // Their apexes are on their side of every tangent plane already (Lemma 4.2 for convex
-        // face tetrahedra): `tangent` moves none.
+        // face tetrahedra): `tangent` moves none that lies beyond one. Since session 26 it
+        // moves L-U apexes lying *on* all their planes over a base with a concave edge (the
+        // prisms' and the corner's reflex edges), off them; none is stuck, and the convex solids
+        // have none.
         let (_, moved, stuck) = apatch::scheme::cubic_c1::tangent::contain_tangents(&hull);
-        assert!(moved.is_empty() && stuck == 0, "{name}: {moved:?}");
+        assert_eq!(stuck, 0, "{name}");
+        for &(t, side) in &moved {
+            let q = hull.apexes[t][side as usize].unwrap();
+            let slope = apatch::scheme::cubic_c1::tangent::worst_slope(&hull, t, side, q);
+            assert!(
+                slope.abs() <= apatch::scheme::cubic_c1::tangent::TANGENT_TOL,
+                "{name}: apex {t} {side:?} moved from slope {slope}"
+            );
+            assert!(hull.apexes[t].iter().all(Option::is_some), "{name}: {t}");
+        }
+        if !["l_prism.obj", "star_prism.obj", "corner_poly.obj"].contains(&name) {
+            assert!(moved.is_empty(), "{name}: {moved:?}");
+        }
     }
 }
 

@@ -1,7 +1,7 @@
 //! mpi_poly's inner hull (1994, `hull::inner`): nearly flat folds and needle faces.
 //!
 //! The survey (`cargo test --test inner_mpi -- --ignored --nocapture`) prints the hull
-//! violations of `scenes/pending/paper1994/mpi_poly.toml` by kind and by the input element their
+//! violations of `scenes/paper1994/mpi_poly.toml` by kind and by the input element their
 //! triangles were built for, for the raw hull and the hull the cubic scheme fills.
 
 use apatch::hull::inner::{self, HullViolation, InnerOptions};
@@ -130,7 +130,7 @@ fn mpi_poly_survey() {
         }
     }
     tally("raw hull", &hull, &m.positions);
-    let scene = apatch::scene::load(Path::new("scenes/pending/paper1994/mpi_poly.toml")).unwrap();
+    let scene = apatch::scene::load(Path::new("scenes/paper1994/mpi_poly.toml")).unwrap();
     let prepared = apatch::scene::inner_hull(&scene).unwrap().unwrap();
     tally("scheme's hull", &prepared, &m.positions);
 }
@@ -345,7 +345,7 @@ fn mpi_poly_corner_74_gets_its_own_guard_of_face_8() {
     // 8 violations (211 raw, 219 after the scheme's moves) but no degenerate tetrahedron; the
     // bound is the count's (2 since session 25's apex search: ridge and midpoint planes,
     // missed tangent planes; 219 before, 288 before the shortest lift, 396 before the nudges).
-    let scene = apatch::scene::load(Path::new("scenes/pending/paper1994/mpi_poly.toml")).unwrap();
+    let scene = apatch::scene::load(Path::new("scenes/paper1994/mpi_poly.toml")).unwrap();
     let prepared = apatch::scene::inner_hull(&scene).unwrap().unwrap();
     // Since session 26 the scene cleans the model (`model.clean`) and gives every polygon a
     // guard net (`all_flat_nets`): its hull verifies.
@@ -367,7 +367,7 @@ fn mpi_poly_corner_74_gets_its_own_guard_of_face_8() {
 /// (`guardnet::cell_lift`).
 #[test]
 fn mpi_poly_scene_has_no_holes() {
-    let scene = apatch::scene::load(Path::new("scenes/pending/paper1994/mpi_poly.toml")).unwrap();
+    let scene = apatch::scene::load(Path::new("scenes/paper1994/mpi_poly.toml")).unwrap();
     let built = apatch::scene::build_scene(&scene).unwrap();
     let report = apatch::check::check(&built.complex, &apatch::check::CheckOptions::default());
     assert_eq!(report.holes.crossing, 0, "{:?}", report.holes);

@@ -18,7 +18,8 @@
 //! face tetrahedra sharing G_1G_3 (V_1's) and G_2G_4 (V_2's). When G_1 = G_2 (or G_3 = G_4) the
 //! cell is one triangle with apex M. Beyond the paper: that apex is moved out of the
 //! polyhedron ([`CELL_LIFT`]; with M itself the edge tetrahedra over a net edge, between two
-//! such cells, are flat) and slid along V_1V_2 so that the midpoint s of the two apexes over a
+//! such cells, are flat; over a concave edge into it, and the two-triangle cell's apexes with
+//! it, so that no apex lies on both faces' planes) and slid along V_1V_2 so that the midpoint s of the two apexes over a
 //! net edge lies over that edge (else the cubic scheme cannot make those edge tetrahedra single
 //! sheeted: letter_P showed a spurious sheet). The guard net of a region is the set of guard
 //! pairs these cells use; T is a closed manifold when every pair is walked once in each direction round
