@@ -53,29 +53,10 @@ fn bbox_diagonal(positions: &[DVec3]) -> f64 {
 }
 
 /// `face` with merged corners: representatives substituted, cyclic repeats and spikes
-/// (x, y, x) removed.
+/// (x, y, x) removed ([`crate::mesh::clean::collapse`]).
 fn collapse(face: &[u32], rep: &[u32]) -> Vec<u32> {
-    let mut f: Vec<u32> = face.iter().map(|&v| rep[v as usize]).collect();
-    loop {
-        let n = f.len();
-        if n < 3 {
-            return f;
-        }
-        // A repeated neighbour (cyclically) or a spike a, b, a: remove one or two corners.
-        if let Some(k) = (0..n).find(|&k| f[k] == f[(k + 1) % n]) {
-            f.remove(k);
-            continue;
-        }
-        if let Some(k) = (0..n).find(|&k| f[k] == f[(k + 2) % n]) {
-            // Corners k+1 and k+2 go (the spike's tip and its return).
-            let (a, b) = ((k + 1) % n, (k + 2) % n);
-            let (hi, lo) = (a.max(b), a.min(b));
-            f.remove(hi);
-            f.remove(lo);
-            continue;
-        }
-        return f;
-    }
+    let f: Vec<u32> = face.iter().map(|&v| rep[v as usize]).collect();
+    crate::mesh::clean::collapse(&f)
 }
 
 /// Merges the vertices of `mesh` that share a polygon and lie closer than `t` × the bounding
