@@ -325,9 +325,10 @@ fn mpi_poly_corner_74_gets_its_own_guard_of_face_8() {
     // edges between two corner guards ask their triangles for both sides too
     // (`sides::join_across_zero_edges`), and the apexes rebuilt over their bases overlap
     // until the apex search (which the scene sets) moves them; the scene's hull below has 2.
-    // The bounds leave the counts no room to grow back.
+    // Since session 26 those edges are joined only with the apex search (the nut quintic's
+    // holes), so this raw hull has 223. The bounds leave the counts no room to grow back.
     let v = inner::verify(&hull);
-    assert!(v.len() <= 300, "{} violations", v.len());
+    assert!(v.len() <= 223, "{} violations", v.len());
     let named74 = v
         .iter()
         .filter(|x| {
