@@ -404,16 +404,22 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     })
                 }
             };
-            if let Some(w) = m.weld {
-                if !(0.0..=mesh::weld::MAX_WELD_TOLERANCE).contains(&w) {
-                    return Err(bad(
-                        "model.weld",
+            // `model.weld` and `model.clean` share the weld's range.
+            let in_weld_range = |key: &str, t: f64| {
+                if (0.0..=mesh::weld::MAX_WELD_TOLERANCE).contains(&t) {
+                    Ok(())
+                } else {
+                    Err(bad(
+                        key,
                         format!(
-                            "{w} is not in [0, {}] (relative to the bounding-box diagonal)",
+                            "{t} is not in [0, {}] (relative to the bounding-box diagonal)",
                             mesh::weld::MAX_WELD_TOLERANCE
                         ),
-                    ));
+                    ))
                 }
+            };
+            if let Some(w) = m.weld {
+                in_weld_range("model.weld", w)?;
                 if scheme.get("type").and_then(|v| v.as_str()) != Some("rational-c1") {
                     return Err(bad(
                         "model.weld",
@@ -422,15 +428,7 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                 }
             }
             if let Some(c) = m.clean {
-                if !(0.0..=mesh::weld::MAX_WELD_TOLERANCE).contains(&c) {
-                    return Err(bad(
-                        "model.clean",
-                        format!(
-                            "{c} is not in [0, {}] (relative to the bounding-box diagonal)",
-                            mesh::weld::MAX_WELD_TOLERANCE
-                        ),
-                    ));
-                }
+                in_weld_range("model.clean", c)?;
                 if !matches!(
                     scheme.get("type").and_then(|v| v.as_str()),
                     Some("cubic-c1" | "quintic-c2")
@@ -1052,28 +1050,20 @@ irradiance = 2.0
         }
         let s = parse(&with("weld = 1e-3", "rational-c1"), Path::new("s.toml")).unwrap();
         assert!(matches!(s.model, Model::Mesh { weld: Some(w), .. } if w == 1e-3));
-        for (model, scheme) in [("weld = 0.5", "rational-c1"), ("weld = 1e-3", "quintic-c2")] {
-            let e = format!(
-                "{:#}",
-                parse(&with(model, scheme), Path::new("a/b.toml")).unwrap_err()
-            );
-            assert!(
-                e.contains("a/b.toml") && e.contains("model.weld"),
-                "{model}: {e}"
-            );
-        }
         // `model.clean`: the 1994 schemes only, within the weld's range.
         let s = parse(&with("clean = 1e-3", "cubic-c1"), Path::new("s.toml")).unwrap();
         assert!(matches!(s.model, Model::Mesh { clean: Some(c), .. } if c == 1e-3));
-        for (model, scheme) in [("clean = 0.5", "cubic-c1"), ("clean = 1e-3", "rational-c1")] {
+        for (model, scheme, key) in [
+            ("weld = 0.5", "rational-c1", "model.weld"),
+            ("weld = 1e-3", "quintic-c2", "model.weld"),
+            ("clean = 0.5", "cubic-c1", "model.clean"),
+            ("clean = 1e-3", "rational-c1", "model.clean"),
+        ] {
             let e = format!(
                 "{:#}",
                 parse(&with(model, scheme), Path::new("a/b.toml")).unwrap_err()
             );
-            assert!(
-                e.contains("a/b.toml") && e.contains("model.clean"),
-                "{model}: {e}"
-            );
+            assert!(e.contains("a/b.toml") && e.contains(key), "{model}: {e}");
         }
         let patches = MINIMAL.replace(
             "patches = \"sphere.json\"",

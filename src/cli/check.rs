@@ -162,30 +162,41 @@ type HullRepairs = (
 /// What the 1994 schemes' close-vertex merge (`hull::inner::close`, opt-in) and planar split
 /// (`hull::inner::planar`) do to the scene's mesh: each with its threshold, `None` when it
 /// changes nothing (or the scene is no mesh scene). The split's faces are the input's.
-fn hull_repairs(scene: &apatch::scene::Scene) -> anyhow::Result<HullRepairs> {
+/// `built` is the polyhedron the build used (1994 scenes: after `model.clean`); without it the
+/// scene's file is loaded.
+fn hull_repairs(
+    scene: &apatch::scene::Scene,
+    built: Option<&apatch::mesh::Mesh>,
+) -> anyhow::Result<HullRepairs> {
     let apatch::scene::Model::Mesh {
         file,
         scheme,
         normals,
-        clean,
         ..
     } = &scene.model
     else {
         return Ok((None, None));
     };
     let options = apatch::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
-    let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean)?;
+    let loaded;
+    let m = match built {
+        Some(m) => m,
+        None => {
+            loaded = apatch::mesh::load(file)?.0;
+            &loaded
+        }
+    };
     // The hull's normals, for the split's steep and folded corners (as `hull::inner` has them).
     let vn = normals
         .parse()
         .ok()
-        .and_then(|method| apatch::mesh::vertex_normals(&m, method).ok());
+        .and_then(|method| apatch::mesh::vertex_normals(m, method).ok());
     let merged = apatch::hull::inner::close::merge_close_vertices(
-        &m,
+        m,
         vn.as_deref().unwrap_or(&[]),
         options.merge_close,
     )?;
-    let mesh = merged.as_ref().map_or(&m, |c| &c.mesh);
+    let mesh = merged.as_ref().map_or(m, |c| &c.mesh);
     let vn = merged.as_ref().map_or(vn.as_deref(), |c| {
         (c.normals.len() == mesh.positions.len()).then_some(&c.normals[..])
     });
@@ -332,7 +343,8 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         _ => (None, None),
     };
     let (merged, split) = match &scene {
-        Some(s) => hull_repairs(s)?,
+        // 1994 scenes: the mesh the build loaded (and cleaned), not loaded and cleaned again.
+        Some(s) => hull_repairs(s, built.mesh.as_ref().filter(|_| is_1994(complex)))?,
         None => (None, None),
     };
     let hull_valid = hull.as_ref().is_none_or(Vec::is_empty);

@@ -29,6 +29,7 @@
 //! The result goes through [`super::from_polygons`] (orientation, validation); the inner hull
 //! then checks that it is a closed manifold.
 
+use super::geometry::bbox_diagonal;
 use super::{from_polygons, weld, Mesh, Report};
 use crate::error::{Error, Result};
 use glam::{DMat3, DVec3};
@@ -76,7 +77,7 @@ pub fn clean(mesh: &Mesh, relative: f64) -> Result<(Mesh, Report, CleanReport)> 
         welded: moved,
         ..CleanReport::default()
     };
-    let diag = diagonal(&welded.positions);
+    let diag = bbox_diagonal(&welded.positions);
     let tol = relative * diag;
     let pos = welded.positions.clone();
     let mut faces: Vec<Vec<u32>> = welded.faces.clone();
@@ -90,28 +91,38 @@ pub fn clean(mesh: &Mesh, relative: f64) -> Result<(Mesh, Report, CleanReport)> 
         .collect();
     two_face_vertices(&pos, &mut faces, tol, &mut report)?;
     let planar = planarise(&pos, &faces, diag);
-    report.planarity = max_deviation(&planar, &faces) / diag.max(f64::MIN_POSITIVE);
+    report.planarity =
+        max_deviation(&planar, &faces, &planes(&planar, &faces)) / diag.max(f64::MIN_POSITIVE);
     // The weld keeps each cluster's first position; measure the moves against the file.
     let (cleaned, validation) = from_polygons(planar, faces)?;
+    let mut file = mesh.positions.clone();
+    file.sort_by(|a, b| a.x.total_cmp(&b.x));
     report.max_move = cleaned
         .positions
         .iter()
-        .map(|p| {
-            mesh.positions
-                .iter()
-                .map(|q| q.distance(*p))
-                .fold(f64::INFINITY, f64::min)
-        })
+        .map(|&p| nearest_distance(&file, p))
         .fold(0.0, f64::max);
     Ok((cleaned, validation, report))
 }
 
-fn diagonal(p: &[DVec3]) -> f64 {
-    let Some(&first) = p.first() else { return 0.0 };
-    let (lo, hi) = p
-        .iter()
-        .fold((first, first), |(lo, hi), &q| (lo.min(q), hi.max(q)));
-    (hi - lo).length()
+/// The distance from `p` to the nearest of `sorted` (ordered by x; ∞ when empty): scans
+/// outwards from p's x until the x gap alone exceeds the best distance found.
+fn nearest_distance(sorted: &[DVec3], p: DVec3) -> f64 {
+    let at = sorted.partition_point(|q| q.x < p.x);
+    let mut best = f64::INFINITY;
+    for q in &sorted[at..] {
+        if q.x - p.x >= best {
+            break;
+        }
+        best = best.min(q.distance(p));
+    }
+    for q in sorted[..at].iter().rev() {
+        if p.x - q.x >= best {
+            break;
+        }
+        best = best.min(q.distance(p));
+    }
+    best
 }
 
 /// `face` without cyclically repeated corners and antennas (x, y, x: the corners y and the
@@ -181,7 +192,10 @@ fn split_t_junctions(pos: &[DVec3], faces: &mut [Vec<u32>], tol: f64) -> usize {
     inserted
 }
 
-/// Newell normal (unnormalised area vector) of a polygon.
+/// Newell's area vector summed about the origin (twice the area vector). Not
+/// [`super::geometry::area_vector`] (summed about the first corner): the two differ in
+/// rounding only, but the planarised positions, and with them mpi_poly's hull, depend on it
+/// (with that one mpi_poly's check fails on holes and j-sheets: measured).
 fn area_vector(pos: &[DVec3], face: &[u32]) -> DVec3 {
     let n = face.len();
     (0..n)
@@ -204,11 +218,9 @@ fn two_face_vertices(
                 of_vertex.entry(v).or_default().push(f);
             }
         }
-        let Some((&v, fs)) = of_vertex.iter().find(|(_, fs)| {
-            let mut u = (*fs).clone();
-            u.dedup();
-            u.len() <= 2
-        }) else {
+        // Each list is ascending (faces in order), so repeats are adjacent.
+        let distinct = |fs: &[usize]| 1 + fs.windows(2).filter(|w| w[0] != w[1]).count();
+        let Some((&v, fs)) = of_vertex.iter().find(|(_, fs)| distinct(fs) <= 2) else {
             return Ok(());
         };
         let (f, g) = (fs[0], fs[fs.len() - 1]);
@@ -281,17 +293,18 @@ fn merge_faces(f: &[u32], g: &[u32]) -> Option<Vec<u32>> {
     (out.len() == kept.len()).then_some(out)
 }
 
-/// Largest distance of a corner from its face's plane (Newell normal through the mean).
-fn max_deviation(pos: &[DVec3], faces: &[Vec<u32>]) -> f64 {
+/// Largest distance of a corner from its face's plane, `planes[f]` = (unit normal, offset).
+fn max_deviation(pos: &[DVec3], faces: &[Vec<u32>], planes: &[(DVec3, f64)]) -> f64 {
     faces
         .iter()
-        .map(|f| {
-            let (n, d) = plane(pos, f);
-            f.iter()
-                .map(|&v| (n.dot(pos[v as usize]) - d).abs())
-                .fold(0.0, f64::max)
-        })
+        .zip(planes)
+        .flat_map(|(f, &(n, d))| f.iter().map(move |&v| (n.dot(pos[v as usize]) - d).abs()))
         .fold(0.0, f64::max)
+}
+
+/// Every face's plane ([`plane`]).
+fn planes(pos: &[DVec3], faces: &[Vec<u32>]) -> Vec<(DVec3, f64)> {
+    faces.iter().map(|f| plane(pos, f)).collect()
 }
 
 fn plane(pos: &[DVec3], face: &[u32]) -> (DVec3, f64) {
@@ -310,14 +323,8 @@ fn planarise(pos: &[DVec3], faces: &[Vec<u32>], diag: f64) -> Vec<DVec3> {
         }
     }
     for round in 0..PLANAR_ROUNDS {
-        let planes: Vec<(DVec3, f64)> = faces.iter().map(|f| plane(&x, f)).collect();
-        let worst = faces
-            .iter()
-            .zip(&planes)
-            .flat_map(|(f, &(n, d))| f.iter().map(move |&v| (n, d, v)))
-            .map(|(n, d, v)| (n.dot(x[v as usize]) - d).abs())
-            .fold(0.0, f64::max);
-        if worst <= PLANAR_GOAL * diag {
+        let planes = planes(&x, faces);
+        if max_deviation(&x, faces, &planes) <= PLANAR_GOAL * diag {
             break;
         }
         // Anchored first (no drift along directions the planes leave free), then nearly free.
@@ -346,6 +353,34 @@ fn planarise(pos: &[DVec3], faces: &[Vec<u32>], diag: f64) -> Vec<DVec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sorted scan finds the same nearest distance as trying every point (a scattered
+    /// set from a fixed linear congruential sequence, queries inside and outside its range).
+    #[test]
+    fn nearest_distance_is_the_brute_force_minimum() {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+        };
+        let mut pts: Vec<DVec3> = (0..200)
+            .map(|_| DVec3::new(next(), next(), next()))
+            .collect();
+        let queries: Vec<DVec3> = (0..50)
+            .map(|_| 1.5 * DVec3::new(next(), next(), next()))
+            .collect();
+        pts.sort_by(|a, b| a.x.total_cmp(&b.x));
+        for q in queries {
+            let brute = pts
+                .iter()
+                .map(|p| p.distance(q))
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(nearest_distance(&pts, q), brute);
+        }
+        assert_eq!(nearest_distance(&[], DVec3::ZERO), f64::INFINITY);
+    }
 
     #[test]
     fn collapse_removes_repeats_and_antennas() {

@@ -17,6 +17,19 @@ pub fn area_vector(positions: &[DVec3], face: &[u32]) -> DVec3 {
     0.5 * s
 }
 
+/// The length of the bounding-box diagonal of `positions` (0 when empty): the scale relative
+/// tolerances (`model.clean`, `scheme.merge_close`) are measured in.
+#[must_use]
+pub fn bbox_diagonal(positions: &[DVec3]) -> f64 {
+    let Some(&first) = positions.first() else {
+        return 0.0;
+    };
+    let (lo, hi) = positions
+        .iter()
+        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    (hi - lo).length()
+}
+
 /// The largest distance from the first vertex to another vertex of the face (a length scale).
 #[must_use]
 pub fn face_size(positions: &[DVec3], face: &[u32]) -> f64 {

@@ -41,17 +41,6 @@ pub struct CloseMerge {
     pub dropped_faces: Vec<u32>,
 }
 
-/// The length of the bounding-box diagonal of `positions` (0 when empty).
-fn bbox_diagonal(positions: &[DVec3]) -> f64 {
-    let Some(&first) = positions.first() else {
-        return 0.0;
-    };
-    let (lo, hi) = positions
-        .iter()
-        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    (hi - lo).length()
-}
-
 /// `face` with merged corners: representatives substituted, cyclic repeats and spikes
 /// (x, y, x) removed ([`crate::mesh::clean::collapse`]).
 fn collapse(face: &[u32], rep: &[u32]) -> Vec<u32> {
@@ -71,7 +60,7 @@ pub fn merge_close_vertices(mesh: &Mesh, normals: &[DVec3], t: f64) -> Result<Op
         return Ok(None);
     }
     let nv = mesh.positions.len();
-    let reach = t * bbox_diagonal(&mesh.positions);
+    let reach = t * crate::mesh::geometry::bbox_diagonal(&mesh.positions);
     let mut uf = UnionFind::new(nv);
     let mut any = false;
     for face in &mesh.faces {

@@ -19,8 +19,8 @@
 //! cell is one triangle with apex M. Beyond the paper: that apex is moved out of the
 //! polyhedron ([`CELL_LIFT`]; with M itself the edge tetrahedra over a net edge, between two
 //! such cells, are flat; over a concave edge into it, and the two-triangle cell's apexes with
-//! it, so that no apex lies on both faces' planes) and slid along V_1V_2 so that the midpoint s of the two apexes over a
-//! net edge lies over that edge (else the cubic scheme cannot make those edge tetrahedra single
+//! it, so that no apex lies on both faces' planes) and slid along V_1V_2 so that the midpoint
+//! s of the two apexes over a net edge lies over that edge (else the cubic scheme cannot make those edge tetrahedra single
 //! sheeted: letter_P showed a spurious sheet). The guard net of a region is the set of guard
 //! pairs these cells use; T is a closed manifold when every pair is walked once in each direction round
 //! the region's boundary loops, which the guard assignment ([`GuardNet::build`]) searches for.
@@ -458,8 +458,9 @@ impl GuardNet {
                 qs.iter().map(|&q| 0.5 * (q + m) + inward).collect()
             };
             // One triangle: apex on V_1V_2 (M, or where `cell_slides` puts it), moved out of
-            // (over a concave edge: into) the polyhedron along the bisector of the two faces' normals by CELL_LIFT of the
-            // single guard's distance from the edge (at most CELL_LIFT_REACH edge lengths).
+            // (over a concave edge: into) the polyhedron along the bisector of the two faces'
+            // normals by CELL_LIFT of the single guard's distance from the edge (at most
+            // CELL_LIFT_REACH edge lengths).
             // The edge lies in both face planes (the guards' tangent planes); moved outwards the apex stays tangent-containing (the triangle's points are on the planes' inner sides or on
             // them). With M itself, the edge tetrahedra between two such cells over one net
             // edge are flat (all in the face plane); moved inwards, they fold over the cells.

@@ -142,8 +142,9 @@ fn mixed_base(hull: &SimplicialHull, t: usize, side: Side) -> bool {
 }
 
 /// `hull` with every apex that lies beyond one of its triangle's tangent planes (slope below
-/// −[`TANGENT_TOL`]) moved by [`contained_apex`], the (triangle, side) pairs moved, and how many
-/// such apexes could not be moved.
+/// −[`TANGENT_TOL`]), or on them over a base that is not one-signed ([`mixed_base`]), moved by
+/// [`contained_apex`], the (triangle, side) pairs moved, and how many such apexes could not be
+/// moved.
 #[must_use]
 pub fn contain_tangents(hull: &SimplicialHull) -> (SimplicialHull, Vec<(usize, Side)>, usize) {
     let mut out = hull.clone();
