@@ -380,9 +380,6 @@ fn mpi_poly_scene_has_no_holes() {
     assert!(inner::verify(built.hull.as_ref().unwrap()).is_empty());
 }
 
-/// `model.clean` on mpi_poly (the pending scene's tolerance, 1e-3 of the diagonal) leaves a
-/// closed polyhedron with planar faces and no needle: checked on the result directly, not on
-/// the clean's own report.
 /// The pending quintic scene is C2 on the cubic's cleaned model and valid hull: its singular
 /// stars are relaxed (`consistent_stars = false`). With `consistent_stars = true` (session 26)
 /// the stars' consistency conditions over-determine the flat nets' edge-middle groups (9051
@@ -408,6 +405,9 @@ fn mpi_poly_quintic_scene_is_c2() {
     assert!(inner::verify(built.hull.as_ref().unwrap()).is_empty());
 }
 
+/// `model.clean` on mpi_poly (the pending scene's tolerance, 1e-3 of the diagonal) leaves a
+/// closed polyhedron with planar faces and no needle: checked on the result directly, not on
+/// the clean's own report.
 #[test]
 fn mpi_poly_cleaned_has_no_needles_and_planar_faces() {
     let path = Path::new("scenes/models/mpi_poly.obj");

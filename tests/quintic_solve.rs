@@ -92,9 +92,9 @@ fn nut_sliver_faces_are_written_from_the_thick_side() {
 /// The nut under the quintic (its scene's options before session 27, conditioned stars): the
 /// hull's flat face tetrahedra rebuilt to `verify::C2_MIN_VOLUME` and T's coplanar groups on
 /// the triangulated flat faces made exact zero coplanar groups (`zero_groups`, Appendix B
-/// (5'')(ii)); with the stars'
-/// consistency conditions on the edge middles the complex is C2 and interpolates. (Without
-/// `zero_groups` the same options stop at a singular star system: measured, docs/history/nut.md.)
+/// (5'')(ii)); with the stars' consistency conditions on the edge middles the complex is C2
+/// and interpolates. (Without `zero_groups` the same options stop at a singular star system:
+/// measured, docs/history/nut.md.)
 /// The signs (holes, j-sheets) are not asserted: they fail, as on spot and bunny.
 #[test]
 fn nut_zero_groups_build_c2() {

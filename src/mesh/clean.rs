@@ -358,13 +358,8 @@ mod tests {
     /// set from a fixed linear congruential sequence, queries inside and outside its range).
     #[test]
     fn nearest_distance_is_the_brute_force_minimum() {
-        let mut state = 12345u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
-        };
+        let mut rng = crate::fixtures::Lcg(12345);
+        let mut next = || rng.uniform() * 4.0 - 2.0;
         let mut pts: Vec<DVec3> = (0..200)
             .map(|_| DVec3::new(next(), next(), next()))
             .collect();

@@ -1194,13 +1194,8 @@ mod tests {
     fn cubic_restriction_is_poly_restrict_bit_for_bit() {
         // The inlined cubic restriction takes poly::restrict's steps in its order: equal bits
         // on random weights and segments (barycentrics outside [0, 1] included).
-        let mut seed = 99u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 0.5
-        };
+        let mut rng = crate::fixtures::Lcg(99);
+        let mut rnd = || rng.uniform() * 2.0 - 0.5;
         for _ in 0..200 {
             let w: Vec<f64> = (0..20).map(|_| rnd()).collect();
             let a = [rnd(), rnd(), rnd(), rnd()];
@@ -1239,13 +1234,8 @@ mod tests {
         let store = compile(&p);
         let c = store.get(0);
         assert_eq!(c.segment_degree(), 6);
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::fixtures::Lcg(12345);
+        let mut rnd = || rng.uniform();
         for _ in 0..50 {
             let mut pick = || {
                 let w = [rnd(), rnd(), rnd(), rnd()];

@@ -20,10 +20,11 @@
 //! polyhedron ([`CELL_LIFT`]; with M itself the edge tetrahedra over a net edge, between two
 //! such cells, are flat; over a concave edge into it, and the two-triangle cell's apexes with
 //! it, so that no apex lies on both faces' planes) and slid along V_1V_2 so that the midpoint
-//! s of the two apexes over a net edge lies over that edge (else the cubic scheme cannot make those edge tetrahedra single
-//! sheeted: letter_P showed a spurious sheet). The guard net of a region is the set of guard
-//! pairs these cells use; T is a closed manifold when every pair is walked once in each direction round
-//! the region's boundary loops, which the guard assignment ([`GuardNet::build`]) searches for.
+//! s of the two apexes over a net edge lies over that edge (else the cubic scheme cannot make
+//! those edge tetrahedra single sheeted: letter_P showed a spurious sheet). The guard net of a
+//! region is the set of guard pairs these cells use; T is a closed manifold when every pair is
+//! walked once in each direction round the region's boundary loops, which the guard
+//! assignment ([`GuardNet::build`]) searches for.
 //!
 //! Guards are placed (Appendix B's corner guard circles: any point of a region works) at the
 //! centroid of their piece's kernel clipped by the inner half-planes of both region edges of
@@ -461,8 +462,9 @@ impl GuardNet {
             // (over a concave edge: into) the polyhedron along the bisector of the two faces'
             // normals by CELL_LIFT of the single guard's distance from the edge (at most
             // CELL_LIFT_REACH edge lengths).
-            // The edge lies in both face planes (the guards' tangent planes); moved outwards the apex stays tangent-containing (the triangle's points are on the planes' inner sides or on
-            // them). With M itself, the edge tetrahedra between two such cells over one net
+            // The edge lies in both face planes (the guards' tangent planes); moved outwards
+            // the apex stays tangent-containing (the triangle's points are on the planes'
+            // inner sides or on them). With M itself, the edge tetrahedra between two such cells over one net
             // edge are flat (all in the face plane); moved inwards, they fold over the cells.
             if g1 == g2 {
                 push([g1, g3, g4], single.into_iter().collect());

@@ -484,13 +484,8 @@ mod tests {
     /// the others (where ζ overflows and the rotation is the identity).
     #[test]
     fn anti_diagonal_sweep_equals_row_order_bits() {
-        let mut state = 7_u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = crate::fixtures::Lcg(7);
+        let mut next = || rng.uniform() - 0.5;
         for cols in 1..=13 {
             for kind in 0..3 {
                 let len = 3 + (cols * 7) % 11;
