@@ -57,7 +57,7 @@ fn checksum(found: &[Vec<(f64, Vec<f64>)>]) -> (usize, f64) {
 fn main() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let scenes: Vec<PathBuf> = std::env::var("SCENES").map_or_else(
-        |_| vec![root.join("scenes/pending/paper1994/nut_quintic.toml")],
+        |_| vec![root.join("scenes/paper1994/nut_quintic.toml")],
         |s| s.split(',').map(PathBuf::from).collect(),
     );
     println!(

@@ -93,6 +93,22 @@ fn j_line_check_sees_two_sheets() {
     assert!(one.sheets.j_lines > 0 && one.sheets.j_multi_lines == 0);
 }
 
+/// A zero base is a sheet: F = α4·(α4 − 0.5) (weights 0, −0.25, 0.5 by level) vanishes on the
+/// whole base and again at α4 = ½, so every j-line meets F = 0 twice although only once
+/// between its ends (the flat patch of the nut quintic's crack). F = α4·(α4 + 0.5) (0, 0.25,
+/// 1.5) keeps one sign above its zero base: the base is the only sheet.
+#[test]
+fn j_line_check_counts_a_zero_base() {
+    let two = check(
+        &quadratic_patch([0.0, -0.25, 0.5]),
+        &CheckOptions::default(),
+    );
+    assert!(two.sheets.j_patches == 1 && two.sheets.j_multi_lines == two.sheets.j_lines);
+    assert!(two.failures().contains(&"multiple sheets along j-lines"));
+    let one = check(&quadratic_patch([0.0, 0.25, 1.5]), &CheckOptions::default());
+    assert!(one.sheets.j_lines > 0 && one.sheets.j_multi_lines == 0);
+}
+
 /// Exploration: counters of the build on every paper1994 model (`MODEL=name`).
 #[test]
 #[ignore = "exploration"]

@@ -12,7 +12,7 @@
 use super::eval::PatchEval;
 use super::{CheckOptions, Location, SheetStats};
 use crate::bb::rational::segment_poly;
-use crate::bb::uni;
+use crate::bb::{index_of, multi_indices, uni};
 use crate::complex::{Patch, SheetRule};
 use rayon::prelude::*;
 
@@ -180,13 +180,29 @@ pub(crate) fn j_line_ends(p: &Patch, res: usize) -> Option<(Lattice, Lattice)> {
 }
 
 /// The 1994 single-sheet promise: lines from the j-vertex through the opposite face, or
-/// between the j-edge and the opposite edge, meet F = 0 at most once away from their ends.
+/// between the j-edge and the opposite edge, meet F = 0 at most once away from their ends, and
+/// not at all between their ends when F vanishes at the far end (a zero face: the flat
+/// triangle of a zero coplanar group is itself the sheet).
 fn j_lines(e: &PatchEval<'_>, opts: &CheckOptions, n: usize, stats: &mut SheetStats) {
     let Some((from, to)) = j_line_ends(e.patch, opts.sheet_resolution) else {
         return;
     };
     stats.j_patches += 1;
     let mut multi = false;
+    if let Some(j) = e.patch.jvertex.filter(|_| e.patch.rational.is_empty()) {
+        let (n, w) = (usize::from(e.patch.degree), &e.patch.weights);
+        if zero_face_turns(n, w, usize::from(j)) {
+            // Every j-line through the face's points of the wrong sign meets F = 0 twice;
+            // counted as one line, placed at the face's centroid.
+            stats.j_multi_lines += 1;
+            if stats.j_multi_at.is_none() {
+                let mut c = [1.0 / 3.0; 4];
+                c[usize::from(j)] = 0.0;
+                stats.j_multi_at = Some(Location::new(&[e], point(e, c), None));
+            }
+            multi = true;
+        }
+    }
     for a in &from {
         for b in &to {
             stats.j_lines += 1;
@@ -200,6 +216,43 @@ fn j_lines(e: &PatchEval<'_>, opts: &CheckOptions, n: usize, stats: &mut SheetSt
         }
     }
     stats.j_multi_patches += usize::from(multi);
+}
+
+/// Whether F of a polynomial patch (degree `n` ≥ 2, BB `weights`) vanishes on the whole face
+/// opposite local vertex `j` (every weight there within 1e-12 of the largest) while F/λ_j
+/// takes both strict signs on that face ([`crate::check::holes::polynomial_face_crossed`]'s
+/// evidence: coefficients, lattice, subdivision).
+///
+/// Such a face is itself a sheet (the flat triangle of a zero coplanar group), and F/λ_j,
+/// whose BB weights are n·b_{μ+e_j}/(μ_j + 1), is the derivative of F off the face: where it
+/// takes the apex's other sign the j-lines meet F = 0 a second time between face and apex,
+/// and rays see the face from behind. The j-line lattice alone missed such turns on four nut
+/// quintic patches (session 28); this test is exact on the face.
+#[must_use]
+pub(crate) fn zero_face_turns(n: usize, weights: &[f64], j: usize) -> bool {
+    if n < 2 || j > 3 {
+        return false;
+    }
+    let scale = weights.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
+    // The checker's zero: far above the solves' rounding (1e-16 relative), far below any
+    // weight a scheme sets on purpose.
+    let tiny = 1e-12 * scale;
+    let zero_face = multi_indices(n)
+        .iter()
+        .filter(|l| l[j] == 0)
+        .all(|&l| weights[index_of(l)].abs() <= tiny);
+    if !zero_face {
+        return false;
+    }
+    let g: Vec<f64> = multi_indices(n - 1)
+        .iter()
+        .map(|&mu| {
+            let mut l = mu;
+            l[j] += 1;
+            n as f64 * weights[index_of(l)] / f64::from(l[j])
+        })
+        .collect();
+    crate::check::holes::polynomial_face_crossed(n - 1, &g, j)
 }
 
 /// `Some(first root)` when F on the segment from `a` to `b` has more than one root in (0, 1)
@@ -216,9 +269,15 @@ fn interior_roots_beyond_one(
 }
 
 /// `Some(first root)` when the univariate Bernstein polynomial `c[..len]` on [0, 1] has more
-/// than one root in (0, 1) once roots at the ends are divided out (see
-/// [`interior_roots_beyond_one`]); shared with the quintic scheme's repair, which must judge
-/// a patch's j-lines as this check does.
+/// than one root in [0, 1] apart from a root at 0 (see [`interior_roots_beyond_one`]); shared
+/// with the quintic scheme's repair, which must judge a patch's j-lines as this check does.
+///
+/// A root at 0 (the j-vertex on the surface, a zero-convex j-edge) is shared by every line of
+/// the patch and divided out. A root at 1 is divided out too but still counts: the far end
+/// lies on the surface (the base of a face tetrahedron on a zero coplanar group, where F ≡ 0),
+/// so any root between the ends is a second sheet. Rays then meet that second sheet or the
+/// base from behind: the nut quintic's crack (session 28) was such a patch, whose level-1
+/// weights changed sign over its zero base.
 pub(crate) fn roots_beyond_one(mut c: [f64; 16], mut len: usize, n: usize) -> Option<f64> {
     let scale = c[..len].iter().fold(0.0f64, |m, x| m.max(x.abs()));
     // An end coefficient this small relative to the rest is a root at the end (the j-vertex on
@@ -228,7 +287,9 @@ pub(crate) fn roots_beyond_one(mut c: [f64; 16], mut len: usize, n: usize) -> Op
     while len > 1 && c[0].abs() <= tiny {
         len = uni::deflate_at_zero(&mut c, len);
     }
+    let mut far_root = false;
     while len > 1 && c[len - 1].abs() <= tiny {
+        far_root = true;
         // (1 − t)·B^(m−1)_k = ((m − k)/m)·B^m_k.
         let m = (len - 1) as f64;
         for (k, x) in c[..len - 1].iter_mut().enumerate() {
@@ -244,7 +305,9 @@ pub(crate) fn roots_beyond_one(mut c: [f64; 16], mut len: usize, n: usize) -> Op
             prev = Some(x > 0.0);
         }
     }
-    if changes <= 1 {
+    // Roots allowed between the ends: one, or none beside a root at the far end.
+    let allowed = usize::from(!far_root);
+    if changes <= allowed {
         return None;
     }
     let mut prev: Option<bool> = None;
@@ -264,7 +327,7 @@ pub(crate) fn roots_beyond_one(mut c: [f64; 16], mut len: usize, n: usize) -> Op
         }
         prev = Some(f > 0.0);
     }
-    (count > 1).then_some(first)
+    (count > allowed).then_some(first)
 }
 
 /// Bernstein coefficients of F·(rational denominators) along the segment from `a` to `b`

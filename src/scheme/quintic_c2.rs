@@ -234,6 +234,9 @@ pub fn build_with_stats(
     let (tets, _pos) = system::tetrahedra(hull)?;
     let mut sys = system::assemble(&tets, np)?;
     sys.star_tau = options.star_tau;
+    if !zero_points.is_empty() {
+        sys.require_zero_bases(&tets, &flat::zero_triangles(hull, &zero_points));
+    }
     let hessian_fit = if options.hessian_signs {
         signs::fit_hessians(&tets, np, &mut jets, &|t, l| sys.required_sign(t, l))
     } else {

@@ -20,7 +20,7 @@
 
 use crate::hull::simplicial::SimplicialHull;
 use glam::DVec3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Largest distance of a triangle's fourth point from its edge-neighbour's plane, relative to
 /// the distance of that point from the shared edge's first point, for the two to count as
@@ -123,6 +123,30 @@ pub fn zero_coplanar_groups(hull: &SimplicialHull) -> (SimplicialHull, Vec<u32>)
     (out, moved)
 }
 
+/// The triangles of T on a zero coplanar group of `hull` (as returned by
+/// [`zero_coplanar_groups`], with its `moved` points): all three points moved, with one plane
+/// normal, which the triangle's own normal matches. F vanishes on their face tetrahedra's
+/// bases, so the base itself is the sheet there and the level-1 weights must keep the apex's
+/// sign ([`super::signs`]).
+#[must_use]
+pub fn zero_triangles(hull: &SimplicialHull, moved: &[u32]) -> HashSet<u32> {
+    let moved: HashSet<u32> = moved.iter().copied().collect();
+    (0..hull.triangles.len() as u32)
+        .filter(|&t| {
+            let tri = hull.triangles[t as usize];
+            if !tri.iter().all(|i| moved.contains(i)) {
+                return false;
+            }
+            let n = hull.normals[tri[0] as usize];
+            let [a, b, c] = tri.map(|i| hull.points[i as usize]);
+            tri.iter().all(|&i| hull.normals[i as usize] == n)
+                && (b - a).cross(c - a).try_normalize().is_some_and(|m| {
+                    (m - n).length() <= NORMAL_NOISE || (m + n).length() <= NORMAL_NOISE
+                })
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,10 +184,20 @@ mod tests {
             // Moved by the noise only.
             assert!((flat.points[i] - hull.points[i]).length() < 1e-5);
         }
+        let zero = zero_triangles(&flat, &moved);
+        assert_eq!(
+            zero.len(),
+            4,
+            "every triangle of the fan is on the zero group"
+        );
+        // The last point left out of the moved list: its two triangles are not zero bases.
+        let zero = zero_triangles(&flat, &moved[..4]);
+        assert_eq!(zero, HashSet::from([0, 1]));
         let mut tilted = hull.clone();
         tilted.normals[2] = DVec3::new(0.1, 0.0, 1.0).normalize();
         let (same, moved) = zero_coplanar_groups(&tilted);
         assert!(moved.is_empty());
         assert_eq!(same.points, tilted.points);
+        assert!(zero_triangles(&same, &moved).is_empty());
     }
 }

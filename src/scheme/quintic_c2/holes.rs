@@ -31,7 +31,7 @@ use super::pinned::PinnedSolves;
 use super::system::{HullTet, System};
 use super::{cholesky, dense};
 use crate::bb::{multi_indices, poly};
-use crate::check::sheets::{roots_beyond_one, simplex_lattice};
+use crate::check::sheets::{roots_beyond_one, simplex_lattice, zero_face_turns};
 use crate::complex::Role;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
@@ -221,6 +221,9 @@ pub fn j_sheeted(weights: &[f64], role: Role) -> bool {
     };
     if weights.iter().all(|&w| w >= 0.0) || weights.iter().all(|&w| w <= 0.0) {
         return false;
+    }
+    if role == Role::Face && zero_face_turns(5, weights, 3) {
+        return true;
     }
     from.iter().any(|a| {
         to.iter().any(|b| {

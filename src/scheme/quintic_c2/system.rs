@@ -38,7 +38,7 @@ use crate::error::{Error, Result};
 use crate::hull::simplicial::{EdgePoint, Side, SimplicialHull};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Degree of the scheme.
 pub const N: usize = 5;
@@ -1523,6 +1523,28 @@ impl System {
             .filter(|slots| slots.iter().any(|&s| bad[s as usize]))
             .count();
         st
+    }
+
+    /// Adds the signs a zero base asks: on the face tetrahedra of the triangles `zero` (zero
+    /// coplanar groups, where F ≡ 0 on the base) the base is the sheet, so every level-1
+    /// weight must have the apex's side's sign too (Theorem 2.1 for F/λ_q, whose levels are
+    /// F's levels 1–5 with k = 0). Without it the level-1 weights are free (k = 1) and where
+    /// they turn, F/λ_q vanishes between base and apex: a second sheet, and the base seen
+    /// from behind (the nut quintic's crack).
+    pub fn require_zero_bases(&mut self, tets: &[HullTet], zero: &HashSet<u32>) {
+        let mi = multi_indices(N);
+        for (t, tet) in tets.iter().enumerate() {
+            if tet.role != Role::Face || !zero.contains(&tet.triangle) {
+                continue;
+            }
+            let s = signs::side_sign(tet.side);
+            for (i, l) in mi.iter().enumerate() {
+                if l[3] == 1 {
+                    let k = self.slot_of[t][i] as usize;
+                    self.req[k] = signs::combine(self.req[k], s);
+                }
+            }
+        }
     }
 
     /// The sign Theorem 2.1 asks of the weight at multi-index `l` of tetrahedron `t`, combined
