@@ -250,3 +250,43 @@ fn star_systems_are_singular_for_every_edge_point() {
         "mirror broken"
     );
 }
+
+/// The thinnest edge tetrahedra of every quintic scene's hull as the quintic fills it (after
+/// the L-U partners are added), for choosing `slivers::EDGE_MIN_VOLUME`: prints, per scene,
+/// the smallest pair volumes and how many lie below the bound.
+#[test]
+#[ignore = "survey for humans: builds every 1994 quintic scene's hull (~1 min)"]
+fn edge_sliver_survey() {
+    use apatch::scheme::quintic_c2::slivers;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut paths: Vec<_> = ["paper1994", "pending/paper1994"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with("_quintic.toml"))
+        .collect();
+    paths.sort();
+    for p in paths {
+        let scene = apatch::scene::load(&p).unwrap();
+        let Some(hull) = apatch::scene::inner_hull(&scene).unwrap() else {
+            continue;
+        };
+        let (completed, _) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+        let mut thin = slivers::thin_edges(&completed, 1e-2);
+        thin.sort_by(|a, b| a.2.total_cmp(&b.2));
+        let below = thin
+            .iter()
+            .filter(|t| t.2 < slivers::EDGE_MIN_VOLUME)
+            .count();
+        let smallest: Vec<String> = thin
+            .iter()
+            .take(4)
+            .map(|t| format!("{:.1e}", t.2))
+            .collect();
+        println!(
+            "{}: {below} below the bound; smallest {}",
+            p.file_name().unwrap().to_string_lossy(),
+            smallest.join(", ")
+        );
+    }
+}

@@ -11,7 +11,8 @@ use std::path::Path;
 /// joint stars, `RELAX=0` turning off the relaxed stars, `CONSISTENT=1` the consistent
 /// stars, `HSIGNS=1` the Hessian sign fit, `TANGENTS=1` the tangent containment and
 /// `STAR_TAU` the stars' near-null threshold, `REPAIR=1` the hole repair and
-/// `REPAIR_HESSIANS=0` its Hessian passes off (to explore).
+/// `REPAIR_HESSIANS=0` its Hessian passes off, `THICKEN=0` the sliver edge tetrahedra left
+/// as they are (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -36,6 +37,7 @@ fn options() -> QuinticOptions {
             .unwrap_or(0.0),
         repair_holes: std::env::var("REPAIR").is_ok_and(|s| s == "1"),
         repair_hessians: std::env::var("REPAIR_HESSIANS").map_or(true, |s| s != "0"),
+        thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
     }
 }
 

@@ -289,10 +289,18 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
             r.crossed_before, r.crossed_after, r.sheets_before, r.sheets_after
         )
     };
+    let slivers = if s.slivers_found == 0 {
+        String::new()
+    } else {
+        format!(
+            "; sliver edge tetrahedra {} ({} thickened)",
+            s.slivers_found, s.slivers_thickened
+        )
+    };
     format!(
         "solve            {} unknowns, {} equations, largest group {} ({} sparse), residual \
          {:.1e}; {} points of T relaxed, {} consistency conditions{}; {} weights off Theorem \
-         2.1's sufficient signs, in {} patches{repair}  info",
+         2.1's sufficient signs, in {} patches{slivers}{repair}  info",
         s.unknowns,
         s.equations,
         s.largest_group,

@@ -17,6 +17,7 @@ pub mod jets;
 pub mod ordering;
 mod pinned;
 pub mod signs;
+pub mod slivers;
 pub mod sparse;
 pub mod system;
 
@@ -94,6 +95,11 @@ pub struct QuinticOptions {
     /// faces of face tetrahedra, whose weights are all jets and stars. On by default
     /// (letter_P_poly without `hessian_signs`: 28 → 10 crossed faces; bunny: 6 → 3).
     pub repair_hessians: bool,
+    /// Move apart the apexes of edge tetrahedra that are slivers (relative volume below
+    /// [`slivers::EDGE_MIN_VOLUME`]) before building: their world Hessians carry the weights'
+    /// rounding times (L / h)², which no solve can remove ([`slivers`]). On by default; hulls
+    /// without such slivers are unchanged.
+    pub thicken_edges: bool,
 }
 
 impl Default for QuinticOptions {
@@ -112,6 +118,7 @@ impl Default for QuinticOptions {
             zero_groups: false,
             repair_holes: false,
             repair_hessians: true,
+            thicken_edges: true,
         }
     }
 }
@@ -157,6 +164,7 @@ impl QuinticOptions {
                 "contain_tangents" => o.contain_tangents = flag()?,
                 "repair_holes" => o.repair_holes = flag()?,
                 "repair_hessians" => o.repair_hessians = flag()?,
+                "thicken_edges" => o.thicken_edges = flag()?,
                 "zero_groups" => o.zero_groups = flag()?,
                 "star_tau" => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
                     Some(t) if (0.0..1.0).contains(&t) => o.star_tau = t,
@@ -177,7 +185,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, `thicken_edges`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -212,6 +220,11 @@ pub fn build_with_stats(
         crate::scheme::cubic_c1::sided::complete_lu_pairs(hull)
     } else {
         (hull.clone(), Vec::new())
+    };
+    let (completed, slivers) = if options.thicken_edges {
+        slivers::thicken(&completed)
+    } else {
+        (completed, Vec::new())
     };
     let (completed, tangent_moved) = if options.contain_tangents {
         let (h, moved, _stuck) = crate::scheme::cubic_c1::tangent::contain_tangents(&completed);
@@ -274,6 +287,8 @@ pub fn build_with_stats(
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
     stats.lu_completed = lu_completed.len();
     stats.tangent_moved = tangent_moved;
+    stats.slivers_found = slivers.len();
+    stats.slivers_thickened = slivers.iter().filter(|s| s.after > s.before).count();
     stats.hessian_fit = hessian_fit;
     let mut complex = PatchComplex::new("quintic-c2");
     complex.continuity = Some(2);

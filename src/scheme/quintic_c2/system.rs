@@ -438,6 +438,11 @@ pub struct SolveStats {
     /// Apexes moved to their side of their triangle's tangent planes before building
     /// (`QuinticOptions::contain_tangents`).
     pub tangent_moved: usize,
+    /// Sides of edges of T whose edge tetrahedra were slivers
+    /// (`QuinticOptions::thicken_edges`, [`super::slivers`]).
+    pub slivers_found: usize,
+    /// Of those, the ones whose apexes were moved apart to the bound.
+    pub slivers_thickened: usize,
     /// Points of T whose stars were relaxed (solved with their edge middles and Hessian)
     /// because their determined weights missed Theorem 2.1's signs
     /// (`QuinticOptions::relax_stars`).
