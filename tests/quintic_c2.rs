@@ -283,8 +283,14 @@ fn edge_sliver_survey() {
             .take(4)
             .map(|t| format!("{:.1e}", t.2))
             .collect();
+        let left = if below > 0 {
+            let (thick, _) = slivers::thicken(&completed);
+            slivers::thin_edges(&thick, slivers::EDGE_MIN_VOLUME).len()
+        } else {
+            0
+        };
         println!(
-            "{}: {below} below the bound; smallest {}",
+            "{}: {below} below the bound ({left} after thickening); smallest {}",
             p.file_name().unwrap().to_string_lossy(),
             smallest.join(", ")
         );

@@ -13,7 +13,7 @@
 //! edge towards its own triangle (the rotation that opens the edge tetrahedra), by the least of
 //! a few steps that makes the pair's relative volume reach [`EDGE_MIN_VOLUME`], and keeps a
 //! move only when no face tetrahedron the moved apexes belong to becomes thinner than
-//! [`FACE_MIN_VOLUME`], no base vertex's tangent plane changes sides with respect to a moved
+//! [`FACE_MIN_VOLUME`] (or than it was), no base vertex's tangent plane changes sides with respect to a moved
 //! apex (Definition 3.5 and Theorem 2.1's signs stay as they were), and the hull's verification
 //! finds no more violations than before.
 
@@ -129,15 +129,17 @@ fn plane_signs(hull: &SimplicialHull, t: usize, q: DVec3) -> [i8; 3] {
 }
 
 /// Whether apex `q` may replace triangle `t`'s apex on `side`: its face tetrahedron stays on
-/// that side with a relative volume of at least [`FACE_MIN_VOLUME`] and every base vertex's
-/// tangent plane keeps its side.
+/// that side with a relative volume of at least [`FACE_MIN_VOLUME`] (or, where it was thinner,
+/// at least what it had: flat nets' tetrahedra are) and every base vertex's tangent plane keeps
+/// its side.
 fn acceptable(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> bool {
     let Some(old) = hull.apexes[t][side as usize] else {
         return false;
     };
     let [a, b, c] = hull.triangles[t].map(|k| hull.points[k as usize]);
     let sigma = if side == Side::Outer { 1.0 } else { -1.0 };
-    sigma * relative_volume(a, b, c, q) >= FACE_MIN_VOLUME
+    let floor = FACE_MIN_VOLUME.min(sigma * relative_volume(a, b, c, old));
+    sigma * relative_volume(a, b, c, q) >= floor.max(0.0)
         && plane_signs(hull, t, q) == plane_signs(hull, t, old)
 }
 
@@ -169,6 +171,15 @@ pub fn thicken(hull: &SimplicialHull) -> (SimplicialHull, Vec<Sliver>) {
         let (pi, pj) = ends(&out, edge);
         let elen = (pj - pi).length();
         let [fa, fb] = edge.faces.map(|f| f as usize);
+        let trace = std::env::var_os("APATCH_SLIVER_TRACE").is_some();
+        if trace {
+            eprintln!(
+                "sliver: edge {:?} ({pi}, {pj}) side {side:?} volume {before:.1e}, triangles {fa} {fb}, apexes {q0} {q1}, signs {:?} {:?}",
+                edge.v,
+                plane_signs(&out, fa, q0),
+                plane_signs(&out, fb, q1)
+            );
+        }
         for step in STEPS {
             let d = step * elen;
             // Each apex at least d from the bisecting plane, on its own triangle's side.
@@ -179,12 +190,22 @@ pub fn thicken(hull: &SimplicialHull) -> (SimplicialHull, Vec<Sliver>) {
                 || !acceptable(&out, fa, side, a)
                 || !acceptable(&out, fb, side, b)
             {
+                if trace {
+                    eprintln!(
+                        "  step {step}: volume {v:.1e}, acceptable {} {}",
+                        acceptable(&out, fa, side, a),
+                        acceptable(&out, fb, side, b)
+                    );
+                }
                 continue;
             }
             let mut trial = out.clone();
             trial.apexes[fa][side as usize] = Some(a);
             trial.apexes[fb][side as usize] = Some(b);
             let n = verify(&trial).len();
+            if trace {
+                eprintln!("  step {step}: volume {v:.1e}, violations {violations} -> {n}");
+            }
             if n <= violations {
                 violations = n;
                 out = trial;
