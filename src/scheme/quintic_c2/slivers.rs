@@ -13,9 +13,10 @@
 //! edge towards its own triangle (the rotation that opens the edge tetrahedra), by the least of
 //! a few steps that makes the pair's relative volume reach [`EDGE_MIN_VOLUME`], and keeps a
 //! move only when no face tetrahedron the moved apexes belong to becomes thinner than
-//! [`FACE_MIN_VOLUME`] (or than it was), no base vertex's tangent plane changes sides with respect to a moved
-//! apex (Definition 3.5 and Theorem 2.1's signs stay as they were), and the hull's verification
-//! finds no more violations than before.
+//! [`FACE_MIN_VOLUME`] (or than it was), no base vertex's tangent plane changes sides with
+//! respect to a moved apex unless to the apex's own side (Definition 3.5 and Theorem 2.1's signs
+//! are kept or gained, never lost), and the hull's verification finds no more violations than
+//! before.
 
 use crate::hull::inner::degenerate::relative_volume;
 use crate::hull::inner::verify::verify;
@@ -130,8 +131,9 @@ fn plane_signs(hull: &SimplicialHull, t: usize, q: DVec3) -> [i8; 3] {
 
 /// Whether apex `q` may replace triangle `t`'s apex on `side`: its face tetrahedron stays on
 /// that side with a relative volume of at least [`FACE_MIN_VOLUME`] (or, where it was thinner,
-/// at least what it had: flat nets' tetrahedra are) and every base vertex's tangent plane keeps
-/// its side.
+/// at least what it had: flat nets' tetrahedra are) and no base vertex's tangent plane changes
+/// side except to put the apex on the side it should be on (outer apexes above the plane,
+/// inner below: Theorem 2.1's sign of the number 1 weight toward it).
 fn acceptable(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> bool {
     let Some(old) = hull.apexes[t][side as usize] else {
         return false;
@@ -139,8 +141,12 @@ fn acceptable(hull: &SimplicialHull, t: usize, side: Side, q: DVec3) -> bool {
     let [a, b, c] = hull.triangles[t].map(|k| hull.points[k as usize]);
     let sigma = if side == Side::Outer { 1.0 } else { -1.0 };
     let floor = FACE_MIN_VOLUME.min(sigma * relative_volume(a, b, c, old));
-    sigma * relative_volume(a, b, c, q) >= floor.max(0.0)
-        && plane_signs(hull, t, q) == plane_signs(hull, t, old)
+    let want = if side == Side::Outer { 1 } else { -1 };
+    let kept = plane_signs(hull, t, q)
+        .iter()
+        .zip(plane_signs(hull, t, old))
+        .all(|(&now, was)| now == was || now == want);
+    sigma * relative_volume(a, b, c, q) >= floor.max(0.0) && kept
 }
 
 /// Thickens the edge tetrahedra below [`EDGE_MIN_VOLUME`] (module docs). Returns the hull with
