@@ -253,7 +253,8 @@ fn star_systems_are_singular_for_every_edge_point() {
 
 /// The thinnest edge tetrahedra of every quintic scene's hull as the quintic fills it (after
 /// the L-U partners are added), for choosing `slivers::EDGE_MIN_VOLUME`: prints, per scene,
-/// the smallest pair volumes and how many lie below the bound.
+/// the smallest pair volumes, how many lie below the bound and remain after thickening, and
+/// the hull violations before and after the L-U completion.
 #[test]
 #[ignore = "survey for humans: builds every 1994 quintic scene's hull (~1 min)"]
 fn edge_sliver_survey() {
@@ -289,8 +290,12 @@ fn edge_sliver_survey() {
         } else {
             0
         };
+        let violations = (
+            apatch::hull::inner::verify(&hull).len(),
+            apatch::hull::inner::verify(&completed).len(),
+        );
         println!(
-            "{}: {below} below the bound ({left} after thickening); smallest {}",
+            "{}: {below} below the bound ({left} after thickening); smallest {}; hull violations before / after the L-U completion {violations:?}",
             p.file_name().unwrap().to_string_lossy(),
             smallest.join(", ")
         );
