@@ -673,9 +673,10 @@ pub struct BuiltScene {
     /// for patch files.
     pub mesh: Option<mesh::Mesh>,
     /// The inner simplicial hull (1994) the patches fill (`cubic-c1`, `quintic-c2`), the same
-    /// value [`inner_hull`] rebuilds: for `cubic-c1` after the scheme's apex changes
-    /// ([`crate::scheme::cubic_c1::prepare_hull`]), for `quintic-c2` as the hull builder made it
-    /// (the scheme completes L-U pairs internally). `None` for other scenes.
+    /// value [`inner_hull`] rebuilds: after the scheme's own changes
+    /// ([`crate::scheme::cubic_c1::prepare_hull`], [`crate::scheme::quintic_c2::prepare_hull`]:
+    /// L-U partners, apexes moved, for the quintic also opened slivers and zero coplanar
+    /// groups). `None` for other scenes.
     pub hull: Option<crate::hull::simplicial::SimplicialHull>,
     /// What the quintic scheme's solve did (`quintic-c2` scenes; `None` otherwise): its size,
     /// relaxed stars, consistency conditions, whether it fell back to solving every weight at
@@ -826,8 +827,9 @@ pub fn polyhedron_1994(
 
 /// The inner simplicial hull (1994) a `cubic-c1` or `quintic-c2` scene is built on, with the
 /// scene's normals and hull options; `None` for other scenes: the hull (Definition 3.6) without
-/// the patches. For `cubic-c1` it is the hull after the scheme's own changes to the apexes
-/// ([`crate::scheme::cubic_c1::prepare_hull`]), the one its patches fill. Loads the mesh and
+/// the patches. It is the hull after the scheme's own changes to the apexes
+/// ([`crate::scheme::cubic_c1::prepare_hull`], [`crate::scheme::quintic_c2::prepare_hull`]),
+/// the one its patches fill. Loads the mesh and
 /// builds the hull anew: after a build, [`BuiltScene::hull`] is this value (`apatch check`
 /// reads that).
 ///
@@ -866,7 +868,10 @@ pub fn inner_hull(
             crate::scheme::cubic_c1::prepare_hull(&hull, &cubic).hull,
         ));
     }
-    Ok(Some(hull))
+    let quintic = crate::scheme::quintic_c2::QuinticOptions::from_toml(scheme, &scene.path)?;
+    let prepared = crate::scheme::quintic_c2::prepare_hull(&hull, &quintic)
+        .with_context(|| format!("{}", file.display()))?;
+    Ok(Some(prepared.hull))
 }
 
 /// Builds a `cubic-c1` or `quintic-c2` complex as the schemes' `build_from_scene` do (same
@@ -900,10 +905,13 @@ fn build_1994(
         let options = quintic_c2::QuinticOptions::from_toml(scheme, scene)?;
         let inner = crate::hull::inner::InnerOptions::from_toml(scheme, scene)?;
         let (hull, report) = crate::hull::inner::build_with_report(m, vn, &inner)?;
-        let (complex, stats) = quintic_c2::build_with_stats(&hull, &options)?;
+        // The scheme's own changes to the hull, made once: the hull returned is the one the
+        // patches fill (as for the cubic).
+        let prepared = quintic_c2::prepare_hull(&hull, &options).with_context(at)?;
+        let (complex, stats) = quintic_c2::build_prepared(&prepared, &options)?;
         Ok(Built1994 {
             complex,
-            hull,
+            hull: prepared.hull,
             solve: Some(stats),
             report,
             cubic_steps: None,
@@ -1186,12 +1194,7 @@ irradiance = 2.0
                 assert!(!same_hull(hull, &default_hull));
             }
             let quintic = built.complex.scheme == "quintic-c2";
-            // The quintic scheme completes L-U pairs inside its build.
-            let filled = if quintic {
-                cubic_c1::sided::complete_lu_pairs(hull).0
-            } else {
-                hull.clone()
-            };
+            let filled = hull.clone();
             assert_eq!(
                 built.complex.patches.len(),
                 hull_tets(&filled).len(),

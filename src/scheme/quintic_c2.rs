@@ -215,6 +215,33 @@ pub fn build_with_stats(
     hull: &SimplicialHull,
     options: &QuinticOptions,
 ) -> Result<(PatchComplex, BuildStats)> {
+    build_prepared(&prepare_hull(hull, options)?, options)
+}
+
+/// The hull the quintic patches fill: the builder's hull after the scheme's own changes, made
+/// once (as the cubic's [`crate::scheme::cubic_c1::prepare_hull`]), with what each changed.
+#[derive(Clone, Debug)]
+pub struct PreparedHull {
+    /// The changed hull: its face and edge tetrahedra are the patches'.
+    pub hull: SimplicialHull,
+    /// Triangles given the partner apex of an L-U pair (`complete_lu_pairs`).
+    pub lu_completed: usize,
+    /// Sliver edge tetrahedra found, with their volumes before and after (`thicken_edges`).
+    pub slivers: Vec<slivers::Sliver>,
+    /// Apexes moved to their side of their triangle's tangent planes (`contain_tangents`).
+    pub tangent_moved: usize,
+    /// Points of T in exact zero coplanar groups (`zero_groups`): on their plane, with its
+    /// normal and a zero Hessian.
+    pub zero_points: Vec<u32>,
+}
+
+/// Makes the scheme's changes to `hull` ([`PreparedHull`]): L-U partners for single-sided
+/// triangles that are not convex for their side, sliver edge tetrahedra opened, apexes moved
+/// over tangent planes, zero coplanar groups, each as `options` asks.
+///
+/// # Errors
+/// A hull whose arrays are inconsistent or not finite.
+pub fn prepare_hull(hull: &SimplicialHull, options: &QuinticOptions) -> Result<PreparedHull> {
     validate(hull)?;
     let (completed, lu_completed) = if options.complete_lu_pairs {
         crate::scheme::cubic_c1::sided::complete_lu_pairs(hull)
@@ -237,18 +264,44 @@ pub fn build_with_stats(
     } else {
         (completed, Vec::new())
     };
-    let hull = &completed;
+    Ok(PreparedHull {
+        hull: completed,
+        lu_completed: lu_completed.len(),
+        slivers,
+        tangent_moved,
+        zero_points,
+    })
+}
+
+/// The patches on a prepared hull ([`prepare_hull`], whose changes are not made again), with
+/// what the solve did.
+///
+/// # Errors
+/// As [`build`].
+pub fn build_prepared(
+    prepared: &PreparedHull,
+    options: &QuinticOptions,
+) -> Result<(PatchComplex, BuildStats)> {
+    let PreparedHull {
+        hull: completed,
+        lu_completed,
+        slivers,
+        tangent_moved,
+        zero_points,
+    } = prepared;
+    validate(completed)?;
+    let hull = completed;
     let np = hull.points.len() as u32;
     let nt = hull.triangles.len() as u32;
     let mut jets = jets::estimate(hull, options.curvature);
-    for &p in &zero_points {
+    for &p in zero_points {
         jets[p as usize].h = glam::DMat3::ZERO;
     }
     let (tets, _pos) = system::tetrahedra(hull)?;
     let mut sys = system::assemble(&tets, np)?;
     sys.star_tau = options.star_tau;
     if !zero_points.is_empty() {
-        sys.require_zero_bases(&tets, &flat::zero_triangles(hull, &zero_points));
+        sys.require_zero_bases(&tets, &flat::zero_triangles(hull, zero_points));
     }
     let hessian_fit = if options.hessian_signs {
         signs::fit_hessians(&tets, np, &mut jets, &|t, l| sys.required_sign(t, l))
@@ -285,8 +338,8 @@ pub fn build_with_stats(
         }
     }
     stats.signs.base_conflicts = signs::base_conflicts(hull).len();
-    stats.lu_completed = lu_completed.len();
-    stats.tangent_moved = tangent_moved;
+    stats.lu_completed = *lu_completed;
+    stats.tangent_moved = *tangent_moved;
     stats.slivers_found = slivers.len();
     stats.slivers_thickened = slivers.iter().filter(|s| s.after > s.before).count();
     stats.hessian_fit = hessian_fit;
