@@ -251,15 +251,16 @@ fn star_systems_are_singular_for_every_edge_point() {
     );
 }
 
-/// The thinnest edge tetrahedra of every quintic scene's hull as the quintic fills it (after
-/// the L-U partners are added), for choosing `slivers::EDGE_MIN_VOLUME`: prints, per scene,
-/// the smallest pair volumes, how many lie below the bound and remain after thickening, and
-/// the hull violations before and after the L-U completion.
+/// The thinnest edge tetrahedra of every quintic scene's hull as the quintic fills it (the
+/// builder's hull with the L-U partners added, `prepare_hull` without `thicken_edges`), for
+/// choosing `slivers::EDGE_MIN_VOLUME`: prints, per scene, the smallest pair volumes, how many
+/// lie below the bound and remain after the scene's own preparation, and the hull violations
+/// of the built, the L-U completed and the prepared hull.
 #[test]
 #[ignore = "survey for humans: builds every 1994 quintic scene's hull (~1 min)"]
 fn edge_sliver_survey() {
-    use apatch::scheme::quintic_c2::slivers;
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    use apatch::scheme::quintic_c2::{prepare_hull, slivers};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let mut paths: Vec<_> = ["paper1994", "pending/paper1994"]
         .iter()
         .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
@@ -269,10 +270,30 @@ fn edge_sliver_survey() {
     paths.sort();
     for p in paths {
         let scene = apatch::scene::load(&p).unwrap();
-        let Some(hull) = apatch::scene::inner_hull(&scene).unwrap() else {
+        let apatch::scene::Model::Mesh {
+            file,
+            normals,
+            scheme,
+            clean,
+            ..
+        } = &scene.model
+        else {
             continue;
         };
-        let (completed, _) = apatch::scheme::cubic_c1::sided::complete_lu_pairs(&hull);
+        // The builder's hull, before the scheme's changes (`scene::inner_hull` returns it
+        // after them).
+        let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean).unwrap();
+        let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+        let inner = apatch::hull::inner::InnerOptions::from_toml(scheme, &p).unwrap();
+        let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
+        let options = QuinticOptions::from_toml(scheme, &p).unwrap();
+        let lu_only = QuinticOptions {
+            thicken_edges: false,
+            contain_tangents: false,
+            zero_groups: false,
+            ..options.clone()
+        };
+        let completed = prepare_hull(&hull, &lu_only).unwrap().hull;
         let mut thin = slivers::thin_edges(&completed, 1e-2);
         thin.sort_by(|a, b| a.2.total_cmp(&b.2));
         let below = thin
@@ -284,18 +305,15 @@ fn edge_sliver_survey() {
             .take(4)
             .map(|t| format!("{:.1e}", t.2))
             .collect();
-        let left = if below > 0 {
-            let (thick, _) = slivers::thicken(&completed);
-            slivers::thin_edges(&thick, slivers::EDGE_MIN_VOLUME).len()
-        } else {
-            0
-        };
+        let prepared = prepare_hull(&hull, &options).unwrap().hull;
+        let left = slivers::thin_edges(&prepared, slivers::EDGE_MIN_VOLUME).len();
         let violations = (
             apatch::hull::inner::verify(&hull).len(),
             apatch::hull::inner::verify(&completed).len(),
+            apatch::hull::inner::verify(&prepared).len(),
         );
         println!(
-            "{}: {below} below the bound ({left} after thickening); smallest {}; hull violations before / after the L-U completion {violations:?}",
+            "{}: {below} below the bound ({left} after preparing); smallest {}; hull violations built / L-U completed / prepared {violations:?}",
             p.file_name().unwrap().to_string_lossy(),
             smallest.join(", ")
         );

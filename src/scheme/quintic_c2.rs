@@ -283,14 +283,13 @@ pub fn build_prepared(
     options: &QuinticOptions,
 ) -> Result<(PatchComplex, BuildStats)> {
     let PreparedHull {
-        hull: completed,
+        hull,
         lu_completed,
         slivers,
         tangent_moved,
         zero_points,
     } = prepared;
-    validate(completed)?;
-    let hull = completed;
+    validate(hull)?;
     let np = hull.points.len() as u32;
     let nt = hull.triangles.len() as u32;
     let mut jets = jets::estimate(hull, options.curvature);

@@ -14,7 +14,7 @@
 //! Apexes that are already inside their wedges are not touched, nor apexes for which no such
 //! point is found, nor the apexes of trihedral corners (step (3), (3')).
 
-use crate::hull::simplicial::{PointOrigin, SimplicialHull};
+use crate::hull::simplicial::{HullEdge, PointOrigin, SimplicialHull};
 use glam::DVec3;
 
 /// Distance an apex keeps from a bisecting plane, relative to the shared edge's length: enough
@@ -25,6 +25,23 @@ pub const WEDGE_MARGIN: f64 = 0.005;
 
 /// A half-space a·q ≥ b.
 type HalfSpace = (DVec3, f64);
+
+/// The unit directions, perpendicular to the interior edge `e` of T, from the edge into each of
+/// its two triangles (towards their third points), in the order of `e.faces`; `None` for a
+/// degenerate edge or triangle. Their difference is the normal of the plane bisecting the fold.
+#[must_use]
+pub fn inward_directions(hull: &SimplicialHull, e: &HullEdge) -> Option<[DVec3; 2]> {
+    let (p, q) = (hull.points[e.v[0] as usize], hull.points[e.v[1] as usize]);
+    let dir = (q - p).try_normalize()?;
+    let inward = |t: u32| -> Option<DVec3> {
+        let o = hull.triangles[t as usize]
+            .iter()
+            .find(|&&i| i != e.v[0] && i != e.v[1])?;
+        let d = hull.points[*o as usize] - p;
+        (d - d.dot(dir) * dir).try_normalize()
+    };
+    Some([inward(e.faces[0])?, inward(e.faces[1])?])
+}
 
 /// Moves apexes that lie beyond the bisecting plane of a fold of T back into their wedge (module
 /// docs). Returns the number of apexes moved.
@@ -41,21 +58,11 @@ pub fn keep_in_wedges(hull: &mut SimplicialHull) -> usize {
             continue;
         }
         let [fa, fb] = e.faces.map(|f| f as usize);
+        let Some([ua, ub]) = inward_directions(hull, e) else {
+            continue;
+        };
         let (p, q) = (hull.points[e.v[0] as usize], hull.points[e.v[1] as usize]);
-        let Some(dir) = (q - p).try_normalize() else {
-            continue;
-        };
         let elen = (q - p).length();
-        let inward = |t: usize| -> Option<DVec3> {
-            let o = hull.triangles[t]
-                .iter()
-                .find(|&&i| i != e.v[0] && i != e.v[1])?;
-            let d = hull.points[*o as usize] - p;
-            (d - d.dot(dir) * dir).try_normalize()
-        };
-        let (Some(ua), Some(ub)) = (inward(fa), inward(fb)) else {
-            continue;
-        };
         // T does not fold here (coplanar triangles: flat regions, guard nets, whose apexes
         // `guardnet` places on purpose): no wedge.
         if ua.dot(ub) < -1.0 + 1e-9 {

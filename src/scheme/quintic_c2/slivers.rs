@@ -20,6 +20,7 @@
 
 use crate::hull::inner::degenerate::relative_volume;
 use crate::hull::inner::verify::verify;
+use crate::hull::inner::wedge::inward_directions;
 use crate::hull::simplicial::{HullEdge, Side, SimplicialHull};
 use glam::DVec3;
 
@@ -102,16 +103,7 @@ fn apex_pair(hull: &SimplicialHull, e: &HullEdge, side: Side) -> Option<(DVec3, 
 /// triangles, pointing to the first triangle's side (`None` for a degenerate edge or triangle,
 /// or two triangles folded onto each other).
 fn bisector_normal(hull: &SimplicialHull, e: &HullEdge) -> Option<DVec3> {
-    let (p, q) = ends(hull, e);
-    let dir = (q - p).try_normalize()?;
-    let inward = |t: u32| -> Option<DVec3> {
-        let o = hull.triangles[t as usize]
-            .iter()
-            .find(|&&i| i != e.v[0] && i != e.v[1])?;
-        let d = hull.points[*o as usize] - p;
-        (d - d.dot(dir) * dir).try_normalize()
-    };
-    let (ua, ub) = (inward(e.faces[0])?, inward(e.faces[1])?);
+    let [ua, ub] = inward_directions(hull, e)?;
     (ua - ub).try_normalize()
 }
 
@@ -192,16 +184,10 @@ pub fn thicken(hull: &SimplicialHull) -> (SimplicialHull, Vec<Sliver>) {
             let a = q0 + (d - bn.dot(q0 - pi)).max(0.0) * bn;
             let b = q1 - (d + bn.dot(q1 - pi)).max(0.0) * bn;
             let v = pair_volume(pi, pj, a, b);
-            if v < EDGE_MIN_VOLUME
-                || !acceptable(&out, fa, side, a)
-                || !acceptable(&out, fb, side, b)
-            {
+            let ok = [acceptable(&out, fa, side, a), acceptable(&out, fb, side, b)];
+            if v < EDGE_MIN_VOLUME || ok.contains(&false) {
                 if trace {
-                    eprintln!(
-                        "  step {step}: volume {v:.1e}, acceptable {} {}",
-                        acceptable(&out, fa, side, a),
-                        acceptable(&out, fb, side, b)
-                    );
+                    eprintln!("  step {step}: volume {v:.1e}, acceptable {ok:?}");
                 }
                 continue;
             }
