@@ -3,6 +3,7 @@
 
 use apatch::check::{check, CheckOptions};
 use apatch::fixtures::trihedral_hull;
+use apatch::hull::simplicial::EdgePoint;
 use apatch::scheme::quintic_c2::{build_with_stats, QuinticOptions};
 use std::path::Path;
 
@@ -356,4 +357,215 @@ fn spot_control_cage_quintic_is_c2_with_its_sliver_opened() {
         );
     }
     assert!(apatch::hull::inner::verify(built.hull.as_ref().unwrap()).is_empty());
+}
+
+/// How far C1 extrapolates across each face tetrahedron's side face [p_i p_j q] into its edge
+/// tetrahedron, with s placed by `rule`: the sum of |barycentric coordinates| of s in
+/// `[p_i p_j p_k q]` ([`apatch::hull::simplicial::extrapolation`]), with the triangle and edge.
+fn extrapolation(
+    hull: &apatch::hull::simplicial::SimplicialHull,
+    rule: apatch::hull::simplicial::EdgePoint,
+) -> Vec<(f64, u32, u32)> {
+    hull.edge_tets_with(rule)
+        .unwrap()
+        .iter()
+        .map(|et| {
+            let face = hull.face_tet(et.face as usize, et.side).unwrap();
+            (
+                apatch::hull::simplicial::extrapolation(&face, et.tet[3]),
+                et.face,
+                et.edge,
+            )
+        })
+        .collect()
+}
+
+/// Survey (ignored; prints only): per quintic scene, T's triangles with a small angle and the
+/// C1 extrapolation factor from face into edge tetrahedra ([`extrapolation`]).
+#[test]
+#[ignore]
+fn needle_survey() {
+    use apatch::scheme::quintic_c2::prepare_hull;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut paths: Vec<_> = ["paper1994", "pending/paper1994"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with("_quintic.toml"))
+        .collect();
+    paths.sort();
+    for p in paths {
+        let scene = apatch::scene::load(&p).unwrap();
+        let apatch::scene::Model::Mesh {
+            file,
+            normals,
+            scheme,
+            clean,
+            ..
+        } = &scene.model
+        else {
+            continue;
+        };
+        let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean).unwrap();
+        let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+        let inner = apatch::hull::inner::InnerOptions::from_toml(scheme, &p).unwrap();
+        let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
+        let options = QuinticOptions::from_toml(scheme, &p).unwrap();
+        let hull = prepare_hull(&hull, &options).unwrap().hull;
+        let mut angles: Vec<f64> = hull
+            .triangles
+            .iter()
+            .map(|t| {
+                let v = t.map(|i| hull.points[i as usize]);
+                (0..3)
+                    .map(|k| {
+                        let a = v[(k + 1) % 3] - v[k];
+                        let b = v[(k + 2) % 3] - v[k];
+                        a.angle_between(b).to_degrees()
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        angles.sort_by(f64::total_cmp);
+        let mut ex = extrapolation(&hull, EdgePoint::Midpoint);
+        ex.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let over = |t: f64| ex.iter().filter(|e| e.0 > t).count();
+        let balanced = extrapolation(&hull, EdgePoint::Balanced)
+            .iter()
+            .fold(0.0_f64, |m, e| m.max(e.0));
+        println!(
+            "{}: {} triangles, min angles {:.2}° {:.2}° {:.2}°, < 5°: {}; extrapolation max {:.1} (face {}; balanced {balanced:.1}), > 5: {}, > 10: {}, > 20: {}",
+            p.file_name().unwrap().to_string_lossy(),
+            angles.len(),
+            angles[0],
+            angles[1.min(angles.len() - 1)],
+            angles[2.min(angles.len() - 1)],
+            angles.iter().filter(|&&a| a < 5.0).count(),
+            ex[0].0,
+            ex[0].1,
+            over(5.0),
+            over(10.0),
+            over(20.0)
+        );
+    }
+}
+
+/// Details (ignored; prints only) for `APATCH_NEEDLES=scene.toml`: the triangles of T with the
+/// largest extrapolation factors, their angles, their neighbours across each edge and the fold
+/// to each.
+#[test]
+#[ignore]
+fn needle_details() {
+    use apatch::scheme::quintic_c2::prepare_hull;
+    let Ok(name) = std::env::var("APATCH_NEEDLES") else {
+        return;
+    };
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(&name);
+    let scene = apatch::scene::load(&p).unwrap();
+    let apatch::scene::Model::Mesh {
+        file,
+        normals,
+        scheme,
+        clean,
+        ..
+    } = &scene.model
+    else {
+        return;
+    };
+    let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean).unwrap();
+    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+    let inner = apatch::hull::inner::InnerOptions::from_toml(scheme, &p).unwrap();
+    let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
+    let options = QuinticOptions::from_toml(scheme, &p).unwrap();
+    let hull = prepare_hull(&hull, &options).unwrap().hull;
+    let edges = hull.edges().unwrap();
+    let mut ex = extrapolation(&hull, EdgePoint::Midpoint);
+    ex.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let normal = |t: usize| {
+        let v = hull.triangles[t].map(|i| hull.points[i as usize]);
+        (v[1] - v[0]).cross(v[2] - v[0]).normalize()
+    };
+    let mut seen = std::collections::HashSet::new();
+    for &(f, face, edge) in ex.iter().take(40) {
+        if !seen.insert(face) {
+            continue;
+        }
+        let t = hull.triangles[face as usize];
+        let v = t.map(|i| hull.points[i as usize]);
+        let ang: Vec<String> = (0..3)
+            .map(|k| {
+                let a = v[(k + 1) % 3] - v[k];
+                let b = v[(k + 2) % 3] - v[k];
+                format!("{:.2}", a.angle_between(b).to_degrees())
+            })
+            .collect();
+        println!(
+            "face {face} {t:?} elem {} origins {:?} angles {ang:?} factor {f:.1} (edge {:?})",
+            hull.element[face as usize],
+            t.map(|i| hull.origins[i as usize]),
+            edges[edge as usize].v
+        );
+        for e in edges.iter().filter(|e| e.faces.contains(&face)) {
+            let other = if e.faces[0] == face {
+                e.faces[1]
+            } else {
+                e.faces[0]
+            };
+            if other == u32::MAX {
+                continue;
+            }
+            let fold = normal(face as usize)
+                .angle_between(normal(other as usize))
+                .to_degrees();
+            let len = (hull.points[e.v[0] as usize] - hull.points[e.v[1] as usize]).length();
+            println!(
+                "   edge {:?} len {len:.3} -> face {other} {:?} elem {} fold {fold:.3}°",
+                e.v, hull.triangles[other as usize], hull.element[other as usize]
+            );
+        }
+    }
+}
+
+/// The sign projection (`sign_rounds`) on l_prism's quintic, whose solve leaves 80 non-jet
+/// weights off Theorem 2.1's signs (the four relaxed stars at its concave edge): fewer are off
+/// afterwards (44 with 100 rounds, session 30), and the independent check still finds C2
+/// to its bounds, exact vertex values and normals (the jets are not moved), and no hole or
+/// j-sheet.
+#[test]
+fn sign_projection_keeps_c2_and_the_jets_on_l_prism() {
+    let path = Path::new("scenes/paper1994/l_prism_quintic.toml");
+    let mut scene = apatch::scene::load(path).unwrap();
+    let apatch::scene::Model::Mesh { scheme, .. } = &mut scene.model else {
+        panic!("{}: not a mesh scene", path.display());
+    };
+    scheme.insert("sign_rounds".into(), 100.into());
+    let built = apatch::scene::build_scene(&scene).unwrap();
+    let p = &built.solve.as_ref().unwrap().sign_projection;
+    assert!(p.kept && p.off_after < p.off_before, "{p:?}");
+    let r = check(&built.complex, &CheckOptions::default());
+    // The check's own bounds: gradient 1e-9, Hessian 1e-7 (issue 8), vertex value 1e-9 and
+    // normal 1e-7.
+    assert!(r.passed(), "{:?}", r.failures());
+    assert_eq!((r.holes.crossing, r.sheets.j_multi_patches), (0, 0));
+}
+
+/// `sign_rounds` and `balance_edges` are read from the scene; bad values name the key and the
+/// scene file.
+#[test]
+fn sign_rounds_and_balance_edges_are_scene_keys() {
+    let scene = Path::new("x/scene.toml");
+    let table: toml::Table =
+        toml::from_str("type = \"quintic-c2\"\nsign_rounds = 7\nbalance_edges = true").unwrap();
+    let o = QuinticOptions::from_toml(&table, scene).unwrap();
+    assert_eq!((o.sign_rounds, o.balance_edges), (7, true));
+    assert_eq!(QuinticOptions::default().sign_rounds, 0);
+    assert!(!QuinticOptions::default().balance_edges);
+    for bad in ["sign_rounds = -1", "sign_rounds = 2.5", "balance_edges = 1"] {
+        let table: toml::Table = toml::from_str(bad).unwrap();
+        let e = QuinticOptions::from_toml(&table, scene)
+            .unwrap_err()
+            .to_string();
+        let key = bad.split(' ').next().unwrap();
+        assert!(e.contains(key) && e.contains("x/scene.toml"), "{bad}: {e}");
+    }
 }

@@ -12,7 +12,8 @@ use std::path::Path;
 /// stars, `HSIGNS=1` the Hessian sign fit, `TANGENTS=1` the tangent containment and
 /// `STAR_TAU` the stars' near-null threshold, `REPAIR=1` the hole repair and
 /// `REPAIR_HESSIANS=0` its Hessian passes off, `THICKEN=0` the sliver edge tetrahedra left
-/// as they are (to explore).
+/// as they are, `BALANCE=1` the balanced edge points and `SIGN_ROUNDS` the sign projection's
+/// rounds (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -38,6 +39,11 @@ fn options() -> QuinticOptions {
         repair_holes: std::env::var("REPAIR").is_ok_and(|s| s == "1"),
         repair_hessians: std::env::var("REPAIR_HESSIANS").map_or(true, |s| s != "0"),
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
+        balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
+        sign_rounds: std::env::var("SIGN_ROUNDS")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(0),
     }
 }
 

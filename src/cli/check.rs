@@ -297,10 +297,24 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
             s.slivers_found, s.slivers_thickened
         )
     };
+    let p = &s.sign_projection;
+    let projection = if p.too_large {
+        "; sign projection skipped: too large to factor".to_string()
+    } else if p.rounds == 0 {
+        String::new()
+    } else {
+        format!(
+            "; sign projection: {} -> {} weights off their signs in {} rounds{}",
+            p.off_before,
+            p.off_after,
+            p.rounds,
+            if p.kept { "" } else { " (not kept)" }
+        )
+    };
     format!(
         "solve            {} unknowns, {} equations, largest group {} ({} sparse), residual \
          {:.1e}; {} points of T relaxed, {} consistency conditions{}; {} weights off Theorem \
-         2.1's sufficient signs, in {} patches{slivers}{repair}  info",
+         2.1's sufficient signs, in {} patches{slivers}{projection}{repair}  info",
         s.unknowns,
         s.equations,
         s.largest_group,

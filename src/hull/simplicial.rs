@@ -84,6 +84,10 @@ pub enum EdgePoint {
     /// s = (1 − μ) q0 + μ q1 with this μ (q0 the apex of the edge's first triangle): on the
     /// apexes' line but not at its middle.
     Ratio(f64),
+    /// s on the apexes' line at the ratio that keeps C1/C2 extrapolation smallest
+    /// ([`balanced_ratio`]): needle triangles of T and small triangles beside large ones put
+    /// the midpoint far outside a face tetrahedron's frame.
+    Balanced,
 }
 
 impl EdgePoint {
@@ -95,6 +99,9 @@ impl EdgePoint {
             EdgePoint::Midpoint => m,
             EdgePoint::Lift(t) => m + t * (m - 0.5 * (pi + pj)),
             EdgePoint::Ratio(mu) => (1.0 - mu) * q0 + mu * q1,
+            // Without the face tetrahedra the balanced point is the midpoint;
+            // `edge_tets_with` places it with them.
+            EdgePoint::Balanced => m,
         }
     }
 }
@@ -210,7 +217,19 @@ impl SimplicialHull {
                 };
                 let pi = self.points[edge.v[0] as usize];
                 let pj = self.points[edge.v[1] as usize];
-                let s = rule.place(q0, q1, pi, pj);
+                let s = if rule == EdgePoint::Balanced {
+                    let a = self.face_tet(f0 as usize, side);
+                    let b = self.face_tet(f1 as usize, side);
+                    match (a, b) {
+                        (Some(a), Some(b)) => {
+                            let mu = balanced_ratio(&a, &b, q0, q1);
+                            (1.0 - mu) * q0 + mu * q1
+                        }
+                        _ => rule.place(q0, q1, pi, pj),
+                    }
+                } else {
+                    rule.place(q0, q1, pi, pj)
+                };
                 for (face, q) in [(f0, q0), (f1, q1)] {
                     out.push(EdgeTet {
                         edge: e as u32,
@@ -222,6 +241,68 @@ impl SimplicialHull {
             }
         }
         Ok(out)
+    }
+}
+
+/// Nearest [`balanced_ratio`] gets to either apex: the thinner edge tetrahedron keeps at least
+/// this share of the pair's volume.
+pub const BALANCE_MIN_RATIO: f64 = 0.1;
+
+/// Sum of |barycentric coordinates| of `x` in the tetrahedron `t` (∞ when `t` is flat): how
+/// far a polynomial on `t` is extrapolated to reach `x` (C1 conditions across a face multiply
+/// weights by up to this, C2 by its square).
+#[must_use]
+pub fn extrapolation(t: &[DVec3; 4], x: DVec3) -> f64 {
+    let m = glam::DMat3::from_cols(t[1] - t[0], t[2] - t[0], t[3] - t[0]);
+    if m.determinant().abs() <= f64::MIN_POSITIVE {
+        return f64::INFINITY;
+    }
+    let l = m.inverse() * (x - t[0]);
+    (1.0 - l.x - l.y - l.z).abs() + l.x.abs() + l.y.abs() + l.z.abs()
+}
+
+/// The ratio μ of s = (1 − μ) q0 + μ q1 for the edge tetrahedra glued to the face tetrahedra
+/// `a` (apex q0) and `b` (apex q1) over one edge of T that makes the largest extrapolation
+/// among the three faces C1/C2 cross at the pair smallest: s in `a`, s in `b`, and each
+/// apex in the other edge tetrahedron's frame ((2 − μ)/μ and (1 + μ)/(1 − μ), 3 at the
+/// midpoint). Each is convex in μ, so their maximum is, and a golden-section search over
+/// [[`BALANCE_MIN_RATIO`], 1 − [`BALANCE_MIN_RATIO`]] finds it. The pair's union
+/// [p_i p_j q0 q1] does not depend on μ, so the hull's tetrahedra keep their overlaps and
+/// gaps (none) whatever it is. Where the midpoint is within 1% of the best it is kept, so
+/// well-shaped pairs are unchanged.
+#[must_use]
+pub fn balanced_ratio(a: &[DVec3; 4], b: &[DVec3; 4], q0: DVec3, q1: DVec3) -> f64 {
+    let cost = |mu: f64| {
+        let s = (1.0 - mu) * q0 + mu * q1;
+        extrapolation(a, s)
+            .max(extrapolation(b, s))
+            .max((2.0 - mu) / mu)
+            .max((1.0 + mu) / (1.0 - mu))
+    };
+    let (mut lo, mut hi) = (BALANCE_MIN_RATIO, 1.0 - BALANCE_MIN_RATIO);
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (cost(x1), cost(x2));
+    for _ in 0..60 {
+        if f1 <= f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - g * (hi - lo);
+            f1 = cost(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + g * (hi - lo);
+            f2 = cost(x2);
+        }
+    }
+    let best = 0.5 * (lo + hi);
+    if cost(0.5) <= 1.01 * cost(best) {
+        0.5
+    } else {
+        best
     }
 }
 
@@ -264,5 +345,94 @@ mod tests {
         assert!(r[0].tet[3].distance(DVec3::new(0.4, 0.4, 1.25)) < 1e-15);
         let l = hull.edge_tets_with(EdgePoint::Lift(1.0)).unwrap();
         assert_eq!(l[1].tet[3], DVec3::new(0.5, 0.5, 3.0));
+    }
+
+    /// The face tetrahedra over the edge [(0,0,0) (1,0,0)] of a triangle whose third point is
+    /// `h` off the edge's line and of its mirror image across the edge, a flat fold, with
+    /// apexes 0.3 above their centroids.
+    fn pair(h0: f64, h1: f64) -> ([DVec3; 4], [DVec3; 4]) {
+        let (pi, pj) = (DVec3::ZERO, DVec3::X);
+        let k0 = DVec3::new(0.4, h0, 0.0);
+        let k1 = DVec3::new(0.6, -h1, 0.0);
+        let q0 = (pi + pj + k0) / 3.0 + DVec3::new(0.0, 0.0, 0.3);
+        let q1 = (pi + pj + k1) / 3.0 + DVec3::new(0.0, 0.0, 0.3);
+        ([pi, pj, k0, q0], [pj, pi, k1, q1])
+    }
+
+    /// The largest of the four extrapolations [`balanced_ratio`] weighs, at ratio `mu`.
+    fn cost(a: &[DVec3; 4], b: &[DVec3; 4], mu: f64) -> f64 {
+        let s = (1.0 - mu) * a[3] + mu * b[3];
+        extrapolation(a, s)
+            .max(extrapolation(b, s))
+            .max((2.0 - mu) / mu)
+            .max((1.0 + mu) / (1.0 - mu))
+    }
+
+    /// Mirror-image face tetrahedra keep the midpoint exactly: their pair is already balanced.
+    #[test]
+    fn balanced_ratio_keeps_the_midpoint_of_a_symmetric_pair() {
+        let (a, b) = pair(0.8, 0.8);
+        assert_eq!(balanced_ratio(&a, &b, a[3], b[3]), 0.5);
+    }
+
+    /// A needle (third point 0.01 off the edge) beside a thick triangle: the midpoint lies far
+    /// outside the needle's face tetrahedron (cost 28, its C2 factor ~800), the balanced point
+    /// moves towards the needle's apex, and its cost is the least on a fine grid of ratios
+    /// (brute force, independent of the golden-section search) to 1%.
+    #[test]
+    fn balanced_ratio_moves_s_towards_a_needle() {
+        let (a, b) = pair(0.01, 0.8);
+        let mid = cost(&a, &b, 0.5);
+        assert!(mid > 20.0, "midpoint cost {mid}");
+        let mu = balanced_ratio(&a, &b, a[3], b[3]);
+        assert!((BALANCE_MIN_RATIO..0.5).contains(&mu), "μ = {mu}");
+        let best = (1..1000)
+            .map(|k| f64::from(k) / 1000.0)
+            .filter(|m| (BALANCE_MIN_RATIO..=1.0 - BALANCE_MIN_RATIO).contains(m))
+            .map(|m| cost(&a, &b, m))
+            .fold(f64::INFINITY, f64::min);
+        let got = cost(&a, &b, mu);
+        // The grid's step (1e-3 in μ) changes a cost of ~20 by < 1%.
+        assert!(got <= 1.01 * best, "balanced {got}, grid best {best}");
+        assert!(got < 0.5 * mid, "balanced {got}, midpoint {mid}");
+        // The pair's union is [p_i p_j q0 q1] wherever s lies on the apexes' line.
+        let vol = |t: [DVec3; 4]| (t[1] - t[0]).cross(t[2] - t[0]).dot(t[3] - t[0]).abs() / 6.0;
+        let s = (1.0 - mu) * a[3] + mu * b[3];
+        let union = vol([a[0], a[1], a[3], b[3]]);
+        let parts = vol([a[0], a[1], a[3], s]) + vol([a[0], a[1], b[3], s]);
+        // Rounding of two triple products of O(1) vectors.
+        assert!((parts - union).abs() < 1e-14, "{parts} vs {union}");
+    }
+
+    /// `edge_tets_with(Balanced)` places s on the apexes' line at `balanced_ratio`.
+    #[test]
+    fn balanced_edge_tets_use_the_ratio() {
+        let hull = SimplicialHull {
+            points: vec![
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(0.4, 0.01, 0.0),
+                DVec3::new(0.6, -0.8, 0.0),
+            ],
+            normals: vec![DVec3::Z; 4],
+            origins: vec![PointOrigin::Other; 4],
+            triangles: vec![[0, 1, 2], [1, 0, 3]],
+            apexes: vec![
+                [Some(DVec3::new(1.4 / 3.0, 0.01 / 3.0, 0.3)), None],
+                [Some(DVec3::new(1.6 / 3.0, -0.8 / 3.0, 0.3)), None],
+            ],
+            element: vec![0, 1],
+        };
+        let et = hull.edge_tets_with(EdgePoint::Balanced).unwrap();
+        assert_eq!(et.len(), 2);
+        let (a, b) = (
+            hull.face_tet(0, Side::Outer).unwrap(),
+            hull.face_tet(1, Side::Outer).unwrap(),
+        );
+        let mu = balanced_ratio(&a, &b, a[3], b[3]);
+        let s = (1.0 - mu) * a[3] + mu * b[3];
+        assert!(mu < 0.5);
+        assert_eq!(et[0].tet[3], s);
+        assert_eq!(et[1].tet[3], s);
     }
 }

@@ -16,6 +16,7 @@ pub mod holes;
 pub mod jets;
 pub mod ordering;
 mod pinned;
+pub mod project;
 pub mod signs;
 pub mod slivers;
 pub mod sparse;
@@ -23,7 +24,7 @@ pub mod system;
 
 use crate::complex::{Patch, PatchComplex, SheetRule};
 use crate::error::{Error, Result};
-use crate::hull::simplicial::SimplicialHull;
+use crate::hull::simplicial::{EdgePoint, SimplicialHull};
 use crate::mesh::Mesh;
 use anyhow::bail;
 use glam::DVec3;
@@ -100,6 +101,16 @@ pub struct QuinticOptions {
     /// rounding times (L / h)², which no solve can remove ([`slivers`]). On by default; hulls
     /// without such slivers are unchanged.
     pub thicken_edges: bool,
+    /// Place each edge tetrahedron pair's shared point s on its apexes' line where C1/C2
+    /// extrapolate least ([`crate::hull::simplicial::balanced_ratio`]) instead of at the
+    /// midpoint: a needle triangle of T, or a small triangle beside a large one, puts the
+    /// midpoint 20–200 of its face tetrahedron's sizes away, and the C2 conditions then
+    /// multiply the face tetrahedron's weights by that squared. Off by default.
+    pub balance_edges: bool,
+    /// Rounds of alternating projections between Theorem 2.1's signs and the C1/C2 equations
+    /// after the solve ([`project`]; 0 = off, the default): the weights move towards their
+    /// signs, C2 is kept, the jets are not moved.
+    pub sign_rounds: usize,
 }
 
 impl Default for QuinticOptions {
@@ -119,6 +130,8 @@ impl Default for QuinticOptions {
             repair_holes: false,
             repair_hessians: true,
             thicken_edges: true,
+            balance_edges: false,
+            sign_rounds: 0,
         }
     }
 }
@@ -165,6 +178,18 @@ impl QuinticOptions {
                 "repair_holes" => o.repair_holes = flag()?,
                 "repair_hessians" => o.repair_hessians = flag()?,
                 "thicken_edges" => o.thicken_edges = flag()?,
+                "balance_edges" => o.balance_edges = flag()?,
+                "sign_rounds" => {
+                    o.sign_rounds = v
+                        .as_integer()
+                        .and_then(|x| usize::try_from(x).ok())
+                        .ok_or_else(|| {
+                            anyhow::anyhow!(
+                                "{}: `scheme.sign_rounds` must be a whole number ≥ 0, got {v}",
+                                scene.display()
+                            )
+                        })?;
+                }
                 "zero_groups" => o.zero_groups = flag()?,
                 "star_tau" => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
                     Some(t) if (0.0..1.0).contains(&t) => o.star_tau = t,
@@ -185,7 +210,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, `thicken_edges`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -296,7 +321,12 @@ pub fn build_prepared(
     for &p in zero_points {
         jets[p as usize].h = glam::DMat3::ZERO;
     }
-    let (tets, _pos) = system::tetrahedra(hull)?;
+    let rule = if options.balance_edges {
+        EdgePoint::Balanced
+    } else {
+        EdgePoint::Midpoint
+    };
+    let (tets, _pos) = system::tetrahedra_with(hull, rule)?;
     let mut sys = system::assemble(&tets, np)?;
     sys.star_tau = options.star_tau;
     if !zero_points.is_empty() {
@@ -319,6 +349,9 @@ pub fn build_prepared(
         options.consistent_stars,
         options.hessian_signs,
     )?;
+    if options.sign_rounds > 0 {
+        stats.sign_projection = project::project_signs(&sys, &mut value, options.sign_rounds);
+    }
     if options.repair_holes {
         let reach = holes::Reach {
             rings: std::env::var("APATCH_HOLE_RINGS")

@@ -385,7 +385,7 @@ fn face_equations(
 
 /// Stage of a slot (0 = known from the jets), see the module documentation, and the point or
 /// points of T it is attached to (for messages).
-fn stage(key: u128, np: u32) -> (u8, Vec<u32>) {
+pub(super) fn stage(key: u128, np: u32) -> (u8, Vec<u32>) {
     let parts = unkey(key);
     let hull: Vec<(u32, u8)> = parts.iter().copied().filter(|p| p.0 < np).collect();
     let pts: Vec<u32> = hull.iter().map(|p| p.0).collect();
@@ -454,6 +454,8 @@ pub struct SolveStats {
     pub hessian_fit: signs::HessianFit,
     /// What [`super::holes::repair`] changed (`QuinticOptions::repair_holes`).
     pub hole_repair: super::holes::HoleRepair,
+    /// What [`super::project::project_signs`] did (`QuinticOptions::sign_rounds`).
+    pub sign_projection: super::project::SignProjection,
 }
 
 /// One point's vertex-star system ([`System::star_systems`]).
