@@ -390,8 +390,8 @@ fn mpi_poly_scene_has_no_holes() {
 /// towards Theorem 2.1's signs (`sign_rounds`). Here with 60 rounds instead of the scene's 300
 /// (the same effect, a third of the time): the projection must keep C2 and the jets (vertex
 /// values and normals), leave fewer weights off their signs, and leave fewer holes and
-/// j-sheets than the same scene without it (session 30: 487 + 177 without, 212 + 51 with 60
-/// rounds, 179 + 31 with 300; the scene stays pending for those).
+/// j-sheets than the same scene without it (session 30: 487 + 177 without, 114 + 23 with 60
+/// rounds, 98 + 9 with 300; the scene stays pending for those).
 #[test]
 fn mpi_poly_quintic_scene_is_c2() {
     let path = Path::new("scenes/pending/paper1994/mpi_poly_quintic.toml");

@@ -528,7 +528,7 @@ fn needle_details() {
 
 /// The sign projection (`sign_rounds`) on l_prism's quintic, whose solve leaves 80 non-jet
 /// weights off Theorem 2.1's signs (the four relaxed stars at its concave edge): fewer are off
-/// afterwards (44 with 100 rounds, session 30), and the independent check still finds C2
+/// afterwards (none with 100 rounds, session 30), and the independent check still finds C2
 /// to its bounds, exact vertex values and normals (the jets are not moved), and no hole or
 /// j-sheet.
 #[test]
