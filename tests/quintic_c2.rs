@@ -252,6 +252,40 @@ fn star_systems_are_singular_for_every_edge_point() {
     );
 }
 
+/// Every 1994 quintic scene, shipped and pending, sorted.
+fn quintic_scenes() -> Vec<std::path::PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut paths: Vec<_> = ["paper1994", "pending/paper1994"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with("_quintic.toml"))
+        .collect();
+    paths.sort();
+    paths
+}
+
+/// The inner hull builder's hull of a mesh scene, before the quintic's changes
+/// (`scene::inner_hull` returns it after them), with the scene's quintic options.
+fn built_hull(p: &Path) -> Option<(apatch::hull::simplicial::SimplicialHull, QuinticOptions)> {
+    let scene = apatch::scene::load(p).unwrap();
+    let apatch::scene::Model::Mesh {
+        file,
+        normals,
+        scheme,
+        clean,
+        ..
+    } = &scene.model
+    else {
+        return None;
+    };
+    let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean).unwrap();
+    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
+    let inner = apatch::hull::inner::InnerOptions::from_toml(scheme, p).unwrap();
+    let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
+    Some((hull, QuinticOptions::from_toml(scheme, p).unwrap()))
+}
+
 /// The thinnest edge tetrahedra of every quintic scene's hull as the quintic fills it (the
 /// builder's hull with the L-U partners added, `prepare_hull` without `thicken_edges`), for
 /// choosing `slivers::EDGE_MIN_VOLUME`: prints, per scene, the smallest pair volumes, how many
@@ -261,33 +295,10 @@ fn star_systems_are_singular_for_every_edge_point() {
 #[ignore = "survey for humans: builds every 1994 quintic scene's hull (~1 min)"]
 fn edge_sliver_survey() {
     use apatch::scheme::quintic_c2::{prepare_hull, slivers};
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let mut paths: Vec<_> = ["paper1994", "pending/paper1994"]
-        .iter()
-        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with("_quintic.toml"))
-        .collect();
-    paths.sort();
-    for p in paths {
-        let scene = apatch::scene::load(&p).unwrap();
-        let apatch::scene::Model::Mesh {
-            file,
-            normals,
-            scheme,
-            clean,
-            ..
-        } = &scene.model
-        else {
+    for p in quintic_scenes() {
+        let Some((hull, options)) = built_hull(&p) else {
             continue;
         };
-        // The builder's hull, before the scheme's changes (`scene::inner_hull` returns it
-        // after them).
-        let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean).unwrap();
-        let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
-        let inner = apatch::hull::inner::InnerOptions::from_toml(scheme, &p).unwrap();
-        let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
-        let options = QuinticOptions::from_toml(scheme, &p).unwrap();
         let lu_only = QuinticOptions {
             thicken_edges: false,
             contain_tangents: false,
@@ -386,31 +397,10 @@ fn extrapolation(
 #[ignore]
 fn needle_survey() {
     use apatch::scheme::quintic_c2::prepare_hull;
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let mut paths: Vec<_> = ["paper1994", "pending/paper1994"]
-        .iter()
-        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.to_string_lossy().ends_with("_quintic.toml"))
-        .collect();
-    paths.sort();
-    for p in paths {
-        let scene = apatch::scene::load(&p).unwrap();
-        let apatch::scene::Model::Mesh {
-            file,
-            normals,
-            scheme,
-            clean,
-            ..
-        } = &scene.model
-        else {
+    for p in quintic_scenes() {
+        let Some((hull, options)) = built_hull(&p) else {
             continue;
         };
-        let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean).unwrap();
-        let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
-        let inner = apatch::hull::inner::InnerOptions::from_toml(scheme, &p).unwrap();
-        let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
-        let options = QuinticOptions::from_toml(scheme, &p).unwrap();
         let hull = prepare_hull(&hull, &options).unwrap().hull;
         let mut angles: Vec<f64> = hull
             .triangles
@@ -461,22 +451,9 @@ fn needle_details() {
         return;
     };
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(&name);
-    let scene = apatch::scene::load(&p).unwrap();
-    let apatch::scene::Model::Mesh {
-        file,
-        normals,
-        scheme,
-        clean,
-        ..
-    } = &scene.model
-    else {
+    let Some((hull, options)) = built_hull(&p) else {
         return;
     };
-    let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean).unwrap();
-    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
-    let inner = apatch::hull::inner::InnerOptions::from_toml(scheme, &p).unwrap();
-    let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
-    let options = QuinticOptions::from_toml(scheme, &p).unwrap();
     let hull = prepare_hull(&hull, &options).unwrap().hull;
     let edges = hull.edges().unwrap();
     let mut ex = extrapolation(&hull, EdgePoint::Midpoint);
