@@ -308,7 +308,11 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
             p.off_before,
             p.off_after,
             p.rounds,
-            if p.kept { "" } else { " (not kept)" }
+            if p.kept {
+                String::new()
+            } else {
+                format!(" (not kept: equations met to {:.1e})", p.residual)
+            }
         )
     };
     format!(
