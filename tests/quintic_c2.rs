@@ -382,11 +382,10 @@ fn extrapolation(
         .iter()
         .map(|et| {
             let face = hull.face_tet(et.face as usize, et.side).unwrap();
-            (
-                apatch::hull::simplicial::extrapolation(&face, et.tet[3]),
-                et.face,
-                et.edge,
-            )
+            let factor = apatch::bb::Tet::new(face).map_or(f64::INFINITY, |t| {
+                apatch::hull::simplicial::extrapolation(&t, et.tet[3])
+            });
+            (factor, et.face, et.edge)
         })
         .collect()
 }

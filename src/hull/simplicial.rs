@@ -9,6 +9,7 @@
 //! `[p_i p_j q_l s]`, `[p_i p_j q_n s]` with `s = (q_l + q_n)/2` (Def. 3.6 (5)(ii)); those are
 //! derived here, not stored, so every hull builder gets them the same way.
 
+use crate::bb::Tet;
 use glam::DVec3;
 use std::collections::HashMap;
 
@@ -218,15 +219,12 @@ impl SimplicialHull {
                 let pi = self.points[edge.v[0] as usize];
                 let pj = self.points[edge.v[1] as usize];
                 let s = if rule == EdgePoint::Balanced {
-                    let a = self.face_tet(f0 as usize, side);
-                    let b = self.face_tet(f1 as usize, side);
-                    match (a, b) {
-                        (Some(a), Some(b)) => {
-                            let mu = balanced_ratio(&a, &b, q0, q1);
-                            (1.0 - mu) * q0 + mu * q1
-                        }
-                        _ => rule.place(q0, q1, pi, pj),
-                    }
+                    let face = |f: u32, q: DVec3| {
+                        let [a, b, c] = self.triangles[f as usize].map(|i| self.points[i as usize]);
+                        [a, b, c, q]
+                    };
+                    let mu = balanced_ratio(&face(f0, q0), &face(f1, q1));
+                    (1.0 - mu) * q0 + mu * q1
                 } else {
                     rule.place(q0, q1, pi, pj)
                 };
@@ -248,37 +246,40 @@ impl SimplicialHull {
 /// this share of the pair's volume.
 pub const BALANCE_MIN_RATIO: f64 = 0.1;
 
-/// Sum of |barycentric coordinates| of `x` in the tetrahedron `t` (∞ when `t` is flat): how
-/// far a polynomial on `t` is extrapolated to reach `x` (C1 conditions across a face multiply
-/// weights by up to this, C2 by its square).
+/// Sum of |barycentric coordinates| of `x` in the tetrahedron `t`: how far a polynomial on `t`
+/// is extrapolated to reach `x` (C1 conditions across a face multiply weights by up to this,
+/// C2 by its square).
 #[must_use]
-pub fn extrapolation(t: &[DVec3; 4], x: DVec3) -> f64 {
-    let m = glam::DMat3::from_cols(t[1] - t[0], t[2] - t[0], t[3] - t[0]);
-    if m.determinant().abs() <= f64::MIN_POSITIVE {
-        return f64::INFINITY;
-    }
-    let l = m.inverse() * (x - t[0]);
-    (1.0 - l.x - l.y - l.z).abs() + l.x.abs() + l.y.abs() + l.z.abs()
+pub fn extrapolation(t: &Tet, x: DVec3) -> f64 {
+    t.bary(x).iter().map(|l| l.abs()).sum()
+}
+
+/// The largest extrapolation the C1/C2 faces of an edge tetrahedron pair make with s at ratio
+/// `mu` on the apexes' line: s in either face tetrahedron `a` (apex `a.v[3]`) or `b`, and each
+/// apex in the other edge tetrahedron's frame ((2 − μ)/μ and (1 + μ)/(1 − μ), 3 at the
+/// midpoint). What [`balanced_ratio`] makes least.
+#[must_use]
+pub fn pair_extrapolation(a: &Tet, b: &Tet, mu: f64) -> f64 {
+    let s = (1.0 - mu) * a.v[3] + mu * b.v[3];
+    extrapolation(a, s)
+        .max(extrapolation(b, s))
+        .max((2.0 - mu) / mu)
+        .max((1.0 + mu) / (1.0 - mu))
 }
 
 /// The ratio μ of s = (1 − μ) q0 + μ q1 for the edge tetrahedra glued to the face tetrahedra
-/// `a` (apex q0) and `b` (apex q1) over one edge of T that makes the largest extrapolation
-/// among the three faces C1/C2 cross at the pair smallest: s in `a`, s in `b`, and each
-/// apex in the other edge tetrahedron's frame ((2 − μ)/μ and (1 + μ)/(1 − μ), 3 at the
-/// midpoint). Each is convex in μ, so their maximum is, and a golden-section search over
-/// [[`BALANCE_MIN_RATIO`], 1 − [`BALANCE_MIN_RATIO`]] finds it. The pair's union
-/// [p_i p_j q0 q1] does not depend on μ, so the hull's tetrahedra keep their overlaps and
-/// gaps (none) whatever it is. Where the midpoint is within 1% of the best it is kept, so
-/// well-shaped pairs are unchanged.
+/// `a` (apex q0 = `a[3]`) and `b` (apex q1 = `b[3]`) over one edge of T that makes
+/// [`pair_extrapolation`] least. Each of its terms is convex in μ, so their maximum is, and a
+/// golden-section search over [[`BALANCE_MIN_RATIO`], 1 − [`BALANCE_MIN_RATIO`]] finds it. The
+/// pair's union [p_i p_j q0 q1] does not depend on μ, so the hull's tetrahedra keep their
+/// overlaps and gaps (none) whatever it is. Where the midpoint is within 1% of the best it is
+/// kept, so well-shaped pairs are unchanged; so is a degenerate face tetrahedron's.
 #[must_use]
-pub fn balanced_ratio(a: &[DVec3; 4], b: &[DVec3; 4], q0: DVec3, q1: DVec3) -> f64 {
-    let cost = |mu: f64| {
-        let s = (1.0 - mu) * q0 + mu * q1;
-        extrapolation(a, s)
-            .max(extrapolation(b, s))
-            .max((2.0 - mu) / mu)
-            .max((1.0 + mu) / (1.0 - mu))
+pub fn balanced_ratio(a: &[DVec3; 4], b: &[DVec3; 4]) -> f64 {
+    let (Some(a), Some(b)) = (Tet::new(*a), Tet::new(*b)) else {
+        return 0.5;
     };
+    let cost = |mu: f64| pair_extrapolation(&a, &b, mu);
     let (mut lo, mut hi) = (BALANCE_MIN_RATIO, 1.0 - BALANCE_MIN_RATIO);
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
@@ -359,20 +360,16 @@ mod tests {
         ([pi, pj, k0, q0], [pj, pi, k1, q1])
     }
 
-    /// The largest of the four extrapolations [`balanced_ratio`] weighs, at ratio `mu`.
+    /// [`pair_extrapolation`] of the pair at ratio `mu`.
     fn cost(a: &[DVec3; 4], b: &[DVec3; 4], mu: f64) -> f64 {
-        let s = (1.0 - mu) * a[3] + mu * b[3];
-        extrapolation(a, s)
-            .max(extrapolation(b, s))
-            .max((2.0 - mu) / mu)
-            .max((1.0 + mu) / (1.0 - mu))
+        pair_extrapolation(&Tet::new(*a).unwrap(), &Tet::new(*b).unwrap(), mu)
     }
 
     /// Mirror-image face tetrahedra keep the midpoint exactly: their pair is already balanced.
     #[test]
     fn balanced_ratio_keeps_the_midpoint_of_a_symmetric_pair() {
         let (a, b) = pair(0.8, 0.8);
-        assert_eq!(balanced_ratio(&a, &b, a[3], b[3]), 0.5);
+        assert_eq!(balanced_ratio(&a, &b), 0.5);
     }
 
     /// A needle (third point 0.01 off the edge) beside a thick triangle: the midpoint lies far
@@ -384,7 +381,7 @@ mod tests {
         let (a, b) = pair(0.01, 0.8);
         let mid = cost(&a, &b, 0.5);
         assert!(mid > 20.0, "midpoint cost {mid}");
-        let mu = balanced_ratio(&a, &b, a[3], b[3]);
+        let mu = balanced_ratio(&a, &b);
         assert!((BALANCE_MIN_RATIO..0.5).contains(&mu), "μ = {mu}");
         let best = (1..1000)
             .map(|k| f64::from(k) / 1000.0)
@@ -429,7 +426,7 @@ mod tests {
             hull.face_tet(0, Side::Outer).unwrap(),
             hull.face_tet(1, Side::Outer).unwrap(),
         );
-        let mu = balanced_ratio(&a, &b, a[3], b[3]);
+        let mu = balanced_ratio(&a, &b);
         let s = (1.0 - mu) * a[3] + mu * b[3];
         assert!(mu < 0.5);
         assert_eq!(et[0].tet[3], s);

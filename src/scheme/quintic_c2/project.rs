@@ -7,14 +7,14 @@
 //! crosses the hull's boundary faces (holes) or a j-line twice (j-sheets).
 //!
 //! This step moves the solved weights, keeping the jets (numbers 0–2) fixed, alternately onto
-//! the box of the signs (each weight with a sign condition clamped to at least a small margin
+//! the box of the signs (each weight with a sign condition clamped to at least [`SIGN_MARGIN`]
 //! on its side) and back onto the scheme's C1/C2 equations (the closest point, one sparse
 //! factor of the equations reused in every round: [`cholesky::Projector::meet`]). Each round
 //! is two Euclidean projections onto convex sets, so the distance to their intersection never
 //! grows; where the intersection is empty (the signs are sufficient, not necessary, and some
 //! cannot all hold) the weights still move towards it. The last move is onto the equations,
-//! so C2 holds to the factor's refinement whatever the signs do, and the result is kept only
-//! when fewer weights miss their signs than before.
+//! so C2 holds to the factor's refinement whatever the signs do; the result is kept only when
+//! fewer weights miss their signs than before and the equations are met to [`KEEP_RESIDUAL`].
 
 use super::cholesky::{self, Projector};
 use super::sparse::Row;
@@ -96,8 +96,9 @@ pub fn project_signs(sys: &System, value: &mut [f64], rounds: usize) -> SignProj
         })
         .collect();
     let mut x: Vec<f64> = slots.iter().map(|&s| value[s]).collect();
+    let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     // As in `signs::SignStats`: weights this small are zero up to the solves' rounding.
-    let tiny = -1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let tiny = -1e-12 * scale;
     let mut report = SignProjection {
         off_before: off(&x, &signed, tiny),
         ..SignProjection::default()
@@ -118,7 +119,6 @@ pub fn project_signs(sys: &System, value: &mut [f64], rounds: usize) -> SignProj
         )
     });
     let projector = Projector::new(&rows, n, &c, &ordering);
-    let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let margin = SIGN_MARGIN * median_abs(&x);
     let trace = std::env::var_os("APATCH_SIGN_TRACE").is_some();
     let mut residual = 0.0;
