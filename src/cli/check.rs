@@ -304,10 +304,15 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
         String::new()
     } else {
         format!(
-            "; sign projection: {} -> {} weights off their signs in {} rounds{}",
+            "; sign projection: {} -> {} weights off their signs in {} rounds{}{}",
             p.off_before,
             p.off_after,
             p.rounds,
+            if p.precise {
+                ", last move in double-double"
+            } else {
+                ""
+            },
             if p.kept {
                 String::new()
             } else {
