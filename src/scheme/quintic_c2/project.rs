@@ -158,13 +158,7 @@ pub fn project_rows(
     let mut residual = 0.0;
     for r in 0..rounds {
         crate::progress::report(|| format!("quintic-c2 sign projection: round {}", r + 1));
-        let mut clamped = 0;
-        for &(j, sign) in signed {
-            if sign * x[j] < margin {
-                x[j] = sign * margin;
-                clamped += 1;
-            }
-        }
+        let clamped = clamp(x, signed, margin);
         report.rounds = r + 1;
         if clamped == 0 {
             break;
@@ -181,20 +175,13 @@ pub fn project_rows(
     if residual > KEEP_RESIDUAL * scale {
         // The last move again, from the same clamped weights, with the precise factor.
         crate::progress::report(|| "quintic-c2 sign projection: double-double factor".into());
+        drop(projector);
         let precise = Projector::precise(rows, n, c, &ordering, cholesky::PRECISE_PIVOT);
-        let before = x.clone();
-        for &(j, sign) in signed {
-            if sign * x[j] < margin {
-                x[j] = sign * margin;
-            }
-        }
-        let got = precise.meet(x, REFINE_TARGET * scale);
+        clamp(x, signed, margin);
+        // A precise move that does no better leaves the residual above the bound: refused
+        // below either way, and `x` restored to the start.
+        residual = residual.min(precise.meet(x, REFINE_TARGET * scale));
         report.precise = true;
-        if got < residual {
-            residual = got;
-        } else {
-            *x = before;
-        }
     }
     report.residual = residual;
     let after = off(x, signed, tiny);
@@ -205,6 +192,19 @@ pub fn project_rows(
         *x = start;
     }
     report
+}
+
+/// Clamps every weight of `signed` (index, sign) to at least `margin` on its side (the sign
+/// box); returns how many moved.
+fn clamp(x: &mut [f64], signed: &[(usize, f64)], margin: f64) -> usize {
+    let mut clamped = 0;
+    for &(j, sign) in signed {
+        if sign * x[j] < margin {
+            x[j] = sign * margin;
+            clamped += 1;
+        }
+    }
+    clamped
 }
 
 /// Weights of `signed` (index, sign) on the wrong side of `margin`.
