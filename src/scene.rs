@@ -838,6 +838,33 @@ pub fn polyhedron_1994(
 pub fn inner_hull(
     scene: &Scene,
 ) -> anyhow::Result<Option<crate::hull::simplicial::SimplicialHull>> {
+    let Some(hull) = builder_hull(scene)? else {
+        return Ok(None);
+    };
+    let Model::Mesh { file, scheme, .. } = &scene.model else {
+        return Ok(None);
+    };
+    if scheme.get("type").and_then(|v| v.as_str()) == Some("cubic-c1") {
+        let (cubic, _) = crate::scheme::cubic_c1::options_from_toml(scheme, &scene.path)?;
+        return Ok(Some(
+            crate::scheme::cubic_c1::prepare_hull(&hull, &cubic).hull,
+        ));
+    }
+    let quintic = crate::scheme::quintic_c2::QuinticOptions::from_toml(scheme, &scene.path)?;
+    let prepared = crate::scheme::quintic_c2::prepare_hull(&hull, &quintic)
+        .with_context(|| format!("{}", file.display()))?;
+    Ok(Some(prepared.hull))
+}
+
+/// The inner hull builder's hull of a `cubic-c1` or `quintic-c2` scene, before the scheme's
+/// own changes ([`inner_hull`] returns it after them); `None` for other scenes. For surveys of
+/// what the builder gives and what the schemes change.
+///
+/// # Errors
+/// As [`inner_hull`].
+pub fn builder_hull(
+    scene: &Scene,
+) -> anyhow::Result<Option<crate::hull::simplicial::SimplicialHull>> {
     let Model::Mesh {
         file,
         normals,
@@ -862,16 +889,7 @@ pub fn inner_hull(
     let options = crate::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
     let hull = crate::hull::inner::build(&m, &vn, &options)
         .with_context(|| format!("{}", file.display()))?;
-    if scheme.get("type").and_then(|v| v.as_str()) == Some("cubic-c1") {
-        let (cubic, _) = crate::scheme::cubic_c1::options_from_toml(scheme, &scene.path)?;
-        return Ok(Some(
-            crate::scheme::cubic_c1::prepare_hull(&hull, &cubic).hull,
-        ));
-    }
-    let quintic = crate::scheme::quintic_c2::QuinticOptions::from_toml(scheme, &scene.path)?;
-    let prepared = crate::scheme::quintic_c2::prepare_hull(&hull, &quintic)
-        .with_context(|| format!("{}", file.display()))?;
-    Ok(Some(prepared.hull))
+    Ok(Some(hull))
 }
 
 /// Builds a `cubic-c1` or `quintic-c2` complex as the schemes' `build_from_scene` do (same

@@ -1,6 +1,8 @@
 //! C2 quintic scheme (1994 §6) on the trihedral hulls of convex polyhedra: continuity,
 //! interpolation and single-sheetedness measured by the independent checker.
 
+mod common;
+
 use apatch::check::{check, CheckOptions};
 use apatch::fixtures::trihedral_hull;
 use apatch::hull::simplicial::EdgePoint;
@@ -265,24 +267,14 @@ fn quintic_scenes() -> Vec<std::path::PathBuf> {
     paths
 }
 
-/// The inner hull builder's hull of a mesh scene, before the quintic's changes
-/// (`scene::inner_hull` returns it after them), with the scene's quintic options.
+/// The inner hull builder's hull of a quintic scene, before the quintic's changes
+/// (`scene::builder_hull`), with the scene's quintic options.
 fn built_hull(p: &Path) -> Option<(apatch::hull::simplicial::SimplicialHull, QuinticOptions)> {
     let scene = apatch::scene::load(p).unwrap();
-    let apatch::scene::Model::Mesh {
-        file,
-        normals,
-        scheme,
-        clean,
-        ..
-    } = &scene.model
-    else {
+    let hull = apatch::scene::builder_hull(&scene).unwrap()?;
+    let apatch::scene::Model::Mesh { scheme, .. } = &scene.model else {
         return None;
     };
-    let (m, _, _) = apatch::scene::polyhedron_1994(file, *clean).unwrap();
-    let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
-    let inner = apatch::hull::inner::InnerOptions::from_toml(scheme, p).unwrap();
-    let hull = apatch::hull::inner::build(&m, &vn, &inner).unwrap();
     Some((hull, QuinticOptions::from_toml(scheme, p).unwrap()))
 }
 
@@ -341,10 +333,7 @@ fn edge_sliver_survey() {
 fn spot_control_cage_quintic_is_c2_with_its_sliver_opened() {
     let path = Path::new("scenes/paper1994/spot_control_cage_quintic.toml");
     let mut scene = apatch::scene::load(path).unwrap();
-    let apatch::scene::Model::Mesh { scheme, .. } = &mut scene.model else {
-        panic!("{}: not a mesh scene", path.display());
-    };
-    scheme.insert("repair_holes".into(), false.into());
+    common::set_scheme(&mut scene, "repair_holes", false);
     let built = apatch::scene::build_scene(&scene).unwrap();
     let stats = built.solve.as_ref().unwrap();
     assert_eq!(
@@ -511,10 +500,7 @@ fn needle_details() {
 fn sign_projection_keeps_c2_and_the_jets_on_l_prism() {
     let path = Path::new("scenes/paper1994/l_prism_quintic.toml");
     let mut scene = apatch::scene::load(path).unwrap();
-    let apatch::scene::Model::Mesh { scheme, .. } = &mut scene.model else {
-        panic!("{}: not a mesh scene", path.display());
-    };
-    scheme.insert("sign_rounds".into(), 100.into());
+    common::set_scheme(&mut scene, "sign_rounds", 100);
     let built = apatch::scene::build_scene(&scene).unwrap();
     let p = &built.solve.as_ref().unwrap().sign_projection;
     assert!(p.kept && p.off_after < p.off_before, "{p:?}");
