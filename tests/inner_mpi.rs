@@ -4,6 +4,8 @@
 //! violations of `scenes/paper1994/mpi_poly.toml` by kind and by the input element their
 //! triangles were built for, for the raw hull and the hull the cubic scheme fills.
 
+mod common;
+
 use apatch::hull::inner::{self, HullViolation, InnerOptions};
 use apatch::hull::simplicial::{PointOrigin, SimplicialHull};
 use apatch::mesh::{self, NormalMethod};
@@ -396,10 +398,7 @@ fn mpi_poly_scene_has_no_holes() {
 fn mpi_poly_quintic_scene_is_c2() {
     let path = Path::new("scenes/pending/paper1994/mpi_poly_quintic.toml");
     let mut scene = apatch::scene::load(path).unwrap();
-    let apatch::scene::Model::Mesh { scheme, .. } = &mut scene.model else {
-        panic!("{}: not a mesh scene", path.display());
-    };
-    scheme.insert("sign_rounds".into(), 60.into());
+    common::set_scheme(&mut scene, "sign_rounds", 60);
     let built = apatch::scene::build_scene(&scene).unwrap();
     let report = apatch::check::check(&built.complex, &apatch::check::CheckOptions::default());
     let failures = report.failures();
@@ -415,10 +414,7 @@ fn mpi_poly_quintic_scene_is_c2() {
     assert!(inner::verify(built.hull.as_ref().unwrap()).is_empty());
     let p = &built.solve.as_ref().unwrap().sign_projection;
     assert!(p.kept && p.off_after < p.off_before, "{p:?}");
-    let apatch::scene::Model::Mesh { scheme, .. } = &mut scene.model else {
-        unreachable!()
-    };
-    scheme.insert("sign_rounds".into(), 0.into());
+    common::set_scheme(&mut scene, "sign_rounds", 0);
     let plain = apatch::scene::build_scene(&scene).unwrap();
     let before = apatch::check::check(&plain.complex, &apatch::check::CheckOptions::default());
     let defects = |r: &apatch::check::CheckReport| r.holes.crossing + r.sheets.j_multi_patches;
@@ -446,11 +442,8 @@ fn mpi_poly_quintic_balanced_edges_shrink_the_weights() {
             .fold(0.0_f64, |m, w| m.max(w.abs()))
     };
     let mut build = |balance: bool| {
-        let apatch::scene::Model::Mesh { scheme, .. } = &mut scene.model else {
-            panic!("{}: not a mesh scene", path.display());
-        };
-        scheme.insert("sign_rounds".into(), 0.into());
-        scheme.insert("balance_edges".into(), balance.into());
+        common::set_scheme(&mut scene, "sign_rounds", 0);
+        common::set_scheme(&mut scene, "balance_edges", balance);
         apatch::scene::build_scene(&scene).unwrap().complex
     };
     let (mid, balanced) = (build(false), build(true));
