@@ -13,7 +13,7 @@ use std::path::Path;
 /// `STAR_TAU` the stars' near-null threshold, `REPAIR=1` the hole repair and
 /// `REPAIR_HESSIANS=0` its Hessian passes off, `THICKEN=0` the sliver edge tetrahedra left
 /// as they are, `BALANCE=1` the balanced edge points and `SIGN_ROUNDS` the sign projection's
-/// rounds (to explore).
+/// rounds, `TANGENT_CLEARANCE` the quintic's `tangent_clearance` (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -31,6 +31,10 @@ fn options() -> QuinticOptions {
         consistent_stars: std::env::var("CONSISTENT").is_ok_and(|s| s == "1"),
         hessian_signs: std::env::var("HSIGNS").is_ok_and(|s| s == "1"),
         contain_tangents: std::env::var("TANGENTS").is_ok_and(|s| s == "1"),
+        tangent_clearance: std::env::var("TANGENT_CLEARANCE")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(0.0),
         zero_groups: std::env::var("ZERO").is_ok_and(|s| s == "1"),
         star_tau: std::env::var("STAR_TAU")
             .ok()

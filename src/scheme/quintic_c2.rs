@@ -76,6 +76,15 @@ pub struct QuinticOptions {
     /// the wrong sign on the boundary faces [p_k q s] of the edge tetrahedra next to p_k (a
     /// hole) whatever the free weights are.
     pub contain_tangents: bool,
+    /// As `contain_tangents`, and also move every apex whose slope to a tangent plane of its
+    /// triangle's points is below this (0 = off, the default), though on its side, to the
+    /// margin [`crate::scheme::cubic_c1::tangent::TANGENT_MARGIN`]
+    /// ([`crate::scheme::cubic_c1::tangent::contain_tangents_with`]); the apex search then
+    /// clears the overlaps the moves make (as the cubic's `prepare_hull`). Algorithm 1 puts
+    /// apexes on the polyhedron's edges, so on flat faces the boundary faces [p q s] of the
+    /// edge tetrahedra next to p lie in p's tangent plane and the far star weights decide on
+    /// which side F leaves p (mpi_poly, session 32: holes 98 → 49).
+    pub tangent_clearance: f64,
     /// Make T's coplanar groups whose points' normals agree with their plane up to input
     /// rounding exact zero coplanar groups (Appendix B (5'')(ii), [`flat`]): points on the
     /// plane with its normal, zero Hessians. Off by default (no shipped scene has one).
@@ -126,6 +135,7 @@ impl Default for QuinticOptions {
             consistent_stars: false,
             hessian_signs: false,
             contain_tangents: false,
+            tangent_clearance: 0.0,
             zero_groups: false,
             repair_holes: false,
             repair_hessians: true,
@@ -191,6 +201,16 @@ impl QuinticOptions {
                         })?;
                 }
                 "zero_groups" => o.zero_groups = flag()?,
+                "tangent_clearance" => {
+                    let margin = crate::scheme::cubic_c1::tangent::TANGENT_MARGIN;
+                    match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
+                        Some(c) if (0.0..=margin).contains(&c) => o.tangent_clearance = c,
+                        _ => bail!(
+                            "{}: `scheme.tangent_clearance` must be a number in [0, {margin}] (moved apexes get the slope {margin}), got {v}",
+                            scene.display()
+                        ),
+                    }
+                }
                 "star_tau" => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
                     Some(t) if (0.0..1.0).contains(&t) => o.star_tau = t,
                     _ => bail!(
@@ -210,7 +230,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -278,7 +298,13 @@ pub fn prepare_hull(hull: &SimplicialHull, options: &QuinticOptions) -> Result<P
     } else {
         (completed, Vec::new())
     };
-    let (completed, tangent_moved) = if options.contain_tangents {
+    let (completed, tangent_moved) = if options.tangent_clearance > 0.0 {
+        let (h, moved, _stuck) = crate::scheme::cubic_c1::tangent::contain_tangents_with(
+            &completed,
+            options.tangent_clearance,
+        );
+        (crate::hull::inner::search_apexes(h, true).0, moved.len())
+    } else if options.contain_tangents {
         let (h, moved, _stuck) = crate::scheme::cubic_c1::tangent::contain_tangents(&completed);
         (h, moved.len())
     } else {

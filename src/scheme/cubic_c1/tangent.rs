@@ -147,6 +147,22 @@ fn mixed_base(hull: &SimplicialHull, t: usize, side: Side) -> bool {
 /// moved.
 #[must_use]
 pub fn contain_tangents(hull: &SimplicialHull) -> (SimplicialHull, Vec<(usize, Side)>, usize) {
+    contain_tangents_with(hull, 0.0)
+}
+
+/// [`contain_tangents`] that also moves every apex whose worst slope is below `clearance` (> 0)
+/// though on its side, to the margin [`TANGENT_MARGIN`]. The quintic needs it where apexes lie
+/// *on* a point's tangent plane: Algorithm 1 puts step (3) and (5)(i) apexes on the
+/// polyhedron's edges, so on a flat face the boundary faces [p q s] of the edge tetrahedra next
+/// to its points lie in the surface's own plane, their number 1 and 2 weights vanish, and the
+/// star weights (λ_p = 2), which the C2 conditions fix far from the data, decide on which side
+/// the surface leaves p (mpi_poly: most edge-tetrahedron holes). `clearance` 0 is
+/// [`contain_tangents`] exactly.
+#[must_use]
+pub fn contain_tangents_with(
+    hull: &SimplicialHull,
+    clearance: f64,
+) -> (SimplicialHull, Vec<(usize, Side)>, usize) {
     let mut out = hull.clone();
     let mut moved = Vec::new();
     let mut stuck = 0;
@@ -156,7 +172,9 @@ pub fn contain_tangents(hull: &SimplicialHull) -> (SimplicialHull, Vec<(usize, S
                 continue;
             };
             let slope = worst_slope(hull, t, side, q);
-            if slope >= -TANGENT_TOL && !(slope <= TANGENT_TOL && mixed_base(hull, t, side)) {
+            let beyond = slope < -TANGENT_TOL;
+            let on_mixed = slope <= TANGENT_TOL && mixed_base(hull, t, side);
+            if !beyond && !on_mixed && slope >= clearance {
                 continue;
             }
             match contained_apex(hull, t, side, q) {
@@ -253,6 +271,40 @@ mod tests {
         let (out, moved, stuck) = contain_tangents(&single);
         assert!(moved.is_empty() && stuck == 0);
         assert_eq!(out.apexes, single.apexes);
+    }
+
+    /// An outer apex on its side of every tangent plane but on one of them (slope 0 at p_0, as
+    /// Algorithm 1's apexes on the polyhedron's edges are on a flat face's plane), over a
+    /// single-sided triangle: [`contain_tangents`] leaves it, a clearance above its worst slope
+    /// moves it to the margin (slopes checked by the dot products), and a clearance below it
+    /// changes nothing.
+    #[test]
+    fn apex_on_a_tangent_plane_is_cleared_on_request() {
+        let mut h = hull(DVec3::new(0.3, 0.3, -2.0));
+        h.apexes[0][1] = None;
+        let q = h.apexes[0][0].expect("outer apex");
+        // Turn n_0 about the triangle's plane until q − p_0 lies in p_0's tangent plane,
+        // keeping n_0 towards the outer side (+z).
+        let d = (q - h.points[0]).normalize();
+        let n0 = (DVec3::Z - d * d.z).normalize();
+        h.normals[0] = n0;
+        assert!((q - h.points[0]).dot(n0).abs() < 1e-12 && n0.z > 0.0);
+        let worst = worst_slope(&h, 0, Side::Outer, q);
+        assert!(worst.abs() < 1e-12, "{worst}");
+        let (out, moved, _) = contain_tangents(&h);
+        assert!(moved.is_empty());
+        assert_eq!(out.apexes, h.apexes);
+        let (out, moved, stuck) = contain_tangents_with(&h, 0.01);
+        assert_eq!((moved, stuck), (vec![(0, Side::Outer)], 0));
+        let p = out.apexes[0][0].expect("apex");
+        for (pk, nk) in h.points.iter().zip(&h.normals) {
+            let slope = (p - *pk).dot(*nk) / (p - *pk).length();
+            // The margin, up to the last round's growth of |p − p_k| (1e-6 relative).
+            assert!(slope >= TANGENT_MARGIN - 1e-6, "{slope}");
+        }
+        let (out, moved, _) = contain_tangents_with(&h, -0.5);
+        assert!(moved.is_empty());
+        assert_eq!(out.apexes, h.apexes);
     }
 
     /// A deep inner apex already on its side of every tangent plane is left alone.
