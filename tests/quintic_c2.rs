@@ -511,18 +511,30 @@ fn sign_projection_keeps_c2_and_the_jets_on_l_prism() {
     assert_eq!((r.holes.crossing, r.sheets.j_multi_patches), (0, 0));
 }
 
-/// `sign_rounds` and `balance_edges` are read from the scene; bad values name the key and the
-/// scene file.
+/// `sign_rounds`, `balance_edges` and `tangent_clearance` are read from the scene; bad values
+/// (a clearance above the slope moved apexes get, 0.02, could never be met) name the key and
+/// the scene file.
 #[test]
 fn sign_rounds_and_balance_edges_are_scene_keys() {
     let scene = Path::new("x/scene.toml");
-    let table: toml::Table =
-        toml::from_str("type = \"quintic-c2\"\nsign_rounds = 7\nbalance_edges = true").unwrap();
+    let table: toml::Table = toml::from_str(
+        "type = \"quintic-c2\"\nsign_rounds = 7\nbalance_edges = true\ntangent_clearance = 0.01",
+    )
+    .unwrap();
     let o = QuinticOptions::from_toml(&table, scene).unwrap();
     assert_eq!((o.sign_rounds, o.balance_edges), (7, true));
+    assert_eq!(o.tangent_clearance, 0.01);
     assert_eq!(QuinticOptions::default().sign_rounds, 0);
     assert!(!QuinticOptions::default().balance_edges);
-    for bad in ["sign_rounds = -1", "sign_rounds = 2.5", "balance_edges = 1"] {
+    assert_eq!(QuinticOptions::default().tangent_clearance, 0.0);
+    for bad in [
+        "sign_rounds = -1",
+        "sign_rounds = 2.5",
+        "balance_edges = 1",
+        "tangent_clearance = 0.05",
+        "tangent_clearance = -0.01",
+        "tangent_clearance = true",
+    ] {
         let table: toml::Table = toml::from_str(bad).unwrap();
         let e = QuinticOptions::from_toml(&table, scene)
             .unwrap_err()
