@@ -174,7 +174,7 @@ pub fn contain_tangents_with(
             let slope = worst_slope(hull, t, side, q);
             let beyond = slope < -TANGENT_TOL;
             let on_mixed = slope <= TANGENT_TOL && mixed_base(hull, t, side);
-            if !beyond && !on_mixed && slope >= clearance {
+            if !beyond && !on_mixed && (clearance <= 0.0 || slope >= clearance) {
                 continue;
             }
             match contained_apex(hull, t, side, q) {
@@ -305,6 +305,17 @@ mod tests {
         let (out, moved, _) = contain_tangents_with(&h, -0.5);
         assert!(moved.is_empty());
         assert_eq!(out.apexes, h.apexes);
+        // Just below the plane by round-off (slope −1e-11, within TANGENT_TOL): clearance 0 is
+        // the old rule exactly, which leaves it.
+        let mut low = h.clone();
+        low.apexes[0][0] = Some(q - 1e-11 * (q - h.points[0]).length() * n0);
+        let worst = worst_slope(&low, 0, Side::Outer, low.apexes[0][0].unwrap());
+        assert!(worst < 0.0 && worst > -TANGENT_TOL, "{worst}");
+        for clearance in [0.0, -0.5] {
+            let (out, moved, _) = contain_tangents_with(&low, clearance);
+            assert!(moved.is_empty(), "{clearance}");
+            assert_eq!(out.apexes, low.apexes);
+        }
     }
 
     /// A deep inner apex already on its side of every tangent plane is left alone.
