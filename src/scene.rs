@@ -12,6 +12,8 @@
 //! #                               # the bounding-box diagonal (modelling slop, see mesh::weld)
 //! # clean = 1e-3                  # opt-in (cubic-c1, quintic-c2): weld at this × the diagonal,
 //! #                               # split T-junctions, merge needle tips, planarise (mesh::clean)
+//! # clean_coplanar = 0.5          # with `clean`: neighbouring faces meeting at less than this
+//! #                               # many degrees become one face (modelling slop)
 //! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
 //!
 //! [scheme]
@@ -86,10 +88,11 @@ pub enum Model {
         /// Optional weld tolerance relative to the bounding-box diagonal (`model.weld`,
         /// rational-c1 only, see [`mod@crate::mesh::weld`]), applied before triangulation.
         weld: Option<f64>,
-        /// Optional cleaning tolerance relative to the bounding-box diagonal (`model.clean`,
-        /// cubic-c1 and quintic-c2 only, see [`mod@crate::mesh::clean`]): the hull is built on
-        /// the cleaned polyhedron.
-        clean: Option<f64>,
+        /// Optional cleaning (`model.clean`: the tolerance relative to the bounding-box
+        /// diagonal; `model.clean_coplanar`: the angle below which neighbouring faces are one
+        /// plane), cubic-c1 and quintic-c2 only, see [`mod@crate::mesh::clean`]: the hull is
+        /// built on the cleaned polyhedron.
+        clean: Option<mesh::CleanOptions>,
     },
     /// A patch complex JSON file (resolved).
     Patches(PathBuf),
@@ -133,6 +136,7 @@ struct ModelSection {
     subdivide: Option<SubdivideSection>,
     weld: Option<f64>,
     clean: Option<f64>,
+    clean_coplanar: Option<f64>,
 }
 
 /// `model.subdivide = { rule = "loop", levels = N }`.
@@ -348,7 +352,11 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
             if file.scheme.is_some() {
                 return Err(bad("scheme", "only applies with `model.file`".into()));
             }
-            if m.subdivide.is_some() || m.weld.is_some() || m.clean.is_some() {
+            if m.subdivide.is_some()
+                || m.weld.is_some()
+                || m.clean.is_some()
+                || m.clean_coplanar.is_some()
+            {
                 return Err(bad(
                     "model.subdivide/weld/clean",
                     "only applies with `model.file`".into(),
@@ -441,13 +449,33 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     ));
                 }
             }
+            if let Some(a) = m.clean_coplanar {
+                if m.clean.is_none() {
+                    return Err(bad(
+                        "model.clean_coplanar",
+                        "only applies with `model.clean`".into(),
+                    ));
+                }
+                if !(a > 0.0 && a <= mesh::clean::MAX_COPLANAR_ANGLE) {
+                    return Err(bad(
+                        "model.clean_coplanar",
+                        format!(
+                            "{a} is not in (0, {}] (degrees)",
+                            mesh::clean::MAX_COPLANAR_ANGLE
+                        ),
+                    ));
+                }
+            }
             Model::Mesh {
                 file: dir.join(f),
                 normals,
                 scheme,
                 subdivide,
                 weld: m.weld,
-                clean: m.clean,
+                clean: m.clean.map(|relative| mesh::CleanOptions {
+                    relative,
+                    coplanar_angle: m.clean_coplanar.unwrap_or(0.0),
+                }),
             }
         }
     };
@@ -814,14 +842,14 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
 /// Unreadable meshes and cleans that fail, naming the file.
 pub fn polyhedron_1994(
     file: &Path,
-    clean: Option<f64>,
+    clean: Option<mesh::CleanOptions>,
 ) -> anyhow::Result<(mesh::Mesh, mesh::Report, Option<mesh::CleanReport>)> {
     let (m, report) = mesh::load(file)?;
-    let Some(t) = clean else {
+    let Some(options) = clean else {
         return Ok((m, report, None));
     };
-    let (c, report, changes) =
-        mesh::clean(&m, t).with_context(|| format!("{}: `model.clean`", file.display()))?;
+    let (c, report, changes) = mesh::clean_with(&m, options)
+        .with_context(|| format!("{}: `model.clean`", file.display()))?;
     Ok((c, report, Some(changes)))
 }
 
@@ -1078,12 +1106,29 @@ irradiance = 2.0
         assert!(matches!(s.model, Model::Mesh { weld: Some(w), .. } if w == 1e-3));
         // `model.clean`: the 1994 schemes only, within the weld's range.
         let s = parse(&with("clean = 1e-3", "cubic-c1"), Path::new("s.toml")).unwrap();
-        assert!(matches!(s.model, Model::Mesh { clean: Some(c), .. } if c == 1e-3));
+        assert!(
+            matches!(s.model, Model::Mesh { clean: Some(c), .. } if c.relative == 1e-3 && c.coplanar_angle == 0.0)
+        );
+        // `model.clean_coplanar`: with `model.clean` only, an angle in (0, 5] degrees.
+        let both = "clean = 1e-3\nclean_coplanar = 0.5";
+        let s = parse(&with(both, "quintic-c2"), Path::new("s.toml")).unwrap();
+        assert!(matches!(s.model, Model::Mesh { clean: Some(c), .. } if c.coplanar_angle == 0.5));
         for (model, scheme, key) in [
             ("weld = 0.5", "rational-c1", "model.weld"),
             ("weld = 1e-3", "quintic-c2", "model.weld"),
             ("clean = 0.5", "cubic-c1", "model.clean"),
             ("clean = 1e-3", "rational-c1", "model.clean"),
+            ("clean_coplanar = 0.5", "cubic-c1", "model.clean_coplanar"),
+            (
+                "clean = 1e-3\nclean_coplanar = 0",
+                "cubic-c1",
+                "model.clean_coplanar",
+            ),
+            (
+                "clean = 1e-3\nclean_coplanar = 9",
+                "cubic-c1",
+                "model.clean_coplanar",
+            ),
         ] {
             let e = format!(
                 "{:#}",

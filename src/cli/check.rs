@@ -458,11 +458,19 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         if let Some(c) = &built.clean {
+            let nearly = if c.coplanar_merged > 0 {
+                format!(
+                    ", {} nearly coplanar face pairs merged (`model.clean_coplanar`)",
+                    c.coplanar_merged
+                )
+            } else {
+                String::new()
+            };
             println!(
                 "clean            {} vertices welded, {} T-junctions split, {} coplanar face \
-                 pairs merged and {} straight vertices dropped at two-face vertices, planar to \
-                 {:.1e} of the diagonal, vertices moved ≤ {:.3e}: the surface approximates the \
-                 cleaned polyhedron (`model.clean`, `mesh::clean`)  info",
+                 pairs merged and {} straight vertices dropped at two-face vertices{nearly}, \
+                 planar to {:.1e} of the diagonal, vertices moved ≤ {:.3e}: the surface \
+                 approximates the cleaned polyhedron (`model.clean`, `mesh::clean`)  info",
                 c.welded,
                 c.t_junctions,
                 c.merged_faces,

@@ -23,7 +23,8 @@
 //!    face as planar. Alternate fitting each face's plane (Newell normal through the corners'
 //!    mean) and moving each vertex to the least-squares point of its faces' planes, anchored to
 //!    its welded position (a small weight, so that a direction the planes leave free does not
-//!    drift), the anchor released for the last rounds; stop when every corner lies within
+//!    drift), the anchor released for the last rounds (nearly coplanar neighbours that could
+//!    not be merged share one plane); stop when every corner lies within
 //!    [`PLANAR_GOAL`] × the diagonal of its face's plane.
 //!
 //! The result goes through [`super::from_polygons`] (orientation, validation); the inner hull
@@ -38,6 +39,23 @@ use std::collections::{BTreeMap, HashMap};
 /// Two faces round a two-face vertex are merged when their unit normals' dot product exceeds
 /// this (8°: a needle's tip lies between two pieces of one plane, up to the weld's slop).
 pub const COPLANAR_COS: f64 = 0.99;
+
+/// Largest `model.clean_coplanar` angle, degrees: above it a modelled crease could be taken
+/// for slop.
+pub const MAX_COPLANAR_ANGLE: f64 = 5.0;
+
+/// What [`clean_with`] does beyond the tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CleanOptions {
+    /// The tolerance, relative to the bounding-box diagonal (`model.clean`).
+    pub relative: f64,
+    /// Edge-adjacent faces meeting at less than this many degrees are merged into one polygon
+    /// (or, where their union is not one loop, planarised onto one plane): modelling slop, not
+    /// a modelled crease (`model.clean_coplanar`; 0 = off). mpi_poly.obj has 16 such pairs at
+    /// 0.09°–0.16° (its next angle is above 5°); kept apart, each is a nearly flat crease of T
+    /// between two flat nets, across which the quintic bends.
+    pub coplanar_angle: f64,
+}
 
 /// The planarisation stops when every corner lies this close (× the bounding-box diagonal) to
 /// its face's plane: well under `verify`'s edge-convexity tolerance (1e-9 relative), so nearly
@@ -58,6 +76,8 @@ pub struct CleanReport {
     pub merged_faces: usize,
     /// Two-face vertices dropped from a straight chain.
     pub dropped_vertices: usize,
+    /// Pairs of nearly coplanar faces merged (`model.clean_coplanar`).
+    pub coplanar_merged: usize,
     /// Largest distance a vertex moved from the file's position (weld and planarisation).
     pub max_move: f64,
     /// Largest distance of a corner from its face's plane after the planarisation, relative
@@ -72,6 +92,21 @@ pub struct CleanReport {
 /// A tolerance out of range (as [`super::weld`]), a two-face vertex whose faces are neither
 /// coplanar nor straight through it, or a result [`from_polygons`] rejects.
 pub fn clean(mesh: &Mesh, relative: f64) -> Result<(Mesh, Report, CleanReport)> {
+    clean_with(
+        mesh,
+        CleanOptions {
+            relative,
+            coplanar_angle: 0.0,
+        },
+    )
+}
+
+/// [`clean`] with nearly coplanar faces merged too ([`CleanOptions::coplanar_angle`]).
+///
+/// # Errors
+/// As [`clean`].
+pub fn clean_with(mesh: &Mesh, options: CleanOptions) -> Result<(Mesh, Report, CleanReport)> {
+    let relative = options.relative;
     let (welded, _, moved) = weld(mesh, relative)?;
     let mut report = CleanReport {
         welded: moved,
@@ -90,7 +125,14 @@ pub fn clean(mesh: &Mesh, relative: f64) -> Result<(Mesh, Report, CleanReport)> 
         .filter(|f| f.len() >= 3)
         .collect();
     two_face_vertices(&pos, &mut faces, tol, &mut report)?;
-    let planar = planarise(&pos, &faces, diag);
+    let cos = (options.coplanar_angle > 0.0).then(|| options.coplanar_angle.to_radians().cos());
+    if let Some(cos) = cos {
+        report.coplanar_merged = merge_near_coplanar(&pos, &mut faces, cos);
+        if report.coplanar_merged > 0 {
+            two_face_vertices(&pos, &mut faces, tol, &mut report)?;
+        }
+    }
+    let planar = planarise(&pos, &faces, diag, cos);
     report.planarity =
         max_deviation(&planar, &faces, &planes(&planar, &faces)) / diag.max(f64::MIN_POSITIVE);
     // The weld keeps each cluster's first position; measure the moves against the file.
@@ -260,6 +302,53 @@ fn two_face_vertices(
     }
 }
 
+/// Merges edge-adjacent faces whose normals' dot product exceeds `cos` into one polygon, pair by pair, where their union is one loop (pairs whose union is not stay apart
+/// and are planarised onto one plane instead, [`plane_groups`]). Returns how many merged.
+fn merge_near_coplanar(pos: &[DVec3], faces: &mut Vec<Vec<u32>>, cos: f64) -> usize {
+    let mut merged = 0;
+    let mut refused: std::collections::HashSet<(Vec<u32>, Vec<u32>)> = Default::default();
+    'search: loop {
+        let mut of_edge: HashMap<(u32, u32), usize> = HashMap::new();
+        for (f, face) in faces.iter().enumerate() {
+            for k in 0..face.len() {
+                of_edge.insert((face[k], face[(k + 1) % face.len()]), f);
+            }
+        }
+        for f in 0..faces.len() {
+            let nf = area_vector(pos, &faces[f]).normalize_or_zero();
+            for k in 0..faces[f].len() {
+                let n = faces[f].len();
+                let Some(&g) = of_edge.get(&(faces[f][(k + 1) % n], faces[f][k])) else {
+                    continue;
+                };
+                if g <= f {
+                    continue;
+                }
+                let ng = area_vector(pos, &faces[g]).normalize_or_zero();
+                if nf.dot(ng) <= cos {
+                    continue;
+                }
+                let key = (faces[f].clone(), faces[g].clone());
+                if refused.contains(&key) {
+                    continue;
+                }
+                match merge_faces(&faces[f], &faces[g]).map(|m| collapse(&m)) {
+                    Some(m) if m.len() >= 3 => {
+                        faces[f] = m;
+                        faces.remove(g);
+                        merged += 1;
+                        continue 'search;
+                    }
+                    _ => {
+                        refused.insert(key);
+                    }
+                }
+            }
+        }
+        return merged;
+    }
+}
+
 /// The union of two polygons sharing a chain of edges (the shared edges removed), when it is
 /// one loop.
 fn merge_faces(f: &[u32], g: &[u32]) -> Option<Vec<u32>> {
@@ -307,6 +396,63 @@ fn planes(pos: &[DVec3], faces: &[Vec<u32>]) -> Vec<(DVec3, f64)> {
     faces.iter().map(|f| plane(pos, f)).collect()
 }
 
+/// The plane group of every face: edge-adjacent faces whose normals' dot product exceeds `cos`
+/// are joined (transitively); ids are the group's first face.
+fn plane_groups(pos: &[DVec3], faces: &[Vec<u32>], cos: f64) -> Vec<usize> {
+    let normals: Vec<DVec3> = faces
+        .iter()
+        .map(|f| area_vector(pos, f).normalize_or_zero())
+        .collect();
+    let mut of_edge: HashMap<(u32, u32), usize> = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            of_edge.insert((face[k], face[(k + 1) % face.len()]), f);
+        }
+    }
+    let mut group: Vec<usize> = (0..faces.len()).collect();
+    fn root(g: &mut [usize], mut x: usize) -> usize {
+        while g[x] != x {
+            g[x] = g[g[x]];
+            x = g[x];
+        }
+        x
+    }
+    for (f, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            let Some(&h) = of_edge.get(&(face[(k + 1) % face.len()], face[k])) else {
+                continue;
+            };
+            if normals[f].dot(normals[h]) > cos {
+                let (a, b) = (root(&mut group, f), root(&mut group, h));
+                group[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    (0..faces.len()).map(|f| root(&mut group, f)).collect()
+}
+
+/// Every face's plane, one per plane group ([`plane_groups`]): the group's summed area vector
+/// through the mean of its faces' corners.
+fn group_planes(pos: &[DVec3], faces: &[Vec<u32>], group: &[usize]) -> Vec<(DVec3, f64)> {
+    let mut area: HashMap<usize, (DVec3, DVec3, usize)> = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        let e = area
+            .entry(group[f])
+            .or_insert((DVec3::ZERO, DVec3::ZERO, 0));
+        e.0 += area_vector(pos, face);
+        e.1 += face.iter().map(|&v| pos[v as usize]).sum::<DVec3>();
+        e.2 += face.len();
+    }
+    group
+        .iter()
+        .map(|g| {
+            let (a, sum, count) = area[g];
+            let n = a.normalize_or_zero();
+            (n, n.dot(sum / count as f64))
+        })
+        .collect()
+}
+
 fn plane(pos: &[DVec3], face: &[u32]) -> (DVec3, f64) {
     let n = area_vector(pos, face).normalize_or_zero();
     let mean = face.iter().map(|&v| pos[v as usize]).sum::<DVec3>() / face.len() as f64;
@@ -314,7 +460,8 @@ fn plane(pos: &[DVec3], face: &[u32]) -> (DVec3, f64) {
 }
 
 /// Step 5 of the module docs: positions with every face planar (to [`PLANAR_GOAL`]).
-fn planarise(pos: &[DVec3], faces: &[Vec<u32>], diag: f64) -> Vec<DVec3> {
+/// With `coplanar` (a cosine), nearly coplanar neighbours share one plane ([`plane_groups`]).
+fn planarise(pos: &[DVec3], faces: &[Vec<u32>], diag: f64, coplanar: Option<f64>) -> Vec<DVec3> {
     let mut x = pos.to_vec();
     let mut of_vertex: Vec<Vec<usize>> = vec![Vec::new(); pos.len()];
     for (f, face) in faces.iter().enumerate() {
@@ -322,8 +469,12 @@ fn planarise(pos: &[DVec3], faces: &[Vec<u32>], diag: f64) -> Vec<DVec3> {
             of_vertex[v as usize].push(f);
         }
     }
+    let group = coplanar.map(|cos| plane_groups(pos, faces, cos));
     for round in 0..PLANAR_ROUNDS {
-        let planes = planes(&x, faces);
+        let planes = match &group {
+            Some(g) => group_planes(&x, faces, g),
+            None => planes(&x, faces),
+        };
         if max_deviation(&x, faces, &planes) <= PLANAR_GOAL * diag {
             break;
         }
@@ -464,5 +615,49 @@ mod tests {
         p[8].x = 1.2;
         let e = clean(&Mesh::new(p, faces), 1e-3).unwrap_err().to_string();
         assert!(e.contains("vertex 8") && e.contains("not coplanar"), "{e}");
+    }
+
+    /// The cube's top z = 1 as two faces meeting at 0.1° along y = 0.5 (the midline's ends
+    /// 8, 9 lifted by 1e-3, each a corner of its side wall too): with `clean_coplanar` 0.5°
+    /// they merge into one face, the midline's ends, now between two faces on a straight edge,
+    /// are dropped, and the top is planar again (the cube back, 8 corners, 6 quads); with the
+    /// merge off the two faces stay apart. A 0.05° angle is below a 0.5° threshold, 0.1°
+    /// above a 0.05° one: only the angle decides.
+    #[test]
+    fn nearly_coplanar_faces_merge_on_request() {
+        let mut p = cube_corners();
+        p.push(DVec3::new(0.0, 0.5, 1.0 + 1e-3));
+        p.push(DVec3::new(1.0, 0.5, 1.0 + 1e-3));
+        let faces = vec![
+            vec![0, 2, 3, 1],
+            vec![4, 5, 9, 8],
+            vec![8, 9, 7, 6],
+            vec![0, 1, 5, 4],
+            vec![2, 6, 7, 3],
+            vec![0, 4, 8, 6, 2],
+            vec![1, 3, 7, 9, 5],
+        ];
+        let m = Mesh::new(p, faces);
+        // The two halves' normals: 1e-3 over 0.5, 0.115°.
+        // 1e-3 of the diagonal √3 covers the ends' 1e-3 off the straight edges they are
+        // dropped from.
+        let options = |angle: f64| CleanOptions {
+            relative: 1e-3,
+            coplanar_angle: angle,
+        };
+        let (c, validation, report) = clean_with(&m, options(0.5)).unwrap();
+        validation.require(true).unwrap();
+        assert_eq!(report.coplanar_merged, 1, "{report:?}");
+        assert_eq!(report.dropped_vertices, 2, "{report:?}");
+        assert_eq!(c.faces.len(), 6, "{:?}", c.faces);
+        assert!(c.faces.iter().all(|f| f.len() == 4), "{:?}", c.faces);
+        // Planar within rounding of the solve (as above).
+        assert!(bend(&c) < 1e-12, "{}", bend(&c));
+        for (angle, merged) in [(0.0, 0), (0.05, 0)] {
+            let (c, _, report) = clean_with(&m, options(angle)).unwrap();
+            assert_eq!(report.coplanar_merged, merged, "{angle}");
+            assert_eq!(c.faces.len(), 7, "{angle}");
+            assert_eq!(clean(&m, 1e-3).unwrap().0.faces, c.faces);
+        }
     }
 }

@@ -62,7 +62,7 @@ mod triangulate;
 mod validate;
 pub mod weld;
 
-pub use clean::{clean, CleanReport};
+pub use clean::{clean, clean_with, CleanOptions, CleanReport};
 pub use load::{from_polygons, load, load_bytes, Format};
 pub use normals::{above_face_failures, loop_limit_normal, vertex_normals, NormalMethod};
 pub use orient::signed_volume;
