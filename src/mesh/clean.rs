@@ -302,18 +302,14 @@ fn two_face_vertices(
     }
 }
 
-/// Merges edge-adjacent faces whose normals' dot product exceeds `cos` into one polygon, pair by pair, where their union is one loop (pairs whose union is not stay apart
-/// and are planarised onto one plane instead, [`plane_groups`]). Returns how many merged.
+/// Merges edge-adjacent faces whose normals' dot product exceeds `cos` into one polygon, pair
+/// by pair, where their union is one loop (pairs whose union is not stay apart and are
+/// planarised onto one plane instead, [`plane_groups`]). Returns how many merged.
 fn merge_near_coplanar(pos: &[DVec3], faces: &mut Vec<Vec<u32>>, cos: f64) -> usize {
     let mut merged = 0;
     let mut refused: std::collections::HashSet<(Vec<u32>, Vec<u32>)> = Default::default();
     'search: loop {
-        let mut of_edge: HashMap<(u32, u32), usize> = HashMap::new();
-        for (f, face) in faces.iter().enumerate() {
-            for k in 0..face.len() {
-                of_edge.insert((face[k], face[(k + 1) % face.len()]), f);
-            }
-        }
+        let of_edge = face_of_edge(faces);
         for f in 0..faces.len() {
             let nf = area_vector(pos, &faces[f]).normalize_or_zero();
             for k in 0..faces[f].len() {
@@ -396,6 +392,17 @@ fn planes(pos: &[DVec3], faces: &[Vec<u32>]) -> Vec<(DVec3, f64)> {
     faces.iter().map(|f| plane(pos, f)).collect()
 }
 
+/// The face holding each directed edge (a → b) of `faces`.
+fn face_of_edge(faces: &[Vec<u32>]) -> HashMap<(u32, u32), usize> {
+    let mut of_edge = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            of_edge.insert((face[k], face[(k + 1) % face.len()]), f);
+        }
+    }
+    of_edge
+}
+
 /// The plane group of every face: edge-adjacent faces whose normals' dot product exceeds `cos`
 /// are joined (transitively); ids are the group's first face.
 fn plane_groups(pos: &[DVec3], faces: &[Vec<u32>], cos: f64) -> Vec<usize> {
@@ -403,12 +410,7 @@ fn plane_groups(pos: &[DVec3], faces: &[Vec<u32>], cos: f64) -> Vec<usize> {
         .iter()
         .map(|f| area_vector(pos, f).normalize_or_zero())
         .collect();
-    let mut of_edge: HashMap<(u32, u32), usize> = HashMap::new();
-    for (f, face) in faces.iter().enumerate() {
-        for k in 0..face.len() {
-            of_edge.insert((face[k], face[(k + 1) % face.len()]), f);
-        }
-    }
+    let of_edge = face_of_edge(faces);
     let mut group: Vec<usize> = (0..faces.len()).collect();
     fn root(g: &mut [usize], mut x: usize) -> usize {
         while g[x] != x {
@@ -541,6 +543,30 @@ mod tests {
             .collect()
     }
 
+    /// The unit cube with its top z = 1 split into two quads along y = 0.5, at the midline's
+    /// ends `a` (vertex 8, over x = 0) and `b` (9, over x = 1); `walls`: the side walls x = 0
+    /// and x = 1 have them as corners too (else they are T-junctions).
+    fn split_top(a: DVec3, b: DVec3, walls: bool) -> Mesh {
+        let mut p = cube_corners();
+        p.push(a);
+        p.push(b);
+        let (w0, w1) = if walls {
+            (vec![0, 4, 8, 6, 2], vec![1, 3, 7, 9, 5])
+        } else {
+            (vec![0, 4, 6, 2], vec![1, 3, 7, 5])
+        };
+        let faces = vec![
+            vec![0, 2, 3, 1],
+            vec![4, 5, 9, 8],
+            vec![8, 9, 7, 6],
+            vec![0, 1, 5, 4],
+            vec![2, 6, 7, 3],
+            w0,
+            w1,
+        ];
+        Mesh::new(p, faces)
+    }
+
     /// Largest distance of a corner from its face's plane, fitted here by three corners
     /// (independent of [`plane`]'s Newell fit).
     fn bend(c: &Mesh) -> f64 {
@@ -560,19 +586,11 @@ mod tests {
     /// name 8 and 9: two T-junctions. Not a closed manifold as it stands.
     #[test]
     fn t_junctions_are_split_and_a_bent_corner_is_planarised() {
-        let mut p = cube_corners();
-        p.push(DVec3::new(0.0, 0.5, 1.0));
-        p.push(DVec3::new(1.0 + 1e-4, 0.5, 1.0));
-        let faces = vec![
-            vec![0, 2, 3, 1],
-            vec![4, 5, 9, 8],
-            vec![8, 9, 7, 6],
-            vec![0, 1, 5, 4],
-            vec![2, 6, 7, 3],
-            vec![0, 4, 6, 2],
-            vec![1, 3, 7, 5],
-        ];
-        let m = Mesh::new(p, faces);
+        let m = split_top(
+            DVec3::new(0.0, 0.5, 1.0),
+            DVec3::new(1.0 + 1e-4, 0.5, 1.0),
+            false,
+        );
         // 1e-3 of the diagonal √3 reaches both junctions (distance 0 and 1e-4).
         let (c, validation, report) = clean(&m, 1e-3).unwrap();
         validation.require(true).unwrap();
@@ -625,19 +643,11 @@ mod tests {
     /// above a 0.05° one: only the angle decides.
     #[test]
     fn nearly_coplanar_faces_merge_on_request() {
-        let mut p = cube_corners();
-        p.push(DVec3::new(0.0, 0.5, 1.0 + 1e-3));
-        p.push(DVec3::new(1.0, 0.5, 1.0 + 1e-3));
-        let faces = vec![
-            vec![0, 2, 3, 1],
-            vec![4, 5, 9, 8],
-            vec![8, 9, 7, 6],
-            vec![0, 1, 5, 4],
-            vec![2, 6, 7, 3],
-            vec![0, 4, 8, 6, 2],
-            vec![1, 3, 7, 9, 5],
-        ];
-        let m = Mesh::new(p, faces);
+        let m = split_top(
+            DVec3::new(0.0, 0.5, 1.0 + 1e-3),
+            DVec3::new(1.0, 0.5, 1.0 + 1e-3),
+            true,
+        );
         // The two halves' normals: 1e-3 over 0.5, 0.115°.
         // 1e-3 of the diagonal √3 covers the ends' 1e-3 off the straight edges they are
         // dropped from.
