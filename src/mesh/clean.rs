@@ -31,6 +31,7 @@
 //! then checks that it is a closed manifold.
 
 use super::geometry::bbox_diagonal;
+use super::topology::{directed_edge_faces, UnionFind};
 use super::{from_polygons, weld, Mesh, Report};
 use crate::error::{Error, Result};
 use glam::{DMat3, DVec3};
@@ -309,7 +310,7 @@ fn merge_near_coplanar(pos: &[DVec3], faces: &mut Vec<Vec<u32>>, cos: f64) -> us
     let mut merged = 0;
     let mut refused: std::collections::HashSet<(Vec<u32>, Vec<u32>)> = Default::default();
     'search: loop {
-        let of_edge = face_of_edge(faces);
+        let of_edge = directed_edge_faces(faces);
         for f in 0..faces.len() {
             let nf = area_vector(pos, &faces[f]).normalize_or_zero();
             for k in 0..faces[f].len() {
@@ -392,63 +393,44 @@ fn planes(pos: &[DVec3], faces: &[Vec<u32>]) -> Vec<(DVec3, f64)> {
     faces.iter().map(|f| plane(pos, f)).collect()
 }
 
-/// The face holding each directed edge (a → b) of `faces`.
-fn face_of_edge(faces: &[Vec<u32>]) -> HashMap<(u32, u32), usize> {
-    let mut of_edge = HashMap::new();
-    for (f, face) in faces.iter().enumerate() {
-        for k in 0..face.len() {
-            of_edge.insert((face[k], face[(k + 1) % face.len()]), f);
-        }
-    }
-    of_edge
-}
-
 /// The plane group of every face: edge-adjacent faces whose normals' dot product exceeds `cos`
-/// are joined (transitively); ids are the group's first face.
+/// are joined (transitively); ids are face indices (the group's representative).
 fn plane_groups(pos: &[DVec3], faces: &[Vec<u32>], cos: f64) -> Vec<usize> {
     let normals: Vec<DVec3> = faces
         .iter()
         .map(|f| area_vector(pos, f).normalize_or_zero())
         .collect();
-    let of_edge = face_of_edge(faces);
-    let mut group: Vec<usize> = (0..faces.len()).collect();
-    fn root(g: &mut [usize], mut x: usize) -> usize {
-        while g[x] != x {
-            g[x] = g[g[x]];
-            x = g[x];
-        }
-        x
-    }
+    let of_edge = directed_edge_faces(faces);
+    let mut groups = UnionFind::new(faces.len());
     for (f, face) in faces.iter().enumerate() {
         for k in 0..face.len() {
             let Some(&h) = of_edge.get(&(face[(k + 1) % face.len()], face[k])) else {
                 continue;
             };
             if normals[f].dot(normals[h]) > cos {
-                let (a, b) = (root(&mut group, f), root(&mut group, h));
-                group[a.max(b)] = a.min(b);
+                groups.union(f as u32, h as u32);
             }
         }
     }
-    (0..faces.len()).map(|f| root(&mut group, f)).collect()
+    (0..faces.len())
+        .map(|f| groups.find(f as u32) as usize)
+        .collect()
 }
 
 /// Every face's plane, one per plane group ([`plane_groups`]): the group's summed area vector
 /// through the mean of its faces' corners.
 fn group_planes(pos: &[DVec3], faces: &[Vec<u32>], group: &[usize]) -> Vec<(DVec3, f64)> {
-    let mut area: HashMap<usize, (DVec3, DVec3, usize)> = HashMap::new();
-    for (f, face) in faces.iter().enumerate() {
-        let e = area
-            .entry(group[f])
-            .or_insert((DVec3::ZERO, DVec3::ZERO, 0));
+    let mut sums = vec![(DVec3::ZERO, DVec3::ZERO, 0usize); faces.len()];
+    for (face, &g) in faces.iter().zip(group) {
+        let e = &mut sums[g];
         e.0 += area_vector(pos, face);
         e.1 += face.iter().map(|&v| pos[v as usize]).sum::<DVec3>();
         e.2 += face.len();
     }
     group
         .iter()
-        .map(|g| {
-            let (a, sum, count) = area[g];
+        .map(|&g| {
+            let (a, sum, count) = sums[g];
             let n = a.normalize_or_zero();
             (n, n.dot(sum / count as f64))
         })

@@ -287,6 +287,20 @@ impl Topology {
     }
 }
 
+/// The face holding each directed edge (a → b) of the polygons `faces` (the last face wins
+/// where an edge repeats, as in a non-manifold mesh): the face across an edge (a → b) of an
+/// oriented mesh is the one holding (b → a).
+#[must_use]
+pub fn directed_edge_faces(faces: &[Vec<u32>]) -> std::collections::HashMap<(u32, u32), usize> {
+    let mut of_edge = std::collections::HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            of_edge.insert((face[k], face[(k + 1) % face.len()]), f);
+        }
+    }
+    of_edge
+}
+
 /// Disjoint sets over `0..n` with path halving and union by size.
 pub struct UnionFind {
     parent: Vec<u32>,

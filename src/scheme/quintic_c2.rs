@@ -298,14 +298,17 @@ pub fn prepare_hull(hull: &SimplicialHull, options: &QuinticOptions) -> Result<P
     } else {
         (completed, Vec::new())
     };
-    let (completed, tangent_moved) = if options.tangent_clearance > 0.0 {
-        let (h, moved, _stuck) = crate::scheme::cubic_c1::tangent::contain_tangents_with(
-            &completed,
-            options.tangent_clearance,
-        );
-        (crate::hull::inner::search_apexes(h, true).0, moved.len())
-    } else if options.contain_tangents {
-        let (h, moved, _stuck) = crate::scheme::cubic_c1::tangent::contain_tangents(&completed);
+    let clearance = options.tangent_clearance;
+    let (completed, tangent_moved) = if options.contain_tangents || clearance > 0.0 {
+        let (h, moved, _stuck) =
+            crate::scheme::cubic_c1::tangent::contain_tangents_with(&completed, clearance);
+        // Only the clearance's moves are followed by the apex search (spot_control_cage's
+        // `contain_tangents` hull stays as it was).
+        let h = if clearance > 0.0 {
+            crate::hull::inner::search_apexes(h, true).0
+        } else {
+            h
+        };
         (h, moved.len())
     } else {
         (completed, 0)

@@ -42,12 +42,7 @@ pub fn merge_coplanar_counted(mesh: &Mesh) -> (Mesh, Vec<usize>) {
         .iter()
         .map(|f| area_vector(&mesh.positions, f).try_normalize())
         .collect();
-    let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
-    for (f, face) in mesh.faces.iter().enumerate() {
-        for k in 0..face.len() {
-            directed.insert((face[k], face[(k + 1) % face.len()]), f);
-        }
-    }
+    let directed = crate::mesh::topology::directed_edge_faces(&mesh.faces);
     let mut parent: Vec<usize> = (0..nf).collect();
     fn root(p: &mut [usize], mut x: usize) -> usize {
         while p[x] != x {
