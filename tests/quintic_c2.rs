@@ -518,11 +518,12 @@ fn sign_projection_keeps_c2_and_the_jets_on_l_prism() {
 fn sign_rounds_and_balance_edges_are_scene_keys() {
     let scene = Path::new("x/scene.toml");
     let table: toml::Table = toml::from_str(
-        "type = \"quintic-c2\"\nsign_rounds = 7\nbalance_edges = true\ntangent_clearance = 0.01",
+        "type = \"quintic-c2\"\nsign_rounds = 7\nbalance_edges = true\ntangent_clearance = 0.01\nsign_program = true",
     )
     .unwrap();
     let o = QuinticOptions::from_toml(&table, scene).unwrap();
     assert_eq!((o.sign_rounds, o.balance_edges), (7, true));
+    assert!(o.sign_program && !QuinticOptions::default().sign_program);
     assert_eq!(o.tangent_clearance, 0.01);
     assert_eq!(QuinticOptions::default().sign_rounds, 0);
     assert!(!QuinticOptions::default().balance_edges);
@@ -534,6 +535,7 @@ fn sign_rounds_and_balance_edges_are_scene_keys() {
         "tangent_clearance = 0.05",
         "tangent_clearance = -0.01",
         "tangent_clearance = true",
+        "sign_program = 1",
     ] {
         let table: toml::Table = toml::from_str(bad).unwrap();
         let e = QuinticOptions::from_toml(&table, scene)

@@ -301,13 +301,25 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
     let projection = if p.too_large {
         "; sign projection skipped: too large to factor".to_string()
     } else if p.rounds == 0 {
-        String::new()
+        match &p.program_error {
+            Some(e) => format!("; sign program not solved: {e}"),
+            None => String::new(),
+        }
     } else {
         format!(
-            "; sign projection: {} -> {} weights off their signs in {} rounds{}{}",
+            "; sign projection: {} -> {} weights off their signs {}{}{}",
             p.off_before,
             p.off_after,
-            p.rounds,
+            if p.program {
+                "by the linear program (HiGHS)".to_string()
+            } else {
+                let failed = p
+                    .program_error
+                    .as_ref()
+                    .map(|e| format!(" (sign program not solved: {e})"))
+                    .unwrap_or_default();
+                format!("in {} rounds{failed}", p.rounds)
+            },
             if p.precise {
                 ", last move in double-double"
             } else {

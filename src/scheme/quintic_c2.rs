@@ -17,6 +17,7 @@ pub mod jets;
 pub mod ordering;
 mod pinned;
 pub mod project;
+pub mod signfit;
 pub mod signs;
 pub mod slivers;
 pub mod sparse;
@@ -120,6 +121,10 @@ pub struct QuinticOptions {
     /// after the solve ([`project`]; 0 = off, the default): the weights move towards their
     /// signs, C2 is kept, the jets are not moved.
     pub sign_rounds: usize,
+    /// Instead of the rounds, move the weights to the fewest (L1-least) misses of Theorem
+    /// 2.1's signs that the C1/C2 equations allow, by a linear program ([`signfit`]; needs the
+    /// cargo feature `highs`). Off by default.
+    pub sign_program: bool,
 }
 
 impl Default for QuinticOptions {
@@ -142,6 +147,7 @@ impl Default for QuinticOptions {
             thicken_edges: true,
             balance_edges: false,
             sign_rounds: 0,
+            sign_program: false,
         }
     }
 }
@@ -189,6 +195,7 @@ impl QuinticOptions {
                 "repair_hessians" => o.repair_hessians = flag()?,
                 "thicken_edges" => o.thicken_edges = flag()?,
                 "balance_edges" => o.balance_edges = flag()?,
+                "sign_program" => o.sign_program = flag()?,
                 "sign_rounds" => {
                     o.sign_rounds = v
                         .as_integer()
@@ -230,7 +237,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -378,8 +385,9 @@ pub fn build_prepared(
         options.consistent_stars,
         options.hessian_signs,
     )?;
-    if options.sign_rounds > 0 {
-        stats.sign_projection = project::project_signs(&sys, &mut value, options.sign_rounds);
+    if options.sign_rounds > 0 || options.sign_program {
+        stats.sign_projection =
+            project::project_signs(&sys, &mut value, options.sign_rounds, options.sign_program);
     }
     if options.repair_holes {
         let reach = holes::Reach {

@@ -62,11 +62,22 @@ pub struct SignProjection {
     /// Whether the equations were too large to factor ([`cholesky::MAX_FACTOR_ROWS`],
     /// [`cholesky::MAX_FACTOR_ENTRIES`]): nothing was done.
     pub too_large: bool,
+    /// Whether the weights came from the linear program of [`super::signfit`]
+    /// (`sign_program`) instead of the rounds.
+    pub program: bool,
+    /// Why the program was asked for but not used (the rounds ran instead).
+    pub program_error: Option<String>,
 }
 
 /// Moves the non-jet weights of `value` towards Theorem 2.1's signs by at most `rounds`
-/// alternating projections (module docs), keeping every C1/C2 equation of `sys`.
-pub fn project_signs(sys: &System, value: &mut [f64], rounds: usize) -> SignProjection {
+/// alternating projections (module docs), or with `program` to the least violation of the
+/// signs ([`super::signfit`]), keeping every C1/C2 equation of `sys`.
+pub fn project_signs(
+    sys: &System,
+    value: &mut [f64],
+    rounds: usize,
+    program: bool,
+) -> SignProjection {
     let ns = sys.keys.len();
     let jet: Vec<bool> = (0..ns).map(|s| stage(sys.keys[s], sys.np).0 == 0).collect();
     let mut col = vec![usize::MAX; ns];
@@ -106,7 +117,7 @@ pub fn project_signs(sys: &System, value: &mut [f64], rounds: usize) -> SignProj
         })
         .collect();
     let mut x: Vec<f64> = slots.iter().map(|&s| value[s]).collect();
-    let report = project_rows(&rows, n, &c, &mut x, &signed, rounds);
+    let report = project_rows(&rows, n, &c, &mut x, &signed, rounds, program);
     if report.kept {
         for (j, &s) in slots.iter().enumerate() {
             value[s] = x[j];
@@ -120,7 +131,9 @@ pub fn project_signs(sys: &System, value: &mut [f64], rounds: usize) -> SignProj
 /// changed only when the result is kept (module docs); the report says what happened. Where
 /// the f64 factor's last move misses [`KEEP_RESIDUAL`], that move is made again with a
 /// double-double factor ([`Projector::precise`]: pivots of nearly dependent rows, which f64
-/// rounds away, kept down to [`cholesky::PRECISE_PIVOT`]).
+/// rounds away, kept down to [`cholesky::PRECISE_PIVOT`]). With `program` the rounds are
+/// replaced by one move from the linear program's solution ([`super::signfit`]) onto the
+/// equations, when the program is solved.
 pub fn project_rows(
     rows: &[Row],
     n: usize,
@@ -128,6 +141,7 @@ pub fn project_rows(
     x: &mut Vec<f64>,
     signed: &[(usize, f64)],
     rounds: usize,
+    program: bool,
 ) -> SignProjection {
     let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     // As in `signs::SignStats`: weights this small are zero up to the solves' rounding.
@@ -137,7 +151,7 @@ pub fn project_rows(
         ..SignProjection::default()
     };
     report.off_after = report.off_before;
-    if n == 0 || signed.is_empty() || report.off_before == 0 {
+    if n == 0 || signed.is_empty() || report.off_before == 0 || (rounds == 0 && !program) {
         return report;
     }
     let limits = (cholesky::MAX_FACTOR_ROWS, cholesky::MAX_FACTOR_ENTRIES);
@@ -156,6 +170,20 @@ pub fn project_rows(
     let trace = std::env::var_os("APATCH_SIGN_TRACE").is_some();
     let start = x.clone();
     let mut residual = 0.0;
+    let mut rounds = rounds;
+    if program {
+        crate::progress::report(|| "quintic-c2 sign program (HiGHS)".into());
+        match super::signfit::least_violation(rows, n, c, x, signed) {
+            Ok(y) => {
+                *x = y;
+                residual = projector.meet(x, REFINE_TARGET * scale);
+                report.program = true;
+                report.rounds = 1;
+                rounds = 0;
+            }
+            Err(e) => report.program_error = Some(e),
+        }
+    }
     for r in 0..rounds {
         crate::progress::report(|| format!("quintic-c2 sign projection: round {}", r + 1));
         let clamped = clamp(x, signed, margin);
@@ -177,7 +205,9 @@ pub fn project_rows(
         crate::progress::report(|| "quintic-c2 sign projection: double-double factor".into());
         drop(projector);
         let precise = Projector::precise(rows, n, c, &ordering, cholesky::PRECISE_PIVOT);
-        clamp(x, signed, margin);
+        if !report.program {
+            clamp(x, signed, margin);
+        }
         // A precise move that does no better leaves the residual above the bound: refused
         // below either way, and `x` restored to the start.
         residual = residual.min(precise.meet(x, REFINE_TARGET * scale));
@@ -213,7 +243,7 @@ fn off(x: &[f64], signed: &[(usize, f64)], margin: f64) -> usize {
 }
 
 /// Median of |x| (0 for none).
-fn median_abs(x: &[f64]) -> f64 {
+pub(super) fn median_abs(x: &[f64]) -> f64 {
     let mut a: Vec<f64> = x.iter().map(|v| v.abs()).collect();
     if a.is_empty() {
         return 0.0;
@@ -237,7 +267,7 @@ mod tests {
         let c = [1.0, 0.0];
         let signed = [(0, 1.0), (2, -1.0), (3, 1.0)];
         let mut x = vec![1.0, 0.0, 0.0, -1.0];
-        let p = project_rows(&rows, 4, &c, &mut x, &signed, 200);
+        let p = project_rows(&rows, 4, &c, &mut x, &signed, 200, false);
         assert!(p.kept && !p.precise, "{p:?}");
         assert_eq!((p.off_before, p.off_after), (1, 0), "{p:?} {x:?}");
         // Equations to the keep bound of the largest weight (module docs).
@@ -260,11 +290,42 @@ mod tests {
         let signed = [(1, 1.0), (2, 1.0)];
         let start = vec![1.0, -0.5, 0.5];
         let mut x = start.clone();
-        let p = project_rows(&rows, 3, &c, &mut x, &signed, 20);
+        let p = project_rows(&rows, 3, &c, &mut x, &signed, 20, false);
         assert!(!p.kept && p.precise, "{p:?}");
         assert!(p.residual > KEEP_RESIDUAL, "{p:?}");
         assert_eq!(p.off_after, p.off_before);
         assert_eq!(x, start);
+    }
+
+    /// x0 + x1 + 2 x2 = 1 with all three asked to be ≤ 0: no point meets every sign, and the
+    /// fewest misses put only x2 off (at 1/2 plus a margin), where the alternating projections
+    /// spread the miss over all three: their limit is the plane's point closest to the box
+    /// corner (−m, −m, −m), which is −m + (1 + 4m)/6 > 0 in x0 and x1 for the margin m = 0.2
+    /// (the median of the start). With the program (feature `highs`) exactly one weight is off and the row is
+    /// met; without the feature the program is reported unsolved and the rounds run instead.
+    #[test]
+    fn the_sign_program_leaves_the_fewest_weights_off() {
+        let rows: Vec<Row> = vec![vec![(0, 1.0), (1, 1.0), (2, 2.0)]];
+        let c = [1.0];
+        let signed = [(0, -1.0), (1, -1.0), (2, -1.0)];
+        let start = vec![0.2, 0.2, 0.3];
+        let mut rounds = start.clone();
+        let p = project_rows(&rows, 3, &c, &mut rounds, &signed, 200, false);
+        // All three stay off: nothing gained, so not kept.
+        assert!(!p.kept && p.off_after == 3, "{p:?} {rounds:?}");
+        let mut x = start.clone();
+        let q = project_rows(&rows, 3, &c, &mut x, &signed, 200, true);
+        if cfg!(feature = "highs") {
+            assert!(q.kept && q.program && q.off_after == 1, "{q:?} {x:?}");
+            assert!(x[0] < 0.0 && x[1] < 0.0 && x[2] > 0.0, "{x:?}");
+            let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            let miss = (x[0] + x[1] + 2.0 * x[2] - 1.0).abs() / 6f64.sqrt();
+            assert!(miss <= KEEP_RESIDUAL * scale, "{miss:e} {x:?}");
+        } else {
+            let e = q.program_error.as_deref().unwrap_or("");
+            assert!(!q.program && e.contains("highs"), "{q:?}");
+            assert_eq!(x, rounds, "the rounds ran instead");
+        }
     }
 
     /// A row 1e-7 (relative) from the span of another: its squared pivot, 5e-15, is below the
@@ -279,7 +340,7 @@ mod tests {
         let c = [1.0, 1.0 + eps];
         let signed = [(3, 1.0)];
         let mut x = vec![0.5, 0.5, 0.0, -1.0];
-        let p = project_rows(&rows, 4, &c, &mut x, &signed, 5);
+        let p = project_rows(&rows, 4, &c, &mut x, &signed, 5, false);
         assert!(p.kept && p.precise, "{p:?}");
         let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         // The second row's own miss, unit-normalised (its norm is √2 to 1e-14).
