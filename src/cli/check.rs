@@ -300,7 +300,7 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
     let p = &s.sign_projection;
     let projection = if p.too_large {
         "; sign projection skipped: too large to factor".to_string()
-    } else if p.rounds == 0 {
+    } else if p.rounds == 0 && !p.program {
         match &p.program_error {
             Some(e) => format!("; sign program not solved: {e}"),
             None => String::new(),

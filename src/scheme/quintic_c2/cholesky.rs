@@ -320,18 +320,18 @@ fn factor<T: Real>(
 
 /// The equations scaled to unit rows (duplicate columns merged), as the factorisation, the
 /// refinement and [`conjugate_gradients`] use them, with each row's own scale to measure the
-/// residual in.
-struct UnitRows {
+/// residual in; also the rows the sign program hands to its solver ([`super::signfit`]).
+pub(super) struct UnitRows {
     /// Â: each row over its norm.
-    rows: Vec<Vec<(u32, f64)>>,
+    pub(super) rows: Vec<Vec<(u32, f64)>>,
     /// ĉ: each right-hand side over its row's norm.
-    c: Vec<f64>,
+    pub(super) c: Vec<f64>,
     /// Each row's norm as given.
     scale: Vec<f64>,
 }
 
 impl UnitRows {
-    fn new(rows: &[Row], c: &[f64]) -> UnitRows {
+    pub(super) fn new(rows: &[Row], c: &[f64]) -> UnitRows {
         debug_assert_eq!(rows.len(), c.len());
         let mut unit = Vec::with_capacity(rows.len());
         let mut cs = Vec::with_capacity(rows.len());

@@ -178,7 +178,6 @@ pub fn project_rows(
                 *x = y;
                 residual = projector.meet(x, REFINE_TARGET * scale);
                 report.program = true;
-                report.rounds = 1;
                 rounds = 0;
             }
             Err(e) => report.program_error = Some(e),
@@ -301,8 +300,9 @@ mod tests {
     /// fewest misses put only x2 off (at 1/2 plus a margin), where the alternating projections
     /// spread the miss over all three: their limit is the plane's point closest to the box
     /// corner (−m, −m, −m), which is −m + (1 + 4m)/6 > 0 in x0 and x1 for the margin m = 0.2
-    /// (the median of the start). With the program (feature `highs`) exactly one weight is off and the row is
-    /// met; without the feature the program is reported unsolved and the rounds run instead.
+    /// (the median of the start). With the program (feature `highs`) exactly one weight is
+    /// off and the row is met; without the feature the program is reported unsolved and the
+    /// rounds run instead.
     #[test]
     fn the_sign_program_leaves_the_fewest_weights_off() {
         let rows: Vec<Row> = vec![vec![(0, 1.0), (1, 1.0), (2, 2.0)]];

@@ -27,15 +27,14 @@ use super::sparse::Row;
 pub const PROGRAM_MARGIN: f64 = 1e-3;
 
 /// Box on each weight's move, in units of the largest |weight|: keeps the program bounded
-/// (its optimum is not unique) without binding at the optimum (mpi_poly's moves stay below 3).
+/// (its optimum is not unique); far wider than any move the equations ask for.
 pub const MOVE_BOX: f64 = 50.0;
 
 /// The weights closest (in the L1 sense above) to Theorem 2.1's `signed` conditions (index, ±1)
-/// with `rows` (over `n` unknowns) = `c`, from the solved `x`; `None` with the reason when
-/// the program is not solved to optimality.
+/// with `rows` (over `n` unknowns) = `c`, from the solved `x`.
 ///
 /// # Errors
-/// HiGHS's status when the program is not solved to optimality.
+/// HiGHS's status when the program is invalid or not solved to optimality.
 #[cfg(feature = "highs")]
 pub fn least_violation(
     rows: &[Row],
@@ -53,20 +52,22 @@ pub fn least_violation(
         .iter()
         .map(|&v| pb.add_column(0.0, (v - MOVE_BOX * scale)..=(v + MOVE_BOX * scale)))
         .collect();
-    for (row, &ci) in rows.iter().zip(c) {
-        // Unit rows, as the projections see them.
-        let norm = row.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt();
-        if norm == 0.0 {
+    // Unit rows with duplicate columns merged, as the projections see them (an empty row
+    // asks nothing).
+    let unit = super::cholesky::UnitRows::new(rows, c);
+    for (row, &ci) in unit.rows.iter().zip(&unit.c) {
+        if row.iter().all(|t| t.1 == 0.0) {
             continue;
         }
-        let rhs = ci / norm;
-        pb.add_row(rhs..=rhs, row.iter().map(|&(j, k)| (cols[j], k / norm)));
+        pb.add_row(ci..=ci, row.iter().map(|&(j, k)| (cols[j as usize], k)));
     }
     for &(j, s) in signed {
         let v = pb.add_column(1.0 / median, 0.0..);
         pb.add_row(margin.., [(cols[j], s), (v, 1.0)]);
     }
-    let mut model = pb.optimise(Sense::Minimise);
+    let mut model = pb
+        .try_optimise(Sense::Minimise)
+        .map_err(|e| format!("HiGHS refused the program: {e:?}"))?;
     model.make_quiet();
     model.set_option("solver", "ipm");
     model.set_option("run_crossover", "on");
