@@ -42,6 +42,14 @@ pub const KEEP_RESIDUAL: f64 = 10.0 * REFINE_TARGET;
 /// refined (iterative refinement, then conjugate gradients with the factor).
 pub const REFINE_TARGET: f64 = 1e-13;
 
+/// Cost of a sign miss on a boundary face of the hull in the linear program
+/// ([`super::signfit`]), against 1 for any other weight. A boundary weight off its sign is
+/// where the surface can cross the hull's boundary (a hole); an inner one risks a second
+/// sheet only where its neighbours turn too. Measured on mpi_poly's pending quintic (session
+/// 34, HiGHS): costs 1, 3, 10, 100 left 1, 1, 0, 0 holes (608, 669, 750, 915 weights off in
+/// all), j-sheets 0 and the Hessian jump ≤ 4.7e-10 with every cost.
+pub const BOUNDARY_COST: f64 = 10.0;
+
 /// What [`project_signs`] did.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct SignProjection {
@@ -116,8 +124,18 @@ pub fn project_signs(
             _ => None,
         })
         .collect();
+    let cost: Vec<f64> = signed
+        .iter()
+        .map(|&(j, _)| {
+            if sys.boundary[slots[j]] {
+                BOUNDARY_COST
+            } else {
+                1.0
+            }
+        })
+        .collect();
     let mut x: Vec<f64> = slots.iter().map(|&s| value[s]).collect();
-    let report = project_rows(&rows, n, &c, &mut x, &signed, rounds, program);
+    let report = project_rows(&rows, n, &c, &mut x, &signed, &cost, rounds, program);
     if report.kept {
         for (j, &s) in slots.iter().enumerate() {
             value[s] = x[j];
@@ -132,14 +150,17 @@ pub fn project_signs(
 /// the f64 factor's last move misses [`KEEP_RESIDUAL`], that move is made again with a
 /// double-double factor ([`Projector::precise`]: pivots of nearly dependent rows, which f64
 /// rounds away, kept down to [`cholesky::PRECISE_PIVOT`]). With `program` the rounds are
-/// replaced by one move from the linear program's solution ([`super::signfit`]) onto the
-/// equations, when the program is solved.
+/// replaced by one move from the linear program's solution ([`super::signfit`], each miss
+/// weighted by `cost`, parallel to `signed`; empty for 1 each) onto the equations, when the
+/// program is solved.
+#[allow(clippy::too_many_arguments)]
 pub fn project_rows(
     rows: &[Row],
     n: usize,
     c: &[f64],
     x: &mut Vec<f64>,
     signed: &[(usize, f64)],
+    cost: &[f64],
     rounds: usize,
     program: bool,
 ) -> SignProjection {
@@ -173,7 +194,7 @@ pub fn project_rows(
     let mut rounds = rounds;
     if program {
         crate::progress::report(|| "quintic-c2 sign program (HiGHS)".into());
-        match super::signfit::least_violation(rows, n, c, x, signed) {
+        match super::signfit::least_violation(rows, n, c, x, signed, cost) {
             Ok(y) => {
                 *x = y;
                 residual = projector.meet(x, REFINE_TARGET * scale);
@@ -266,7 +287,7 @@ mod tests {
         let c = [1.0, 0.0];
         let signed = [(0, 1.0), (2, -1.0), (3, 1.0)];
         let mut x = vec![1.0, 0.0, 0.0, -1.0];
-        let p = project_rows(&rows, 4, &c, &mut x, &signed, 200, false);
+        let p = project_rows(&rows, 4, &c, &mut x, &signed, &[], 200, false);
         assert!(p.kept && !p.precise, "{p:?}");
         assert_eq!((p.off_before, p.off_after), (1, 0), "{p:?} {x:?}");
         // Equations to the keep bound of the largest weight (module docs).
@@ -289,7 +310,7 @@ mod tests {
         let signed = [(1, 1.0), (2, 1.0)];
         let start = vec![1.0, -0.5, 0.5];
         let mut x = start.clone();
-        let p = project_rows(&rows, 3, &c, &mut x, &signed, 20, false);
+        let p = project_rows(&rows, 3, &c, &mut x, &signed, &[], 20, false);
         assert!(!p.kept && p.precise, "{p:?}");
         assert!(p.residual > KEEP_RESIDUAL, "{p:?}");
         assert_eq!(p.off_after, p.off_before);
@@ -310,11 +331,11 @@ mod tests {
         let signed = [(0, -1.0), (1, -1.0), (2, -1.0)];
         let start = vec![0.2, 0.2, 0.3];
         let mut rounds = start.clone();
-        let p = project_rows(&rows, 3, &c, &mut rounds, &signed, 200, false);
+        let p = project_rows(&rows, 3, &c, &mut rounds, &signed, &[], 200, false);
         // All three stay off: nothing gained, so not kept.
         assert!(!p.kept && p.off_after == 3, "{p:?} {rounds:?}");
         let mut x = start.clone();
-        let q = project_rows(&rows, 3, &c, &mut x, &signed, 200, true);
+        let q = project_rows(&rows, 3, &c, &mut x, &signed, &[], 200, true);
         if cfg!(feature = "highs") {
             assert!(q.kept && q.program && q.off_after == 1, "{q:?} {x:?}");
             assert!(x[0] < 0.0 && x[1] < 0.0 && x[2] > 0.0, "{x:?}");
@@ -325,6 +346,33 @@ mod tests {
             let e = q.program_error.as_deref().unwrap_or("");
             assert!(!q.program && e.contains("highs"), "{q:?}");
             assert_eq!(x, rounds, "the rounds ran instead");
+        }
+    }
+
+    /// x0 − x1 = 1 with x0 asked to be ≤ 0 and x1 ≥ 0: one of them must miss, and either miss
+    /// is as large (x0 = −m gives x1 = −1 − m, 1 + 2m short of its margin m; x1 = m gives
+    /// x0 = 1 + m, as short), so only the costs decide: the cheap condition takes the miss,
+    /// whichever of the two it is. Without the feature nothing moves (no rounds asked).
+    #[test]
+    fn the_sign_program_puts_misses_where_they_cost_least() {
+        let rows: Vec<Row> = vec![vec![(0, 1.0), (1, -1.0)]];
+        let c = [1.0];
+        let signed = [(0, -1.0), (1, 1.0)];
+        let start = vec![0.5, -0.5];
+        for (cost, off) in [([BOUNDARY_COST, 1.0], 1), ([1.0, BOUNDARY_COST], 0)] {
+            let mut x = start.clone();
+            let q = project_rows(&rows, 2, &c, &mut x, &signed, &cost, 0, true);
+            if cfg!(feature = "highs") {
+                // Both start off; after the program only `off` is.
+                assert!(q.kept && q.program && q.off_after == 1, "{q:?} {x:?}");
+                let (j, s) = signed[off];
+                assert!(s * x[j] < 0.0, "{cost:?}: {x:?}");
+                let (k, t) = signed[1 - off];
+                assert!(t * x[k] > 0.0, "{cost:?}: {x:?}");
+            } else {
+                assert!(!q.kept && q.program_error.is_some(), "{q:?}");
+                assert_eq!(x, start);
+            }
         }
     }
 
@@ -340,7 +388,7 @@ mod tests {
         let c = [1.0, 1.0 + eps];
         let signed = [(3, 1.0)];
         let mut x = vec![0.5, 0.5, 0.0, -1.0];
-        let p = project_rows(&rows, 4, &c, &mut x, &signed, 5, false);
+        let p = project_rows(&rows, 4, &c, &mut x, &signed, &[], 5, false);
         assert!(p.kept && p.precise, "{p:?}");
         let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         // The second row's own miss, unit-normalised (its norm is √2 to 1e-14).

@@ -8,17 +8,20 @@
 //! the linear program
 //!
 //! ```text
-//! minimise Σ v_i   subject to   A x = c   (the C1/C2 equations, jets held),
-//!                               s_i x_i + v_i ≥ m,  v_i ≥ 0   (each sign condition i),
+//! minimise Σ w_i v_i   subject to   A x = c   (the C1/C2 equations, jets held),
+//!                                   s_i x_i + v_i ≥ m,  v_i ≥ 0   (each sign condition i),
 //! ```
 //!
-//! whose optimal violations v are sparse (an L1 objective), with HiGHS (interior point, then
+//! whose optimal violations v are sparse (an L1 objective; a miss on a boundary face of the
+//! hull, where the surface can leave through the boundary, costs w_i =
+//! [`super::project::BOUNDARY_COST`], any other 1), with HiGHS (interior point, then
 //! crossover to a vertex, so the equations are met to the simplex's accuracy). The caller moves
 //! the result onto the equations with its own factor, as every projection ends.
 //!
 //! On mpi_poly's pending quintic (session 33): 3619 weights off their signs after the solve;
 //! the program leaves 608 (alternating projections: 2683 after 1000 rounds), and the check's
-//! holes and j-sheets go from 24 and 7 to 1 and 0.
+//! holes and j-sheets go from 24 and 7 to 1 and 0; with boundary misses costing 10 (session
+//! 34), 750 weights off and no hole.
 
 use super::sparse::Row;
 
@@ -30,7 +33,9 @@ pub const PROGRAM_MARGIN: f64 = 1e-3;
 /// (its optimum is not unique); far wider than any move the equations ask for.
 pub const MOVE_BOX: f64 = 50.0;
 
-/// The weights closest (in the L1 sense above) to Theorem 2.1's `signed` conditions (index, ±1)
+/// The weights closest (in the L1 sense above, miss i weighted by `cost[i]`, 1 where `cost` is
+/// short; [`super::project::BOUNDARY_COST`] on the hull's boundary faces) to Theorem 2.1's
+/// `signed` conditions (index, ±1)
 /// with `rows` (over `n` unknowns) = `c`, from the solved `x`.
 ///
 /// # Errors
@@ -42,6 +47,7 @@ pub fn least_violation(
     c: &[f64],
     x: &[f64],
     signed: &[(usize, f64)],
+    cost: &[f64],
 ) -> Result<Vec<f64>, String> {
     use highs::{HighsModelStatus, RowProblem, Sense};
     let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
@@ -61,8 +67,8 @@ pub fn least_violation(
         }
         pb.add_row(ci..=ci, row.iter().map(|&(j, k)| (cols[j as usize], k)));
     }
-    for &(j, s) in signed {
-        let v = pb.add_column(1.0 / median, 0.0..);
+    for (i, &(j, s)) in signed.iter().enumerate() {
+        let v = pb.add_column(cost.get(i).copied().unwrap_or(1.0) / median, 0.0..);
         pb.add_row(margin.., [(cols[j], s), (v, 1.0)]);
     }
     let mut model = pb
@@ -91,6 +97,7 @@ pub fn least_violation(
     _c: &[f64],
     _x: &[f64],
     _signed: &[(usize, f64)],
+    _cost: &[f64],
 ) -> Result<Vec<f64>, String> {
     Err("built without the `highs` feature (cargo build --release --features highs)".into())
 }

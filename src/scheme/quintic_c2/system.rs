@@ -183,7 +183,7 @@ pub struct System {
     /// Sign Theorem 2.1 asks of every slot ([`signs::required`] combined over its tetrahedra).
     pub(super) req: Vec<i8>,
     /// Slots on a boundary face of the hull (a face of one tetrahedron only).
-    boundary: Vec<bool>,
+    pub(super) boundary: Vec<bool>,
     /// Near-null threshold of the star systems (`QuinticOptions::star_tau`, 0 = off): the
     /// left singular vectors u of a star whose σ ≤ this × σ_max give conditions uᵀc = 0 on
     /// the weights solved before it, so the star does not amplify their noise by 1/σ.
