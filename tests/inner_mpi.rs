@@ -400,7 +400,7 @@ fn mpi_poly_scene_has_no_holes() {
 fn mpi_poly_quintic_scene_is_c2() {
     let path = Path::new("scenes/pending/paper1994/mpi_poly_quintic.toml");
     let mut scene = apatch::scene::load(path).unwrap();
-    // The projection rounds, not the scene's linear program (feature `highs`).
+    // The projection rounds, not the scene's linear program.
     common::set_scheme(&mut scene, "sign_program", false);
     common::set_scheme(&mut scene, "sign_rounds", 60);
     let built = apatch::scene::build_scene(&scene).unwrap();
@@ -440,7 +440,7 @@ fn mpi_poly_quintic_scene_is_c2() {
 fn mpi_poly_quintic_balanced_edges_shrink_the_weights() {
     let path = Path::new("scenes/pending/paper1994/mpi_poly_quintic.toml");
     let mut scene = apatch::scene::load(path).unwrap();
-    // The projection rounds, not the scene's linear program (feature `highs`).
+    // The projection rounds, not the scene's linear program.
     common::set_scheme(&mut scene, "sign_program", false);
     // The session-30 polyhedron, whose face 8 has the 0.9° needles: the nearly coplanar faces
     // kept apart (`model.clean_coplanar`, session 32, merges face 8 into its plane's other
@@ -576,7 +576,7 @@ fn near_guards_leave_the_passing_models_alone() {
 fn mpi_poly_quintic_tangent_clearance_halves_the_holes() {
     let path = Path::new("scenes/pending/paper1994/mpi_poly_quintic.toml");
     let mut scene = apatch::scene::load(path).unwrap();
-    // The projection rounds, not the scene's linear program (feature `highs`).
+    // The projection rounds, not the scene's linear program.
     common::set_scheme(&mut scene, "sign_program", false);
     common::set_scheme(&mut scene, "sign_rounds", 60);
     let cleared = apatch::scene::build_scene(&scene).unwrap();
@@ -596,6 +596,50 @@ fn mpi_poly_quintic_tangent_clearance_halves_the_holes() {
     );
 }
 
+/// The pending scene built as it is (its sign program on), the program's report asserted
+/// used and kept, with fewer than a quarter of the solve's misses left; and its check.
+fn pending_scene_with_sign_program() -> (apatch::scene::BuiltScene, apatch::check::CheckReport) {
+    let path = Path::new("scenes/pending/paper1994/mpi_poly_quintic.toml");
+    let scene = apatch::scene::load(path).unwrap();
+    let built = apatch::scene::build_scene(&scene).unwrap();
+    let p = &built.solve.as_ref().unwrap().sign_projection;
+    assert!(p.program && p.kept, "{p:?}");
+    assert!(4 * p.off_after < p.off_before, "{p:?}");
+    let report = apatch::check::check(&built.complex, &apatch::check::CheckOptions::default());
+    (built, report)
+}
+
+/// The pending scene as it is in the default build, where the sign program is solved by the
+/// pure-Rust interior point method (session 34; `cargo test --release --test inner_mpi
+/// interior -- --ignored`, about 3–6 min): about as few weights off their signs as HiGHS
+/// leaves (measured 757 against 750 of 3619), C1/C2 and the jets to the check's bounds, and
+/// the defects of the 1000 projection rounds (24 holes, 7 j-sheets) down to the measured 3
+/// holes and 1 j-sheet; not yet a pass (HiGHS's vertex solution has none, the interior
+/// solution is the optimal face's centre).
+#[cfg(not(feature = "highs"))]
+#[test]
+#[ignore = "slow (3-6 min): the interior point method on mpi_poly's pending quintic"]
+fn mpi_poly_quintic_interior_point_sign_program() {
+    // Fewer than a quarter of the solve's misses left (measured: 757 of 3619).
+    let (built, report) = pending_scene_with_sign_program();
+    let failures = report.failures();
+    // The check's own tolerances (gradient 1e-9, Hessian 1e-7 relative: issue 8's bounds).
+    for kind in [
+        "value jump",
+        "gradient jump",
+        "hessian jump",
+        "vertex value",
+        "vertex normal",
+    ] {
+        assert!(!failures.contains(&kind), "{kind}: {failures:?}");
+    }
+    // At most the defects measured (3 holes, 1 j-sheet): a regression guard, far below the
+    // rounds' 24 and 7.
+    assert!(report.holes.crossing <= 3, "{:?}", report.holes);
+    assert!(report.sheets.j_multi_patches <= 1, "{:?}", report.sheets);
+    assert!(inner::verify(built.hull.as_ref().unwrap()).is_empty());
+}
+
 /// The pending scene as it is, with the sign program (`sign_program`, sessions 33–34; only
 /// with the cargo feature `highs`: `cargo test --release --features highs --test inner_mpi
 /// sign_program`, about 70 s): the linear program leaves far fewer weights off their signs
@@ -606,14 +650,8 @@ fn mpi_poly_quintic_tangent_clearance_halves_the_holes() {
 #[cfg(feature = "highs")]
 #[test]
 fn mpi_poly_quintic_sign_program_passes_the_check() {
-    let path = Path::new("scenes/pending/paper1994/mpi_poly_quintic.toml");
-    let scene = apatch::scene::load(path).unwrap();
-    let built = apatch::scene::build_scene(&scene).unwrap();
-    let p = &built.solve.as_ref().unwrap().sign_projection;
-    assert!(p.program && p.kept, "{p:?}");
-    // Fewer than a quarter of the solve's misses (measured: 750 of 3619).
-    assert!(4 * p.off_after < p.off_before, "{p:?}");
-    let report = apatch::check::check(&built.complex, &apatch::check::CheckOptions::default());
+    // Fewer than a quarter of the solve's misses left (measured: 750 of 3619).
+    let (built, report) = pending_scene_with_sign_program();
     // Every check at its own tolerance (gradient 1e-9, Hessian 1e-7 relative: issue 8's
     // bounds; holes, sheets and j-sheets none).
     assert!(report.failures().is_empty(), "{:?}", report.failures());

@@ -13,8 +13,8 @@ use std::path::Path;
 /// `STAR_TAU` the stars' near-null threshold, `REPAIR=1` the hole repair and
 /// `REPAIR_HESSIANS=0` its Hessian passes off, `THICKEN=0` the sliver edge tetrahedra left
 /// as they are, `BALANCE=1` the balanced edge points and `SIGN_ROUNDS` the sign projection's
-/// rounds, `SIGN_PROGRAM=1` its linear program (feature `highs`), `TANGENT_CLEARANCE` the
-/// quintic's `tangent_clearance` (to explore).
+/// rounds, `SIGN_PROGRAM=1` its linear program (HiGHS with the feature `highs`, else the
+/// interior point method), `TANGENT_CLEARANCE` the quintic's `tangent_clearance` (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")

@@ -311,7 +311,10 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
             p.off_before,
             p.off_after,
             if p.program {
-                "by the linear program (HiGHS)".to_string()
+                format!(
+                    "by the linear program ({})",
+                    apatch::scheme::quintic_c2::signfit::SOLVER
+                )
             } else {
                 let failed = p
                     .program_error

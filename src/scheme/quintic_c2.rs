@@ -13,6 +13,7 @@ mod dd;
 pub mod dense;
 pub mod flat;
 pub mod holes;
+pub mod interior;
 pub mod jets;
 pub mod ordering;
 mod pinned;
@@ -122,8 +123,9 @@ pub struct QuinticOptions {
     /// signs, C2 is kept, the jets are not moved.
     pub sign_rounds: usize,
     /// Instead of the rounds, move the weights to the fewest (L1-least) misses of Theorem
-    /// 2.1's signs that the C1/C2 equations allow, by a linear program ([`signfit`]; needs the
-    /// cargo feature `highs`). Off by default.
+    /// 2.1's signs that the C1/C2 equations allow, by a linear program ([`signfit`]: HiGHS
+    /// with the cargo feature `highs`, else the pure-Rust [`interior`] point method; the
+    /// rounds run only if it fails). Off by default.
     pub sign_program: bool,
 }
 

@@ -193,7 +193,7 @@ pub fn project_rows(
     let mut residual = 0.0;
     let mut rounds = rounds;
     if program {
-        crate::progress::report(|| "quintic-c2 sign program (HiGHS)".into());
+        crate::progress::report(|| format!("quintic-c2 sign program ({})", super::signfit::SOLVER));
         match super::signfit::least_violation(rows, n, c, x, signed, cost) {
             Ok(y) => {
                 *x = y;
@@ -321,9 +321,8 @@ mod tests {
     /// fewest misses put only x2 off (at 1/2 plus a margin), where the alternating projections
     /// spread the miss over all three: their limit is the plane's point closest to the box
     /// corner (−m, −m, −m), which is −m + (1 + 4m)/6 > 0 in x0 and x1 for the margin m = 0.2
-    /// (the median of the start). With the program (feature `highs`) exactly one weight is
-    /// off and the row is met; without the feature the program is reported unsolved and the
-    /// rounds run instead.
+    /// (the median of the start). With the program (HiGHS with the feature `highs`, the
+    /// interior point method without) exactly one weight is off and the row is met.
     #[test]
     fn the_sign_program_leaves_the_fewest_weights_off() {
         let rows: Vec<Row> = vec![vec![(0, 1.0), (1, 1.0), (2, 2.0)]];
@@ -336,23 +335,18 @@ mod tests {
         assert!(!p.kept && p.off_after == 3, "{p:?} {rounds:?}");
         let mut x = start.clone();
         let q = project_rows(&rows, 3, &c, &mut x, &signed, &[], 200, true);
-        if cfg!(feature = "highs") {
-            assert!(q.kept && q.program && q.off_after == 1, "{q:?} {x:?}");
-            assert!(x[0] < 0.0 && x[1] < 0.0 && x[2] > 0.0, "{x:?}");
-            let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
-            let miss = (x[0] + x[1] + 2.0 * x[2] - 1.0).abs() / 6f64.sqrt();
-            assert!(miss <= KEEP_RESIDUAL * scale, "{miss:e} {x:?}");
-        } else {
-            let e = q.program_error.as_deref().unwrap_or("");
-            assert!(!q.program && e.contains("highs"), "{q:?}");
-            assert_eq!(x, rounds, "the rounds ran instead");
-        }
+        assert!(q.kept && q.program && q.off_after == 1, "{q:?} {x:?}");
+        assert!(x[0] < 0.0 && x[1] < 0.0 && x[2] > 0.0, "{x:?}");
+        let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let miss = (x[0] + x[1] + 2.0 * x[2] - 1.0).abs() / 6f64.sqrt();
+        assert!(miss <= KEEP_RESIDUAL * scale, "{miss:e} {x:?}");
     }
 
     /// x0 − x1 = 1 with x0 asked to be ≤ 0 and x1 ≥ 0: one of them must miss, and either miss
     /// is as large (x0 = −m gives x1 = −1 − m, 1 + 2m short of its margin m; x1 = m gives
     /// x0 = 1 + m, as short), so only the costs decide: the cheap condition takes the miss,
-    /// whichever of the two it is. Without the feature nothing moves (no rounds asked).
+    /// whichever of the two it is (HiGHS with the feature `highs`, the interior point method
+    /// without).
     #[test]
     fn the_sign_program_puts_misses_where_they_cost_least() {
         let rows: Vec<Row> = vec![vec![(0, 1.0), (1, -1.0)]];
@@ -362,17 +356,12 @@ mod tests {
         for (cost, off) in [([BOUNDARY_COST, 1.0], 1), ([1.0, BOUNDARY_COST], 0)] {
             let mut x = start.clone();
             let q = project_rows(&rows, 2, &c, &mut x, &signed, &cost, 0, true);
-            if cfg!(feature = "highs") {
-                // Both start off; after the program only `off` is.
-                assert!(q.kept && q.program && q.off_after == 1, "{q:?} {x:?}");
-                let (j, s) = signed[off];
-                assert!(s * x[j] < 0.0, "{cost:?}: {x:?}");
-                let (k, t) = signed[1 - off];
-                assert!(t * x[k] > 0.0, "{cost:?}: {x:?}");
-            } else {
-                assert!(!q.kept && q.program_error.is_some(), "{q:?}");
-                assert_eq!(x, start);
-            }
+            // Both start off; after the program only `off` is.
+            assert!(q.kept && q.program && q.off_after == 1, "{q:?} {x:?}");
+            let (j, s) = signed[off];
+            assert!(s * x[j] < 0.0, "{cost:?}: {x:?}");
+            let (k, t) = signed[1 - off];
+            assert!(t * x[k] > 0.0, "{cost:?}: {x:?}");
         }
     }
 

@@ -1,5 +1,5 @@
-//! Theorem 2.1's signs by a linear program (`QuinticOptions::sign_program`, cargo feature
-//! `highs`).
+//! Theorem 2.1's signs by a linear program (`QuinticOptions::sign_program`): HiGHS with the
+//! cargo feature `highs`, else the pure-Rust interior point method of [`super::interior`].
 //!
 //! Where the C1/C2 equations and the sign box of Theorem 2.1 (k = 1) do not meet, the
 //! alternating projections of [`super::project`] converge towards a compromise that spreads
@@ -14,9 +14,12 @@
 //!
 //! whose optimal violations v are sparse (an L1 objective; a miss on a boundary face of the
 //! hull, where the surface can leave through the boundary, costs w_i =
-//! [`super::project::BOUNDARY_COST`], any other 1), with HiGHS (interior point, then
-//! crossover to a vertex, so the equations are met to the simplex's accuracy). The caller moves
-//! the result onto the equations with its own factor, as every projection ends.
+//! [`super::project::BOUNDARY_COST`], any other 1). With the feature `highs` HiGHS solves it
+//! (interior point, then crossover to a vertex, so the equations are met to the simplex's
+//! accuracy); HiGHS is C++ built from source (cmake, libclang), so it is not the default.
+//! Without it [`super::interior`] does (Mehrotra's predictor-corrector on the projection's own
+//! double-double factor): an interior solution, slower. The caller moves the result onto the
+//! equations with its own factor, as every projection ends.
 //!
 //! On mpi_poly's pending quintic (session 33): 3619 weights off their signs after the solve;
 //! the program leaves 608 (alternating projections: 2683 after 1000 rounds), and the check's
@@ -28,6 +31,13 @@ use super::sparse::Row;
 /// Margin m of the sign conditions, in units of the median |weight|: clearly signed, far above
 /// the solves' rounding, small against the data.
 pub const PROGRAM_MARGIN: f64 = 1e-3;
+
+/// Which solver [`least_violation`] uses, for reports.
+#[cfg(feature = "highs")]
+pub const SOLVER: &str = "HiGHS";
+/// Which solver [`least_violation`] uses, for reports.
+#[cfg(not(feature = "highs"))]
+pub const SOLVER: &str = "interior point";
 
 /// Box on each weight's move, in units of the largest |weight|: keeps the program bounded
 /// (its optimum is not unique); far wider than any move the equations ask for.
@@ -86,18 +96,19 @@ pub fn least_violation(
     }
 }
 
-/// Without the `highs` feature there is no program to solve.
+/// Without the `highs` feature: the pure-Rust interior point method of [`super::interior`].
 ///
 /// # Errors
-/// Always: says how to build with it.
+/// When the interior point method fails (its message).
 #[cfg(not(feature = "highs"))]
 pub fn least_violation(
-    _rows: &[Row],
-    _n: usize,
-    _c: &[f64],
-    _x: &[f64],
-    _signed: &[(usize, f64)],
-    _cost: &[f64],
+    rows: &[Row],
+    n: usize,
+    c: &[f64],
+    x: &[f64],
+    signed: &[(usize, f64)],
+    cost: &[f64],
 ) -> Result<Vec<f64>, String> {
-    Err("built without the `highs` feature (cargo build --release --features highs)".into())
+    let median = super::project::median_abs(x).max(f64::MIN_POSITIVE);
+    super::interior::least_violation(rows, n, c, x, signed, cost, median, PROGRAM_MARGIN)
 }
