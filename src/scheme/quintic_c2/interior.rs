@@ -52,8 +52,7 @@ struct Condition {
     w: f64,
 }
 
-/// The iterate: primal x, v, b; dual z and p = Aᵀ y.
-#[derive(Clone)]
+/// The iterate: primal x, v, b; dual z and p = Aᵀ y (or a Newton direction for them).
 struct Point {
     x: Vec<f64>,
     v: Vec<f64>,
@@ -62,17 +61,9 @@ struct Point {
     p: Vec<f64>,
 }
 
-/// A Newton direction for [`Point`].
-struct Step {
-    x: Vec<f64>,
-    v: Vec<f64>,
-    b: Vec<f64>,
-    z: Vec<f64>,
-    p: Vec<f64>,
-}
-
 /// The weights (units of `x`) of [`super::signfit`]'s least-violation program, from the
-/// solved `x`, which meets `rows` = `c` (over `n` unknowns). `signed` (index, ±1) are the
+/// solved `x`, which meets `rows` = `c` (over `n` unknowns, `ordering` made for them: the
+/// weighted rows below share their structure). `signed` (index, ±1) are the
 /// sign conditions, `cost` their weights (1 where short), `margin` the sign margin in units
 /// of `median`.
 ///
@@ -83,6 +74,7 @@ pub fn least_violation(
     rows: &[Row],
     n: usize,
     c: &[f64],
+    ordering: &Ordering,
     x: &[f64],
     signed: &[(usize, f64)],
     cost: &[f64],
@@ -95,11 +87,10 @@ pub fn least_violation(
         .map(|(i, &(j, s))| Condition {
             j,
             s,
-            w: cost.get(i).copied().unwrap_or(1.0),
+            w: super::signfit::miss_cost(cost, i),
         })
         .collect();
     let k = conds.len();
-    let ordering = Ordering::of(rows, n);
     let cs: Vec<f64> = c.iter().map(|v| v / median).collect();
     let xs: Vec<f64> = x.iter().map(|v| v / median).collect();
     // Start: v, b ≥ 1 with the condition rows met, z in the middle of its box, y = 0. (z
@@ -174,8 +165,8 @@ pub fn least_violation(
             .iter()
             .map(|r| r.iter().map(|&(j, a)| (j, a * d[j])).collect())
             .collect();
-        let projector = Projector::precise(&scaled, n, &r1, &ordering, PRECISE_PIVOT);
-        let solve = |k1: &[f64], k2: &[f64]| -> Step {
+        let projector = Projector::precise(&scaled, n, &r1, ordering, PRECISE_PIVOT);
+        let solve = |k1: &[f64], k2: &[f64]| -> Point {
             newton(&conds, &pt, &theta, &h, &d, &r2, &rd, k1, k2, &projector)
         };
         // Predictor: μ → 0.
@@ -249,7 +240,7 @@ fn newton(
     k1: &[f64],
     k2: &[f64],
     projector: &Projector,
-) -> Step {
+) -> Point {
     let n = pt.x.len();
     // ρ_i and q = Eᵀ S θ ρ − r_d.
     let rho: Vec<f64> = conds
@@ -281,7 +272,7 @@ fn newton(
     let db: Vec<f64> = (0..conds.len())
         .map(|i| (k2[i] - pt.b[i] * dz[i]) / pt.z[i])
         .collect();
-    Step {
+    Point {
         x: dx,
         v: dv,
         b: db,
@@ -291,7 +282,7 @@ fn newton(
 }
 
 /// The longest primal (v, b ≥ 0) and dual (0 ≤ z ≤ w) steps along `dir`, at most 1.
-fn step_lengths(conds: &[Condition], pt: &Point, dir: &Step) -> (f64, f64) {
+fn step_lengths(conds: &[Condition], pt: &Point, dir: &Point) -> (f64, f64) {
     let mut ap: f64 = 1.0;
     let mut ad: f64 = 1.0;
     for (i, q) in conds.iter().enumerate() {

@@ -194,7 +194,7 @@ pub fn project_rows(
     let mut rounds = rounds;
     if program {
         crate::progress::report(|| format!("quintic-c2 sign program ({})", super::signfit::SOLVER));
-        match super::signfit::least_violation(rows, n, c, x, signed, cost) {
+        match super::signfit::least_violation(rows, n, c, &ordering, x, signed, cost) {
             Ok(y) => {
                 *x = y;
                 residual = projector.meet(x, REFINE_TARGET * scale);

@@ -45,23 +45,62 @@ pub const MOVE_BOX: f64 = 50.0;
 
 /// The weights closest (in the L1 sense above, miss i weighted by `cost[i]`, 1 where `cost` is
 /// short; [`super::project::BOUNDARY_COST`] on the hull's boundary faces) to Theorem 2.1's
-/// `signed` conditions (index, ±1)
-/// with `rows` (over `n` unknowns) = `c`, from the solved `x`.
+/// `signed` conditions (index, ±1) with `rows` (over `n` unknowns, `ordering` made for them)
+/// = `c`, from the solved `x`: by HiGHS with the feature `highs`, else by
+/// [`super::interior`].
 ///
 /// # Errors
-/// HiGHS's status when the program is invalid or not solved to optimality.
-#[cfg(feature = "highs")]
+/// HiGHS's status when the program is invalid or not solved to optimality; the interior point
+/// method's message when it fails.
 pub fn least_violation(
+    rows: &[Row],
+    n: usize,
+    c: &[f64],
+    ordering: &super::cholesky::Ordering,
+    x: &[f64],
+    signed: &[(usize, f64)],
+    cost: &[f64],
+) -> Result<Vec<f64>, String> {
+    let median = super::project::median_abs(x).max(f64::MIN_POSITIVE);
+    #[cfg(feature = "highs")]
+    {
+        let _ = ordering;
+        highs_program(rows, n, c, x, signed, cost, median)
+    }
+    #[cfg(not(feature = "highs"))]
+    {
+        super::interior::least_violation(
+            rows,
+            n,
+            c,
+            ordering,
+            x,
+            signed,
+            cost,
+            median,
+            PROGRAM_MARGIN,
+        )
+    }
+}
+
+/// The cost of missing condition `i`: `cost[i]`, 1 where `cost` is short.
+pub(super) fn miss_cost(cost: &[f64], i: usize) -> f64 {
+    cost.get(i).copied().unwrap_or(1.0)
+}
+
+/// [`least_violation`] by HiGHS, `median` the median |weight| of `x`.
+#[cfg(feature = "highs")]
+fn highs_program(
     rows: &[Row],
     n: usize,
     c: &[f64],
     x: &[f64],
     signed: &[(usize, f64)],
     cost: &[f64],
+    median: f64,
 ) -> Result<Vec<f64>, String> {
     use highs::{HighsModelStatus, RowProblem, Sense};
     let scale = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
-    let median = super::project::median_abs(x).max(f64::MIN_POSITIVE);
     let margin = PROGRAM_MARGIN * median;
     let mut pb = RowProblem::default();
     let cols: Vec<_> = x
@@ -78,7 +117,7 @@ pub fn least_violation(
         pb.add_row(ci..=ci, row.iter().map(|&(j, k)| (cols[j as usize], k)));
     }
     for (i, &(j, s)) in signed.iter().enumerate() {
-        let v = pb.add_column(cost.get(i).copied().unwrap_or(1.0) / median, 0.0..);
+        let v = pb.add_column(miss_cost(cost, i) / median, 0.0..);
         pb.add_row(margin.., [(cols[j], s), (v, 1.0)]);
     }
     let mut model = pb
@@ -94,21 +133,4 @@ pub fn least_violation(
         HighsModelStatus::Optimal => Ok(solved.get_solution().columns()[..n].to_vec()),
         other => Err(format!("{other:?}")),
     }
-}
-
-/// Without the `highs` feature: the pure-Rust interior point method of [`super::interior`].
-///
-/// # Errors
-/// When the interior point method fails (its message).
-#[cfg(not(feature = "highs"))]
-pub fn least_violation(
-    rows: &[Row],
-    n: usize,
-    c: &[f64],
-    x: &[f64],
-    signed: &[(usize, f64)],
-    cost: &[f64],
-) -> Result<Vec<f64>, String> {
-    let median = super::project::median_abs(x).max(f64::MIN_POSITIVE);
-    super::interior::least_violation(rows, n, c, x, signed, cost, median, PROGRAM_MARGIN)
 }
