@@ -29,6 +29,7 @@ fn scenes(dir: &str) -> Vec<PathBuf> {
 const HEAVY: &[&str] = &[
     "bunny_quintic.toml",
     "knot_quintic.toml",
+    "mpi_poly_quintic.toml",
     "spot_control_cage_quintic.toml",
     "spot_quintic.toml",
 ];

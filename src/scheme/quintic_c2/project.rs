@@ -365,6 +365,29 @@ mod tests {
         }
     }
 
+    /// x0 − x1 = 1 and x0 − x2 = 1, x0 asked to be ≤ 0 (cost 2), x1 and x2 ≥ 0 (cost 1 each):
+    /// raising x0 by t costs 2t and saves t on each of x1 and x2, so every x0 in [−m, 1 + m]
+    /// is optimal (a tie). An interior point method ends at the centre of that segment, with
+    /// all three off (x0 + m = (1 + 2m)/3 maximises log(x0 + m) + 2 log(1 + m − x0)); the
+    /// program must end at an end of it, as HiGHS's crossover does and the interior point
+    /// method's reweighted solve ([`super::super::signfit::REWEIGHTINGS`]) does: either x0
+    /// alone off, or x1 and x2 alone.
+    #[test]
+    fn the_sign_program_ends_at_a_vertex_of_a_tie() {
+        let rows: Vec<Row> = vec![vec![(0, 1.0), (1, -1.0)], vec![(0, 1.0), (2, -1.0)]];
+        let c = [1.0, 1.0];
+        let signed = [(0, -1.0), (1, 1.0), (2, 1.0)];
+        let cost = [2.0, 1.0, 1.0];
+        let mut x = vec![0.5, -0.5, -0.5];
+        let q = project_rows(&rows, 3, &c, &mut x, &signed, &cost, 0, true);
+        assert!(q.kept && q.program, "{q:?} {x:?}");
+        let off: Vec<bool> = signed.iter().map(|&(j, s)| s * x[j] < 0.0).collect();
+        assert!(
+            off == [true, false, false] || off == [false, true, true],
+            "{off:?}: {x:?}"
+        );
+    }
+
     /// A row 1e-7 (relative) from the span of another: its squared pivot, 5e-15, is below the
     /// f64 factor's drop threshold (`DEPENDENT_PIVOT` = 1e-13), so the f64 moves drop it and miss
     /// it by ~1e-7; the double-double factor keeps pivots down to `PRECISE_PIVOT` = 1e-15 and
