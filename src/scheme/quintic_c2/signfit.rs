@@ -73,19 +73,13 @@ pub fn least_violation(
     }
     #[cfg(not(feature = "highs"))]
     {
-        let mut y = super::interior::least_violation(
-            rows,
-            n,
-            c,
-            ordering,
-            x,
-            signed,
-            cost,
-            median,
-            PROGRAM_MARGIN,
-        )?;
-        for _ in 0..REWEIGHTINGS {
-            let again = reweighted(&y, signed, cost, median);
+        // The first solve with the given costs, each later one from the last solve's weights.
+        let mut y = x.to_vec();
+        let mut costs = cost.to_vec();
+        for solve in 0..=REWEIGHTINGS {
+            if solve > 0 {
+                costs = reweighted(&y, signed, cost, median);
+            }
             y = super::interior::least_violation(
                 rows,
                 n,
@@ -93,7 +87,7 @@ pub fn least_violation(
                 ordering,
                 &y,
                 signed,
-                &again,
+                &costs,
                 median,
                 PROGRAM_MARGIN,
             )?;
