@@ -119,6 +119,10 @@ pub trait Real:
     + AddAssign
     + SubAssign
 {
+    /// Whether the arithmetic uses `mul_add`, so that code running in it pays for FMA
+    /// instructions ([`super::cholesky`] compiles its factor and solve with them where the
+    /// processor has them).
+    const FUSED: bool;
     /// a · b of two f64 (exact for [`Dd`]).
     fn product(a: f64, b: f64) -> Self;
     fn of(x: f64) -> Self;
@@ -128,6 +132,7 @@ pub trait Real:
 }
 
 impl Real for f64 {
+    const FUSED: bool = false;
     #[inline]
     fn product(a: f64, b: f64) -> f64 {
         a * b
@@ -147,6 +152,7 @@ impl Real for f64 {
 }
 
 impl Real for Dd {
+    const FUSED: bool = true;
     #[inline]
     fn product(a: f64, b: f64) -> Dd {
         let (hi, lo) = two_prod(a, b);
