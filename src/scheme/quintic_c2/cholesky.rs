@@ -13,9 +13,11 @@
 //! QR's rank test drops them; whether they are met shows in [`Solution::residual`]. Where the
 //! f64 factor cannot tell nearly dependent rows from dependent ones (their pivots, squared
 //! distances, sink into f64's rounding), the same factorisation runs in double-double
-//! ([`Projector::precise`], [`PRECISE_PIVOT`]). Every solve runs on one thread in a fixed order
-//! (ties broken by index); [`Projector::project_units`] runs its projections in parallel, each
-//! with the arithmetic it has alone, so the bits do not depend on the thread count.
+//! ([`Projector::precise`], [`PRECISE_PIVOT`]). Every solve runs in a fixed order (ties broken
+//! by index); a factor column with many updates gathers them on two threads, each over half of
+//! the accumulator with every update in the same order (`PARALLEL_UPDATES`), and
+//! [`Projector::project_units`] runs its projections in parallel, each with the arithmetic it
+//! has alone, so the bits do not depend on the thread count.
 
 use super::dd::{Dd, Real};
 use super::dense::Solution;
@@ -265,7 +267,7 @@ fn factor<T: Real>(
         // SAFETY: the processor has FMA, checked just above.
         return unsafe { factor_fma(d, off, drop, sym) };
     }
-    factor_in(d, off, drop, sym)
+    factor_in(d, off, drop, sym, PARALLEL_UPDATES)
 }
 
 /// [`factor`] compiled with FMA, so that double-double products are one instruction each
@@ -281,15 +283,18 @@ unsafe fn factor_fma<T: Real>(
     drop: f64,
     sym: &Ordering,
 ) -> (Factor<T>, usize) {
-    factor_in(d, off, drop, sym)
+    factor_in(d, off, drop, sym, PARALLEL_UPDATES)
 }
 
+/// [`factor`]'s work; columns with at least `parallel` multiply-adds of updates gather them on
+/// two threads.
 #[inline(always)]
 fn factor_in<T: Real>(
     d: &[T],
     off: &[(u32, u32, T)],
     drop: f64,
     sym: &Ordering,
+    parallel: usize,
 ) -> (Factor<T>, usize) {
     let m = d.len();
     let order = sym.order.clone();
@@ -314,28 +319,50 @@ fn factor_in<T: Real>(
     }
     let mut diag: Vec<T> = d.to_vec();
     let mut dropped = 0;
-    // Dense accumulator over nodes, zero outside the current column's pattern.
+    // Each column's pattern as elimination positions (ascending), which index the accumulator.
+    let ppos: Vec<Vec<u32>> = pattern
+        .iter()
+        .map(|p| p.iter().map(|&w| pos[w as usize] as u32).collect())
+        .collect();
+    // Dense accumulator over positions, zero outside the current column's pattern.
     let mut acc = vec![T::default(); m];
     // For each node, the finished columns whose next entry below the diagonal is that node,
     // with the index of that entry: the columns that update it, each met once.
     let mut links: Vec<Vec<(u32, u32)>> = vec![Vec::new(); m];
     for &v in &order {
         let vi = v as usize;
-        let pv = &pattern[vi];
+        let pv = &ppos[vi];
         for (a, &w) in pv.iter().enumerate() {
             acc[w as usize] = vals[vi][a];
         }
         let mut piv = diag[vi];
-        for (j, at) in std::mem::take(&mut links[vi]) {
-            let (pj, lj) = (&pattern[j as usize], &vals[j as usize]);
-            let at = at as usize;
-            let l = lj[at];
+        let updates = std::mem::take(&mut links[vi]);
+        for &(j, at) in &updates {
+            let l = vals[j as usize][at as usize];
             piv -= l * l;
-            for (&w, &lw) in pj[at + 1..].iter().zip(&lj[at + 1..]) {
-                acc[w as usize] -= l * lw;
-            }
-            if at + 1 < pj.len() {
-                links[pj[at + 1] as usize].push((j, at as u32 + 1));
+        }
+        let work: usize = updates
+            .iter()
+            .map(|&(j, at)| ppos[j as usize].len() - at as usize - 1)
+            .sum();
+        if work >= parallel && pv.len() >= 2 {
+            // Two halves of the accumulator (by position), each with every update in the
+            // same order: the same arithmetic per entry as on one thread.
+            let mid = pv[pv.len() / 2] as usize;
+            let (low, high) = acc.split_at_mut(mid);
+            let (ppos, vals) = (&ppos, &vals);
+            rayon::join(
+                || gather_updates(&updates, ppos, vals, low, 0),
+                || gather_updates(&updates, ppos, vals, high, mid),
+            );
+        } else {
+            gather_updates(&updates, &ppos, &vals, &mut acc, 0);
+        }
+        for &(j, at) in &updates {
+            let pj = &pattern[j as usize];
+            let next = at as usize + 1;
+            if next < pj.len() {
+                links[pj[next] as usize].push((j, next as u32));
             }
         }
         // NaN pivots count as dependent too.
@@ -354,7 +381,7 @@ fn factor_in<T: Real>(
             vals[vi][a] = acc[w as usize] / l;
             acc[w as usize] = T::default();
         }
-        if let Some(&first) = pv.first() {
+        if let Some(&first) = pattern[vi].first() {
             links[first as usize].push((v, 0));
         }
     }
@@ -364,6 +391,65 @@ fn factor_in<T: Real>(
         .map(|(p, v)| p.iter().copied().zip(v).collect())
         .collect();
     (Factor { order, cols, diag }, dropped)
+}
+
+/// Multiply-adds of one column's updates from which [`factor`] splits them over two threads
+/// (a fork costs microseconds; a double-double multiply-add a few nanoseconds).
+const PARALLEL_UPDATES: usize = 20_000;
+
+/// The updates `acc[w] −= l_j · l_jw` of one column from the finished columns `updates` (column,
+/// index of the entry at the column being formed), for the positions w in `acc`'s window, which
+/// starts at position `start`: each entry gets its updates in the order given, so a window's
+/// results do not depend on how the accumulator is split.
+fn gather_updates<T: Real>(
+    updates: &[(u32, u32)],
+    ppos: &[Vec<u32>],
+    vals: &[Vec<T>],
+    acc: &mut [T],
+    start: usize,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if T::FUSED && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the processor has FMA, checked just above.
+        return unsafe { gather_updates_fma(updates, ppos, vals, acc, start) };
+    }
+    gather_updates_in(updates, ppos, vals, acc, start);
+}
+
+/// [`gather_updates`] compiled with FMA (see [`factor_fma`]; a thread of `rayon::join` does not
+/// run inside the caller's target feature).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+unsafe fn gather_updates_fma<T: Real>(
+    updates: &[(u32, u32)],
+    ppos: &[Vec<u32>],
+    vals: &[Vec<T>],
+    acc: &mut [T],
+    start: usize,
+) {
+    gather_updates_in(updates, ppos, vals, acc, start);
+}
+
+#[inline(always)]
+fn gather_updates_in<T: Real>(
+    updates: &[(u32, u32)],
+    ppos: &[Vec<u32>],
+    vals: &[Vec<T>],
+    acc: &mut [T],
+    start: usize,
+) {
+    let end = start + acc.len();
+    for &(j, at) in updates {
+        let (pj, lj) = (&ppos[j as usize], &vals[j as usize]);
+        let at = at as usize;
+        let l = lj[at];
+        let tail = &pj[at + 1..];
+        let from = at + 1 + tail.partition_point(|&w| (w as usize) < start);
+        let to = at + 1 + tail.partition_point(|&w| (w as usize) < end);
+        for (&w, &lw) in pj[from..to].iter().zip(&lj[from..to]) {
+            acc[w as usize - start] -= l * lw;
+        }
+    }
 }
 
 /// The equations scaled to unit rows (duplicate columns merged), as the factorisation, the
@@ -1081,7 +1167,7 @@ pub(super) mod tests {
         let ordering = Ordering::of(&rows, 260);
         let unit = UnitRows::new(&rows, &c);
         let (d, off) = normal_matrix::<Dd>(&unit.rows, 260);
-        let (plain, dropped) = factor_in(&d, &off, PRECISE_PIVOT, &ordering);
+        let (plain, dropped) = factor_in(&d, &off, PRECISE_PIVOT, &ordering, usize::MAX);
         // SAFETY: FMA checked above.
         let (fused, dropped_fused) = unsafe { factor_fma(&d, &off, PRECISE_PIVOT, &ordering) };
         assert_eq!(dropped, dropped_fused);
@@ -1095,6 +1181,28 @@ pub(super) mod tests {
         assert_eq!(y, y_fused);
         // The products do round differently from plain f64 ones (else the test shows nothing).
         assert!(plain.diag.iter().any(|x| x.lo != 0.0));
+    }
+
+    /// Columns whose updates are gathered on two threads get the same factor, to the bit, as on
+    /// one, in both precisions: every column split (threshold 0) against none.
+    #[test]
+    fn split_updates_give_the_serial_factor() {
+        let (_, rows, c, _) = system(200, 260, 77);
+        let ordering = Ordering::of(&rows, 260);
+        let unit = UnitRows::new(&rows, &c);
+        let (d, off) = normal_matrix::<Dd>(&unit.rows, 260);
+        let (serial, dropped) = factor_in(&d, &off, PRECISE_PIVOT, &ordering, usize::MAX);
+        let (split, dropped_split) = factor_in(&d, &off, PRECISE_PIVOT, &ordering, 0);
+        assert_eq!(dropped, dropped_split);
+        assert_eq!(serial.diag, split.diag);
+        assert_eq!(serial.cols, split.cols);
+        let (d, off) = normal_matrix::<f64>(&unit.rows, 260);
+        let (serial, _) = factor_in(&d, &off, DEPENDENT_PIVOT, &ordering, usize::MAX);
+        let (split, _) = factor_in(&d, &off, DEPENDENT_PIVOT, &ordering, 0);
+        assert_eq!(serial.diag, split.diag);
+        assert_eq!(serial.cols, split.cols);
+        // Fill: some columns have updates to split.
+        assert!(ordering.entries() > 260, "{}", ordering.entries());
     }
 
     /// [`Projector::project_units`] (batched, parallel) gives the projections

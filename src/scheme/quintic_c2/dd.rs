@@ -111,6 +111,8 @@ impl Div for Dd {
 /// The scalars [`super::cholesky`]'s factor runs in: f64, or [`Dd`] where f64 is not enough.
 pub trait Real:
     Copy
+    + Send
+    + Sync
     + Default
     + Add<Output = Self>
     + Sub<Output = Self>
