@@ -336,15 +336,19 @@ fn factor_in<T: Real>(
             acc[w as usize] = vals[vi][a];
         }
         let mut piv = diag[vi];
+        // Each update's pivot term, its size, and the updating column's next target (a later
+        // column, so the pushes do not touch what the gather below reads).
         let updates = std::mem::take(&mut links[vi]);
+        let mut work = 0;
         for &(j, at) in &updates {
+            let (pj, next) = (&pattern[j as usize], at as usize + 1);
             let l = vals[j as usize][at as usize];
             piv -= l * l;
+            work += pj.len() - next;
+            if next < pj.len() {
+                links[pj[next] as usize].push((j, next as u32));
+            }
         }
-        let work: usize = updates
-            .iter()
-            .map(|&(j, at)| ppos[j as usize].len() - at as usize - 1)
-            .sum();
         if work >= parallel && pv.len() >= 2 {
             // Two halves of the accumulator (by position), each with every update in the
             // same order: the same arithmetic per entry as on one thread.
@@ -357,13 +361,6 @@ fn factor_in<T: Real>(
             );
         } else {
             gather_updates(&updates, &ppos, &vals, &mut acc, 0);
-        }
-        for &(j, at) in &updates {
-            let pj = &pattern[j as usize];
-            let next = at as usize + 1;
-            if next < pj.len() {
-                links[pj[next] as usize].push((j, next as u32));
-            }
         }
         // NaN pivots count as dependent too.
         if piv.f64().is_nan() || piv.f64() <= drop * d[vi].f64().max(f64::MIN_POSITIVE) {
