@@ -183,9 +183,10 @@ impl SimplicialHull {
                     }
                     Some(&e) if edges[e].faces[1] == u32::MAX => edges[e].faces[1] = t as u32,
                     Some(_) => {
+                        let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
                         return Err(format!(
-                            "hull edge ({a}, {b}) is shared by more than two triangles"
-                        ))
+                            "hull edge ({a}, {b}), from {pa} to {pb}, is shared by more than two triangles"
+                        ));
                     }
                 }
             }
@@ -346,6 +347,25 @@ mod tests {
         assert!(r[0].tet[3].distance(DVec3::new(0.4, 0.4, 1.25)) < 1e-15);
         let l = hull.edge_tets_with(EdgePoint::Lift(1.0)).unwrap();
         assert_eq!(l[1].tet[3], DVec3::new(0.5, 0.5, 3.0));
+    }
+
+    /// Three triangles on one edge: the error names the edge by its points and where they are
+    /// (hull point indices alone cannot be found in the model).
+    #[test]
+    fn non_manifold_edge_is_named_with_its_points() {
+        let hull = SimplicialHull {
+            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, DVec3::NEG_Y],
+            normals: vec![DVec3::Z; 5],
+            origins: vec![PointOrigin::Other; 5],
+            triangles: vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+            apexes: vec![[None, None]; 3],
+            element: vec![0; 3],
+        };
+        let e = hull.edges().unwrap_err();
+        assert!(
+            e.contains("(0, 1)") && e.contains("[0, 0, 0]") && e.contains("[1, 0, 0]"),
+            "{e}"
+        );
     }
 
     /// The face tetrahedra over the edge [(0,0,0) (1,0,0)] of a triangle whose third point is
