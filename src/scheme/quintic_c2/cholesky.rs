@@ -275,6 +275,12 @@ fn factor<T: Real>(
 /// nut quintic's `apatch check`, and this 8 % of its time). Fused or not, `mul_add` is
 /// correctly rounded and nothing else contracts, so the factor is the same to the bit
 /// (the test `fused_factor_is_the_plain_one`).
+///
+/// Why a twin per function (here, `solve_batch_fma`, `gather_updates_fma`) rather than one
+/// generic `with_fma(closure)`: tried in session 37, the compiler kept each closure a function
+/// of its own, outside the FMA copy (`objdump -d`: no `vfmadd` in `gather_updates::{closure}`
+/// or `solve_batch::{closure}`, against 1 and 28 in the twins), so the products were libm calls
+/// again.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "fma")]
 unsafe fn factor_fma<T: Real>(
