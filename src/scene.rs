@@ -14,6 +14,9 @@
 //! #                               # split T-junctions, merge needle tips, planarise (mesh::clean)
 //! # clean_coplanar = 0.5          # with `clean`: neighbouring faces meeting at less than this
 //! #                               # many degrees become one face (modelling slop)
+//! # flatten = 1e-4                # opt-in (cubic-c1, quintic-c2): snap regions of faces within
+//! #                               # this × the diagonal of one plane onto it (rounded files,
+//! #                               # mesh::flatten); set it to the file's rounding, no more
 //! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
 //!
 //! [scheme]
@@ -93,6 +96,10 @@ pub enum Model {
         /// plane), cubic-c1 and quintic-c2 only, see [`mod@crate::mesh::clean`]: the hull is
         /// built on the cleaned polyhedron.
         clean: Option<mesh::CleanOptions>,
+        /// Optional flattening (`model.flatten`: the tolerance relative to the bounding-box
+        /// diagonal), cubic-c1 and quintic-c2 only, see [`mod@crate::mesh::flatten`]: nearly
+        /// flat regions of a rounded file snapped onto their planes before the hull.
+        flatten: Option<f64>,
     },
     /// A patch complex JSON file (resolved).
     Patches(PathBuf),
@@ -137,6 +144,7 @@ struct ModelSection {
     weld: Option<f64>,
     clean: Option<f64>,
     clean_coplanar: Option<f64>,
+    flatten: Option<f64>,
 }
 
 /// `model.subdivide = { rule = "loop", levels = N }`.
@@ -356,9 +364,10 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                 || m.weld.is_some()
                 || m.clean.is_some()
                 || m.clean_coplanar.is_some()
+                || m.flatten.is_some()
             {
                 return Err(bad(
-                    "model.subdivide/weld/clean",
+                    "model.subdivide/weld/clean/flatten",
                     "only applies with `model.file`".into(),
                 ));
             }
@@ -466,6 +475,27 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     ));
                 }
             }
+            if let Some(t) = m.flatten {
+                if !matches!(
+                    scheme.get("type").and_then(|v| v.as_str()),
+                    Some("cubic-c1" | "quintic-c2")
+                ) {
+                    return Err(bad(
+                        "model.flatten",
+                        "only applies to `scheme.type = \"cubic-c1\"` or `\"quintic-c2\"`".into(),
+                    ));
+                }
+                // Beyond 1e-3 of the diagonal modelled shallow features would be flattened.
+                if !(t > 0.0 && t <= mesh::flatten::MAX_RELATIVE) {
+                    return Err(bad(
+                        "model.flatten",
+                        format!(
+                            "{t} is not in (0, {:e}] (a share of the bounding-box diagonal)",
+                            mesh::flatten::MAX_RELATIVE
+                        ),
+                    ));
+                }
+            }
             Model::Mesh {
                 file: dir.join(f),
                 normals,
@@ -476,6 +506,7 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     relative,
                     coplanar_angle: m.clean_coplanar.unwrap_or(0.0),
                 }),
+                flatten: m.flatten,
             }
         }
     };
@@ -718,6 +749,8 @@ pub struct BuiltScene {
     pub cubic_steps: Option<crate::scheme::cubic_c1::PrepareSteps>,
     /// What `model.clean` changed (1994 scenes that set it; `None` otherwise).
     pub clean: Option<mesh::CleanReport>,
+    /// What `model.flatten` changed (1994 scenes that set it; `None` otherwise).
+    pub flatten: Option<mesh::flatten::FlattenReport>,
 }
 
 /// [`build_complex`], returning the loaded mesh and the hull beside the complex
@@ -736,6 +769,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
             hull_report: None,
             cubic_steps: None,
             clean: None,
+            flatten: None,
         }),
         Model::Mesh {
             file,
@@ -744,6 +778,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
             subdivide,
             weld,
             clean,
+            flatten,
         } => {
             let ty = scheme.get("type").and_then(|v| v.as_str()).ok_or_else(|| {
                 anyhow!(
@@ -803,13 +838,15 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                         hull_report: None,
                         cubic_steps: None,
                         clean: None,
+                        flatten: None,
                     })
                 }
                 "cubic-c1" | "quintic-c2" => {
                     let method: NormalMethod = normals.parse().map_err(|e: String| {
                         anyhow!("{}: `model.normals`: {e}", scene.path.display())
                     })?;
-                    let (m, report, cleaned) = polyhedron_1994(file, *clean)?;
+                    let (m, report, cleaned, flattened) =
+                        polyhedron_1994_with(file, *clean, *flatten)?;
                     crate::hull::inner::closed::require_closed(&m, &report)?;
                     let vn = mesh::vertex_normals(&m, method)?;
                     let built = build_1994(ty, &m, &vn, scheme, &scene.path)
@@ -823,6 +860,7 @@ pub fn build_scene(scene: &Scene) -> anyhow::Result<BuiltScene> {
                         hull_report: Some(built.report),
                         cubic_steps: built.cubic_steps,
                         clean: cleaned,
+                        flatten: flattened,
                     })
                 }
                 _ => bail!(
@@ -844,13 +882,37 @@ pub fn polyhedron_1994(
     file: &Path,
     clean: Option<mesh::CleanOptions>,
 ) -> anyhow::Result<(mesh::Mesh, mesh::Report, Option<mesh::CleanReport>)> {
-    let (m, report) = mesh::load(file)?;
+    let (m, report, cleaned, _) = polyhedron_1994_with(file, clean, None)?;
+    Ok((m, report, cleaned))
+}
+
+/// [`polyhedron_1994`] with the scene's `model.flatten` too (applied first,
+/// [`mod@crate::mesh::flatten`]), and what it changed.
+///
+/// # Errors
+/// As [`polyhedron_1994`].
+pub fn polyhedron_1994_with(
+    file: &Path,
+    clean: Option<mesh::CleanOptions>,
+    flatten: Option<f64>,
+) -> anyhow::Result<(
+    mesh::Mesh,
+    mesh::Report,
+    Option<mesh::CleanReport>,
+    Option<mesh::flatten::FlattenReport>,
+)> {
+    let (mut m, report) = mesh::load(file)?;
+    let flattened = flatten.map(|t| {
+        let (f, changes) = mesh::flatten::flatten(&m, t);
+        m = f;
+        changes
+    });
     let Some(options) = clean else {
-        return Ok((m, report, None));
+        return Ok((m, report, None, flattened));
     };
     let (c, report, changes) = mesh::clean_with(&m, options)
         .with_context(|| format!("{}: `model.clean`", file.display()))?;
-    Ok((c, report, Some(changes)))
+    Ok((c, report, Some(changes), flattened))
 }
 
 /// The inner simplicial hull (1994) a `cubic-c1` or `quintic-c2` scene is built on, with the
@@ -898,6 +960,7 @@ pub fn builder_hull(
         normals,
         scheme,
         clean,
+        flatten,
         ..
     } = &scene.model
     else {
@@ -912,7 +975,7 @@ pub fn builder_hull(
     let method: NormalMethod = normals
         .parse()
         .map_err(|e: String| anyhow!("{}: `model.normals`: {e}", scene.path.display()))?;
-    let (m, _, _) = polyhedron_1994(file, *clean)?;
+    let (m, _, _, _) = polyhedron_1994_with(file, *clean, *flatten)?;
     let vn = mesh::vertex_normals(&m, method)?;
     let options = crate::hull::inner::InnerOptions::from_toml(scheme, &scene.path)?;
     let hull = crate::hull::inner::build(&m, &vn, &options)
@@ -1113,7 +1176,13 @@ irradiance = 2.0
         let both = "clean = 1e-3\nclean_coplanar = 0.5";
         let s = parse(&with(both, "quintic-c2"), Path::new("s.toml")).unwrap();
         assert!(matches!(s.model, Model::Mesh { clean: Some(c), .. } if c.coplanar_angle == 0.5));
+        // `model.flatten`: the 1994 schemes only, in (0, 1e-3] of the diagonal.
+        let s = parse(&with("flatten = 1e-4", "quintic-c2"), Path::new("s.toml")).unwrap();
+        assert!(matches!(s.model, Model::Mesh { flatten: Some(t), .. } if t == 1e-4));
         for (model, scheme, key) in [
+            ("flatten = 1e-4", "rational-c1", "model.flatten"),
+            ("flatten = 0", "cubic-c1", "model.flatten"),
+            ("flatten = 0.01", "quintic-c2", "model.flatten"),
             ("weld = 0.5", "rational-c1", "model.weld"),
             ("weld = 1e-3", "quintic-c2", "model.weld"),
             ("clean = 0.5", "cubic-c1", "model.clean"),

@@ -111,3 +111,43 @@ for cap, flip in ((list(range(6)), True), ([6 + i for i in range(6)], False)):
         for t in ([q[0], q[1], q[2]], [q[0], q[2], q[3]]):
             tris.append(list(reversed(t)) if flip else t)
 write("hallway_corner.obj", "hallway corner: L-shaped corridor block, triangulated", v, tris)
+
+# Rounded box: a 1 x 0.6 x 0.4 box, each side a 6 x 6 grid of triangles (diagonals
+# alternating), turned about x and y and its coordinates rounded to 4 decimals: the sides are
+# flat only up to the rounding (fandisk.obj's flat faces in small; `model.flatten`).
+dims = (1.0, 0.6, 0.4)
+n = 6
+index = {}
+bverts = []
+bfaces = []
+def vid(p):
+    key = tuple(round(c * 1e9) for c in p)
+    if key not in index:
+        index[key] = len(bverts)
+        bverts.append(p)
+    return index[key]
+for axis in range(3):
+    for side in (0, 1):
+        u, w = [a for a in range(3) if a != axis]
+        grid = [[None] * (n + 1) for _ in range(n + 1)]
+        for i in range(n + 1):
+            for j in range(n + 1):
+                p = [0.0] * 3
+                p[axis] = dims[axis] * (side - 0.5)
+                p[u] = dims[u] * (i / n - 0.5)
+                p[w] = dims[w] * (j / n - 0.5)
+                grid[i][j] = vid(p)
+        for i in range(n):
+            for j in range(n):
+                a, b, c, d = grid[i][j], grid[i + 1][j], grid[i + 1][j + 1], grid[i][j + 1]
+                bfaces += [[a, b, c], [a, c, d]] if (i + j) % 2 == 0 else [[a, b, d], [b, c, d]]
+bfaces = orient(bverts, bfaces)
+ax, ay = 0.37, 0.23
+def turn(p):
+    x, y, z = p
+    y, z = y * math.cos(ax) - z * math.sin(ax), y * math.sin(ax) + z * math.cos(ax)
+    x, z = x * math.cos(ay) + z * math.sin(ay), -x * math.sin(ay) + z * math.cos(ay)
+    return [round(x, 4), round(y, 4), round(z, 4)]
+write("box_rounded.obj", "box, 6 x 6 triangles a side, turned, coordinates rounded to 4 decimals",
+      [turn(p) for p in bverts], bfaces,
+      "flat sides only up to the rounding (scenes/paper1994/box_rounded*.toml: model.flatten)")

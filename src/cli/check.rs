@@ -89,6 +89,7 @@ pub fn load_built(
         hull_report: None,
         cubic_steps: None,
         clean: None,
+        flatten: None,
     };
     match ext.as_str() {
         "json" => Ok((only(apatch::complex_io::read_json_file(path)?), None)),
@@ -416,6 +417,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         if let Some(c) = &built.clean {
             out.insert("clean".into(), serde_json::to_value(c)?);
         }
+        if let Some(f) = &built.flatten {
+            out.insert("flatten".into(), serde_json::to_value(f)?);
+        }
         if let Some(c) = &built.cubic_steps {
             out.insert(
                 "cubic_steps".into(),
@@ -472,6 +476,14 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
+        if let Some(f) = &built.flatten {
+            println!(
+                "flatten          {} nearly flat regions ({} faces) snapped onto their planes, {} \
+                 vertices moved ≤ {:.3e}: the hull is built on the flattened polyhedron \
+                 (`model.flatten`, `mesh::flatten`)  info",
+                f.regions, f.faces, f.moved, f.max_move
+            );
+        }
         if let Some(c) = &built.clean {
             let nearly = if c.coplanar_merged > 0 {
                 format!(

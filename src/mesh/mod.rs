@@ -46,6 +46,7 @@
 
 pub mod clean;
 pub mod convexity;
+pub mod flatten;
 pub mod geometry;
 mod load;
 mod normals;
