@@ -12,13 +12,17 @@
 //!
 //! What: faces are grown into regions of edge-adjacent faces whose every corner lies within
 //! `relative` × the bounding-box diagonal of the region's plane (area-weighted normal through
-//! the mean of its corners, refitted as the region grows), largest faces first. Each region of
-//! two or more faces gets its final plane, and every vertex is moved to the point nearest its
-//! file position on all the planes of its regions. A vertex whose planes meet at a small angle
-//! would move far along their intersection; such a vertex (a move beyond [`MAX_MOVE`] × the
-//! tolerance) leaves the smaller region, with the faces it has there, and the planes are fitted
-//! again. The moves stay within the tolerance, so this undoes rounding and does not change the
-//! shape; the coplanar merge then makes each region one polygon.
+//! the mean of its corners, refitted as the region grows), largest faces first; a face joins
+//! only along one chain of its edges, so every region stays a disk. Each region of two or more
+//! faces gets its final plane (neighbouring regions that fit one plane share it), and every
+//! vertex is moved to the point nearest its file position on all the planes of its regions. A
+//! vertex whose planes meet at a small angle would move far along their intersection; such a
+//! vertex (a move beyond [`MAX_MOVE`] × the tolerance) leaves the smaller region, with the
+//! faces it has there, and the planes are fitted again. The moves stay within [`MAX_MOVE`] ×
+//! the tolerance, so this undoes rounding and does not change the shape; the coplanar merge
+//! then makes each region one polygon. Set the tolerance to the file's rounding: a gently
+//! curved tessellation whose neighbouring faces deviate less than it would be flattened in
+//! strips (fandisk's cylinders at 1e-4, docs/quintic.md "Rounded flat faces").
 
 use super::geometry::{area_vector, bbox_diagonal};
 use super::topology::directed_edge_faces;
@@ -42,7 +46,8 @@ const NORMAL_COS: f64 = 0.9;
 /// What [`flatten`] changed.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct FlattenReport {
-    /// Regions of two or more faces snapped onto one plane.
+    /// Planes that regions of two or more faces were snapped onto (neighbouring regions of
+    /// one plane count once).
     pub regions: usize,
     /// Faces in those regions.
     pub faces: usize,
@@ -68,8 +73,8 @@ fn fit(positions: &[DVec3], faces: &[Vec<u32>], members: &[usize]) -> Option<(DV
     Some((n, sum / count.max(1) as f64))
 }
 
-/// The regions of nearly coplanar faces: for each face, its region (`usize::MAX` for none),
-/// and the regions' faces. Deterministic: seeds by decreasing area, then index.
+/// The regions of nearly coplanar faces (every face in exactly one, most of them alone).
+/// Deterministic: seeds by decreasing area, then index.
 fn grow(mesh: &Mesh, tol: f64) -> Vec<Vec<usize>> {
     let pos = &mesh.positions;
     let nf = mesh.faces.len();
