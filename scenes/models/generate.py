@@ -151,3 +151,48 @@ def turn(p):
 write("box_rounded.obj", "box, 6 x 6 triangles a side, turned, coordinates rounded to 4 decimals",
       [turn(p) for p in bverts], bfaces,
       "flat sides only up to the rounding (scenes/paper1994/box_rounded*.toml: model.flatten)")
+
+# Rounded L block: three unit cubes in an L (scaled by 0.5), each unit face a 4 x 4 grid of
+# triangles, turned like the rounded box and rounded to 4 decimals: two non-convex hexagonal
+# sides, flat only up to the rounding (`model.flatten` on non-convex faces).
+cells = {(0, 0, 0), (1, 0, 0), (0, 1, 0)}
+n = 4
+index = {}
+lverts = []
+lfaces = []
+def lvid(p):
+    key = tuple(round(c * 1e9) for c in p)
+    if key not in index:
+        index[key] = len(lverts)
+        lverts.append(p)
+    return index[key]
+for cell in sorted(cells):
+    for axis in range(3):
+        for side in (0, 1):
+            nb = list(cell)
+            nb[axis] += 1 if side else -1
+            if tuple(nb) in cells:
+                continue
+            u, w = [a for a in range(3) if a != axis]
+            grid = [[None] * (n + 1) for _ in range(n + 1)]
+            for i in range(n + 1):
+                for j in range(n + 1):
+                    p = [float(c) for c in cell]
+                    p[axis] += side
+                    p[u] += i / n
+                    p[w] += j / n
+                    grid[i][j] = lvid([0.5 * (c - m) for c, m in zip(p, (2 / 3, 2 / 3, 0.5))])
+            for i in range(n):
+                for j in range(n):
+                    a, b, c, d = grid[i][j], grid[i + 1][j], grid[i + 1][j + 1], grid[i][j + 1]
+                    for t in ([a, b, c], [a, c, d]) if (i + j) % 2 == 0 else ([a, b, d], [b, c, d]):
+                        # Outward: the normal points along +axis on the high side.
+                        pa, pb, pc = (lverts[k] for k in t)
+                        e1 = [pb[k] - pa[k] for k in range(3)]
+                        e2 = [pc[k] - pa[k] for k in range(3)]
+                        nrm = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                               e1[0] * e2[1] - e1[1] * e2[0]]
+                        lfaces.append(t if nrm[axis] * (1 if side else -1) > 0 else [t[0], t[2], t[1]])
+write("l_rounded.obj", "L block of three unit cubes (x 0.5), 4 x 4 triangles a unit face, turned, coordinates rounded to 4 decimals",
+      [turn(p) for p in lverts], lfaces,
+      "flat sides only up to the rounding (scenes/paper1994/l_rounded*.toml: model.flatten)")
