@@ -383,6 +383,35 @@ fn inner_hull_scene_reports_hull_and_distance() {
     );
 }
 
+/// A scene with `model.flatten`: `check` says what the flattening did (`--json`: `flatten`), the
+/// same figures as `mesh::flatten` on the file, and the hull it reports is the flattened box's:
+/// one face per side, so the cube's 32 patches (a second path: the box's 432 triangles would
+/// give thousands).
+#[test]
+fn flatten_scene_reports_its_flattening() {
+    let scene =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper1994/box_rounded_quintic.toml");
+    let o = apatch(&["check", scene.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let (m, _) = apatch::mesh::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models/box_rounded.obj"),
+    )
+    .unwrap();
+    let (_, r) = apatch::mesh::flatten::flatten(&m, 1e-4);
+    assert_eq!(v["flatten"]["regions"].as_u64().unwrap(), r.regions as u64);
+    assert_eq!(v["flatten"]["moved"].as_u64().unwrap(), r.moved as u64);
+    assert_eq!(v["flatten"]["max_move"].as_f64().unwrap(), r.max_move);
+    assert_eq!(v["patches"].as_u64(), Some(32), "{v}");
+    assert_eq!(v["passed"], true);
+    let o = apatch(&["check", scene.to_str().unwrap()]);
+    assert!(
+        stdout(&o).contains("flatten          6 nearly flat regions (432 faces)"),
+        "{}",
+        stdout(&o)
+    );
+}
+
 /// A quintic scene: `check` reports what the scheme's solve did, the same figures as the
 /// library's `quintic_c2::build_with_stats` on the scene's hull and options (a second path to
 /// the numbers); a cubic scene has no solve to report.
