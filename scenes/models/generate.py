@@ -115,17 +115,32 @@ write("hallway_corner.obj", "hallway corner: L-shaped corridor block, triangulat
 # Rounded box: a 1 x 0.6 x 0.4 box, each side a 6 x 6 grid of triangles (diagonals
 # alternating), turned about x and y and its coordinates rounded to 4 decimals: the sides are
 # flat only up to the rounding (fandisk.obj's flat faces in small; `model.flatten`).
+def welder():
+    """A vertex list and the function giving a position's index in it (equal positions, to
+    1e-9, are one vertex)."""
+    index = {}
+    verts = []
+    def vid(p):
+        key = tuple(round(c * 1e9) for c in p)
+        if key not in index:
+            index[key] = len(verts)
+            verts.append(p)
+        return index[key]
+    return verts, vid
+
+def grid_triangles(grid, n):
+    """The triangles of an n x n grid of vertex indices, diagonals alternating."""
+    out = []
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = grid[i][j], grid[i + 1][j], grid[i + 1][j + 1], grid[i][j + 1]
+            out += [[a, b, c], [a, c, d]] if (i + j) % 2 == 0 else [[a, b, d], [b, c, d]]
+    return out
+
 dims = (1.0, 0.6, 0.4)
 n = 6
-index = {}
-bverts = []
+bverts, vid = welder()
 bfaces = []
-def vid(p):
-    key = tuple(round(c * 1e9) for c in p)
-    if key not in index:
-        index[key] = len(bverts)
-        bverts.append(p)
-    return index[key]
 for axis in range(3):
     for side in (0, 1):
         u, w = [a for a in range(3) if a != axis]
@@ -137,10 +152,7 @@ for axis in range(3):
                 p[u] = dims[u] * (i / n - 0.5)
                 p[w] = dims[w] * (j / n - 0.5)
                 grid[i][j] = vid(p)
-        for i in range(n):
-            for j in range(n):
-                a, b, c, d = grid[i][j], grid[i + 1][j], grid[i + 1][j + 1], grid[i][j + 1]
-                bfaces += [[a, b, c], [a, c, d]] if (i + j) % 2 == 0 else [[a, b, d], [b, c, d]]
+        bfaces += grid_triangles(grid, n)
 bfaces = orient(bverts, bfaces)
 ax, ay = 0.37, 0.23
 def turn(p):
@@ -157,15 +169,8 @@ write("box_rounded.obj", "box, 6 x 6 triangles a side, turned, coordinates round
 # sides, flat only up to the rounding (`model.flatten` on non-convex faces).
 cells = {(0, 0, 0), (1, 0, 0), (0, 1, 0)}
 n = 4
-index = {}
-lverts = []
+lverts, lvid = welder()
 lfaces = []
-def lvid(p):
-    key = tuple(round(c * 1e9) for c in p)
-    if key not in index:
-        index[key] = len(lverts)
-        lverts.append(p)
-    return index[key]
 for cell in sorted(cells):
     for axis in range(3):
         for side in (0, 1):
@@ -182,17 +187,14 @@ for cell in sorted(cells):
                     p[u] += i / n
                     p[w] += j / n
                     grid[i][j] = lvid([0.5 * (c - m) for c, m in zip(p, (2 / 3, 2 / 3, 0.5))])
-            for i in range(n):
-                for j in range(n):
-                    a, b, c, d = grid[i][j], grid[i + 1][j], grid[i + 1][j + 1], grid[i][j + 1]
-                    for t in ([a, b, c], [a, c, d]) if (i + j) % 2 == 0 else ([a, b, d], [b, c, d]):
-                        # Outward: the normal points along +axis on the high side.
-                        pa, pb, pc = (lverts[k] for k in t)
-                        e1 = [pb[k] - pa[k] for k in range(3)]
-                        e2 = [pc[k] - pa[k] for k in range(3)]
-                        nrm = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                               e1[0] * e2[1] - e1[1] * e2[0]]
-                        lfaces.append(t if nrm[axis] * (1 if side else -1) > 0 else [t[0], t[2], t[1]])
+            for t in grid_triangles(grid, n):
+                # Outward: the normal points along +axis on the high side.
+                pa, pb, pc = (lverts[k] for k in t)
+                e1 = [pb[k] - pa[k] for k in range(3)]
+                e2 = [pc[k] - pa[k] for k in range(3)]
+                nrm = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]]
+                lfaces.append(t if nrm[axis] * (1 if side else -1) > 0 else [t[0], t[2], t[1]])
 write("l_rounded.obj", "L block of three unit cubes (x 0.5), 4 x 4 triangles a unit face, turned, coordinates rounded to 4 decimals",
       [turn(p) for p in lverts], lfaces,
       "flat sides only up to the rounding (scenes/paper1994/l_rounded*.toml: model.flatten)")
