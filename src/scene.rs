@@ -444,12 +444,14 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     ));
                 }
             }
+            // The 1994 schemes' own repairs of the polyhedron (`model.clean`, `model.flatten`).
+            let is_1994 = matches!(
+                scheme.get("type").and_then(|v| v.as_str()),
+                Some("cubic-c1" | "quintic-c2")
+            );
             if let Some(c) = m.clean {
                 in_weld_range("model.clean", c)?;
-                if !matches!(
-                    scheme.get("type").and_then(|v| v.as_str()),
-                    Some("cubic-c1" | "quintic-c2")
-                ) {
+                if !is_1994 {
                     return Err(bad(
                         "model.clean",
                         "only applies to `scheme.type = \"cubic-c1\"` or `\"quintic-c2\"` \
@@ -476,10 +478,7 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                 }
             }
             if let Some(t) = m.flatten {
-                if !matches!(
-                    scheme.get("type").and_then(|v| v.as_str()),
-                    Some("cubic-c1" | "quintic-c2")
-                ) {
+                if !is_1994 {
                     return Err(bad(
                         "model.flatten",
                         "only applies to `scheme.type = \"cubic-c1\"` or `\"quintic-c2\"`".into(),

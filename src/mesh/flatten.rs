@@ -25,10 +25,10 @@
 //! strips (fandisk's cylinders at 1e-4, docs/quintic.md "Rounded flat faces").
 
 use super::geometry::{area_vector, bbox_diagonal};
-use super::topology::directed_edge_faces;
+use super::topology::{boundary_loop, directed_edge_faces, UnionFind};
 use super::Mesh;
 use glam::{DMat3, DVec3};
-use std::collections::{HashMap, VecDeque};
+use std::collections::{HashMap, HashSet, VecDeque};
 
 /// Largest `model.flatten` tolerance (relative to the bounding-box diagonal): beyond it
 /// modelled shallow features, not rounding, would be flattened.
@@ -174,45 +174,27 @@ fn keeps_disk(
     })
 }
 
-/// True when the union of `members` is a disk with one simple boundary loop.
+/// True when the union of `members` is a disk: one simple boundary loop
+/// ([`boundary_loop`]) and Euler characteristic 1.
 fn is_disk(faces: &[Vec<u32>], members: &[usize]) -> bool {
-    let mut half: HashMap<(u32, u32), ()> = HashMap::new();
-    for &f in members {
-        let face = &faces[f];
-        for k in 0..face.len() {
-            half.insert((face[k], face[(k + 1) % face.len()]), ());
-        }
-    }
-    let mut next: HashMap<u32, u32> = HashMap::new();
-    for &(a, b) in half.keys() {
-        if !half.contains_key(&(b, a)) && next.insert(a, b).is_some() {
-            return false;
-        }
-    }
-    let Some(&start) = next.keys().min() else {
+    let Some(boundary) = boundary_loop(faces, members) else {
         return false;
     };
-    let mut len = 1;
-    let mut cur = next[&start];
-    while cur != start {
-        if len > next.len() {
-            return false;
-        }
-        len += 1;
-        let Some(&n) = next.get(&cur) else {
-            return false;
-        };
-        cur = n;
-    }
-    // A disk: one loop through every boundary vertex, and Euler characteristic 1.
+    let half: HashSet<(u32, u32)> = members
+        .iter()
+        .flat_map(|&f| {
+            let face = &faces[f];
+            (0..face.len()).map(move |k| (face[k], face[(k + 1) % face.len()]))
+        })
+        .collect();
     let mut vertices: Vec<u32> = members
         .iter()
         .flat_map(|&f| faces[f].iter().copied())
         .collect();
     vertices.sort_unstable();
     vertices.dedup();
-    let edges = (half.len() + next.len()) / 2;
-    len == next.len() && vertices.len() + members.len() == edges + 1
+    let edges = (half.len() + boundary.len()) / 2;
+    vertices.len() + members.len() == edges + 1
 }
 
 /// The point nearest `p` on every plane of `planes` (least-norm move; planes through one line
@@ -270,25 +252,23 @@ pub fn flatten(mesh: &Mesh, relative: f64) -> (Mesh, FlattenReport) {
         }
         // Regions of one plane (a ring the disk rule cut in two, a face grown around) share
         // one fitted plane: neighbours whose union lies within the tolerance of its plane.
-        let mut class: Vec<usize> = (0..regions.len()).collect();
-        fn root(c: &mut [usize], mut x: usize) -> usize {
-            while c[x] != x {
-                c[x] = c[c[x]];
-                x = c[x];
-            }
-            x
-        }
-        let mut tried: std::collections::HashSet<(usize, usize)> = Default::default();
+        // Each set of regions is named by its smallest region (`low`, kept at the set's
+        // representative), so the order below does not depend on how the sets were joined.
+        let mut class = UnionFind::new(regions.len());
+        let mut low: Vec<usize> = (0..regions.len()).collect();
+        let name =
+            |class: &mut UnionFind, low: &[usize], r: usize| low[class.find(r as u32) as usize];
+        let mut tried: HashSet<(usize, usize)> = HashSet::new();
         for list in &of_vertex {
             for (i, &a) in list.iter().enumerate() {
                 for &b in &list[i + 1..] {
-                    let (ra, rb) = (root(&mut class, a), root(&mut class, b));
+                    let (ra, rb) = (name(&mut class, &low, a), name(&mut class, &low, b));
                     if ra == rb || !tried.insert((ra.min(rb), ra.max(rb))) {
                         continue;
                     }
                     let union: Vec<usize> = (0..regions.len())
                         .filter(|&r| {
-                            let rr = root(&mut class, r);
+                            let rr = name(&mut class, &low, r);
                             rr == ra || rr == rb
                         })
                         .flat_map(|r| regions[r].iter().copied())
@@ -301,12 +281,15 @@ pub fn flatten(mesh: &Mesh, relative: f64) -> (Mesh, FlattenReport) {
                         })
                     });
                     if one {
-                        class[ra.max(rb)] = ra.min(rb);
+                        class.union(a as u32, b as u32);
+                        low[class.find(a as u32) as usize] = ra.min(rb);
                     }
                 }
             }
         }
-        let roots: Vec<usize> = (0..regions.len()).map(|r| root(&mut class, r)).collect();
+        let roots: Vec<usize> = (0..regions.len())
+            .map(|r| name(&mut class, &low, r))
+            .collect();
         let mut members: Vec<Vec<usize>> = vec![Vec::new(); regions.len()];
         for (r, &c) in roots.iter().enumerate() {
             members[c].extend(regions[r].iter().copied());

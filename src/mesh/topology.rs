@@ -301,6 +301,37 @@ pub fn directed_edge_faces(faces: &[Vec<u32>]) -> std::collections::HashMap<(u32
     of_edge
 }
 
+/// The boundary of the union of the polygons `faces[f]`, f in `group`, as one simple loop
+/// (counter-clockwise from outside like its faces), or `None` when the boundary is pinched or
+/// not one loop.
+#[must_use]
+pub fn boundary_loop(faces: &[Vec<u32>], group: &[usize]) -> Option<Vec<u32>> {
+    let mut half: std::collections::HashMap<(u32, u32), ()> = std::collections::HashMap::new();
+    for &f in group {
+        let face = &faces[f];
+        for k in 0..face.len() {
+            half.insert((face[k], face[(k + 1) % face.len()]), ());
+        }
+    }
+    let mut next: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    for &(a, b) in half.keys() {
+        if !half.contains_key(&(b, a)) && next.insert(a, b).is_some() {
+            return None; // a pinched boundary
+        }
+    }
+    let start = *next.keys().min()?;
+    let mut poly = vec![start];
+    let mut cur = next[&start];
+    while cur != start {
+        if poly.len() > next.len() {
+            return None;
+        }
+        poly.push(cur);
+        cur = *next.get(&cur)?;
+    }
+    (poly.len() == next.len()).then_some(poly)
+}
+
 /// Disjoint sets over `0..n` with path halving and union by size.
 pub struct UnionFind {
     parent: Vec<u32>,

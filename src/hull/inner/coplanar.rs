@@ -95,7 +95,7 @@ pub fn merge_coplanar_counted(mesh: &Mesh) -> (Mesh, Vec<usize>) {
             keep_all(&mut faces, &mut reps, &mut counts);
             continue;
         }
-        match boundary_loop(mesh, group) {
+        match crate::mesh::topology::boundary_loop(&mesh.faces, group) {
             Some(poly) => {
                 faces.push(poly);
                 reps.push(group[0] as u32);
@@ -155,35 +155,6 @@ pub fn same_plane(positions: &[DVec3], f: &[u32], nf: DVec3, g: &[u32], ng: DVec
         .fold(0.0, f64::max);
     pg.iter()
         .all(|&p| nf.dot(p - o).abs() <= PLANE_DISTANCE * size)
-}
-
-/// The boundary of the union of `group`'s faces as one simple loop (counter-clockwise from
-/// outside like its faces), or `None` when it is not a disk with a simple boundary.
-fn boundary_loop(mesh: &Mesh, group: &[usize]) -> Option<Vec<u32>> {
-    let mut half: HashMap<(u32, u32), ()> = HashMap::new();
-    for &f in group {
-        let face = &mesh.faces[f];
-        for k in 0..face.len() {
-            half.insert((face[k], face[(k + 1) % face.len()]), ());
-        }
-    }
-    let mut next: HashMap<u32, u32> = HashMap::new();
-    for &(a, b) in half.keys() {
-        if !half.contains_key(&(b, a)) && next.insert(a, b).is_some() {
-            return None; // a pinched boundary
-        }
-    }
-    let start = *next.keys().min()?;
-    let mut poly = vec![start];
-    let mut cur = next[&start];
-    while cur != start {
-        if poly.len() > next.len() {
-            return None;
-        }
-        poly.push(cur);
-        cur = *next.get(&cur)?;
-    }
-    (poly.len() == next.len()).then_some(poly)
 }
 
 #[cfg(test)]
