@@ -633,7 +633,7 @@ pub fn build(
 
 /// Prints the time since `since` for a build stage to stderr when the environment variable
 /// `APATCH_STAGE_TIMES` is set (profiling aid: which stages are serial, see
-/// `tests/rational_throughput.rs`); nothing otherwise.
+/// `tests/suite/rational_throughput.rs`); nothing otherwise.
 fn stage_time(name: &str, since: std::time::Instant) {
     if std::env::var_os("APATCH_STAGE_TIMES").is_some() {
         eprintln!(

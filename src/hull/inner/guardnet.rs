@@ -46,7 +46,7 @@ pub const SEARCH_BUDGET: usize = 200_000;
 /// How far the apex of a one-triangle cell moves out of the polyhedron, as a fraction of the
 /// single guard's distance from the edge line (see [`GuardNet::add_edge_cells`]). On letter_P,
 /// 0.05 left six edge tetrahedra over net edges with weights of both signs even with the apexes
-/// slid; 0.2 leaves none (`tests/inner_guardnet.rs`).
+/// slid; 0.2 leaves none (`tests/suite/inner_guardnet.rs`).
 pub const CELL_LIFT: f64 = 0.2;
 
 /// A step (5') cell: region edge V_1V_2 and its four guards (points of T).
@@ -693,7 +693,7 @@ fn cell_concave(hull: &SimplicialHull, positions: &[DVec3], cell: &EdgeCell) -> 
 /// tetrahedron, over a nearly flat stretch of T (a 0.1° fold), covered its neighbours' (58
 /// overlaps); capped, 470 → 351 hull violations on the raw hull. A U prism 20 high over a U of
 /// unit edges (side-face centroids 10 from the caps' edges) had 44 overlaps and now verifies
-/// (`tests/inner_mpi.rs`). letter_P's guards lie within their edges' lengths, so its cells do
+/// (`tests/suite/inner_mpi.rs`). letter_P's guards lie within their edges' lengths, so its cells do
 /// not change.
 pub const CELL_LIFT_REACH: f64 = 1.0;
 

@@ -1,8 +1,7 @@
 //! Quadratic precision (Theorem 4.2), plane recovery, the free-parameter choices, bad input and
 //! the local refinement of the rational C¹ scheme.
 
-#[path = "rational_support.rs"]
-mod support;
+use crate::rational_support as support;
 
 use apatch::complex::{Role, SheetRule};
 use apatch::scheme::rational_c1::bound::minimal_root_slope;

@@ -1,8 +1,7 @@
 //! The paper's examples as scenes (`scenes/paper2001/*.toml`): each builds through
 //! `RationalOptions::from_toml` from its OBJ (file normals) and passes the scheme's checks.
 
-#[path = "rational_support.rs"]
-mod support;
+use crate::rational_support as support;
 
 use apatch::mesh::{load, triangulate, vertex_normals, NormalMethod};
 use apatch::scheme::rational_c1::{build, RationalOptions};

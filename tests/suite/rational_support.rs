@@ -1,5 +1,5 @@
 //! Shared test support for the rational C¹ scheme: generated meshes and measurements
-//! (included by the `rational_*` tests with `#[path]`; has no tests of its own).
+//! (used by the `rational_*` modules as `support`; has no tests of its own).
 #![allow(dead_code)]
 
 use apatch::complex::{Patch, PatchComplex, Role, SheetRule};

@@ -1,8 +1,7 @@
 //! `apatch render` end to end: overrides, outputs (PNG + EXR, no temporary files left), and
 //! one-line errors with exit code 2 that name the scene file and key.
 
-#[path = "support/sphere_scene.rs"]
-mod sphere_scene;
+use crate::sphere_scene;
 
 use sphere_scene::{sphere_scene, write_unit_sphere};
 use std::path::PathBuf;

@@ -352,7 +352,7 @@ fn elements(message: &str) -> Vec<u32> {
 
 /// Survey: a scene's hull violations by kind, by element and by element pair (default the
 /// cage; `CAGE_SCENE=path` for another).
-/// `cargo test --release --test inner_cage survey -- --ignored --nocapture`
+/// `cargo test --release --test suite inner_cage::survey -- --ignored --nocapture`
 #[test]
 #[ignore = "survey: prints hull violations by kind and location"]
 fn survey_cage_violations() {
@@ -387,7 +387,7 @@ fn survey_cage_violations() {
 }
 
 /// Dump: a scene's hull (after the cubic scheme's apex moves) as JSON for offline analysis:
-/// `CAGE_SCENE=… HULL_DUMP=out.json cargo test --release --test inner_cage dump -- --ignored`.
+/// `CAGE_SCENE=… HULL_DUMP=out.json cargo test --release --test suite inner_cage::dump -- --ignored`.
 #[test]
 #[ignore = "writes a hull dump for analysis"]
 fn dump_hull() {
@@ -568,7 +568,7 @@ fn corner_search_key_is_parsed_and_checked() {
 }
 
 /// Survey: what the cage's corner search (`corner_search`, `hull::inner::recut`) kept.
-/// `cargo test --release --test inner_cage recut_survey -- --ignored --nocapture`
+/// `cargo test --release --test suite inner_cage::recut_survey -- --ignored --nocapture`
 #[test]
 #[ignore = "survey: prints the corner search's cuts"]
 fn recut_survey() {

@@ -188,7 +188,7 @@ fn strict_normals_still_name_the_corner() {
 /// spot_control_cage stopped at vertex 12 ("no normal direction is above all its faces");
 /// Appendix C re-meshes vertices 12 and 121 (its mirror image) and the hull builds. This is
 /// the cage taken as it is (`planar_tolerance` off: its bent quads taken as planar); split
-/// into planar faces (the default, `tests/inner_planar.rs`) no corner needs the re-meshing.
+/// into planar faces (the default, `tests/suite/inner_planar.rs`) no corner needs the re-meshing.
 #[test]
 fn spot_control_cage_corners_are_remeshed() {
     let (m, _) = mesh::load(Path::new("scenes/models/spot_control_cage.obj")).unwrap();

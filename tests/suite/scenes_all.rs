@@ -26,7 +26,7 @@ fn scenes(dir: &str) -> Vec<PathBuf> {
 /// Shipped scenes whose build takes minutes (the knot's C2 quintic: ~5 CPU-min, mostly its
 /// 1300 singular star systems and the hole repair). CI's time budget cannot hold them, so
 /// they are checked by the ignored [`heavy_scenes_build_and_pass_check`] instead, with the
-/// same checks: `cargo test --release --test scenes_all -- --ignored`.
+/// same checks: `cargo test --release --test suite scenes_all:: -- --ignored`.
 const HEAVY: &[&str] = &[
     "bunny_quintic.toml",
     "knot_quintic.toml",

@@ -1,10 +1,10 @@
 //! mpi_poly's inner hull (1994, `hull::inner`): nearly flat folds and needle faces.
 //!
-//! The survey (`cargo test --test inner_mpi -- --ignored --nocapture`) prints the hull
+//! The survey (`cargo test --test suite inner_mpi:: -- --ignored --nocapture`) prints the hull
 //! violations of `scenes/paper1994/mpi_poly.toml` by kind and by the input element their
 //! triangles were built for, for the raw hull and the hull the cubic scheme fills.
 
-mod common;
+use crate::common;
 
 use apatch::hull::inner::{self, HullViolation, InnerOptions};
 use apatch::hull::simplicial::{PointOrigin, SimplicialHull};
@@ -433,7 +433,7 @@ fn mpi_poly_quintic_scene_is_c2() {
 
 /// Balancing s on the apexes' lines (`balance_edges`) on the quintic scene's hull, whose T has
 /// needle triangles in its flat nets (C1 extrapolation from a face into an edge tetrahedron up
-/// to 64 at the midpoint, 16 balanced: `cargo test --release --test quintic_c2 needle_survey
+/// to 64 at the midpoint, 16 balanced: `cargo test --release --test suite quintic_c2::needle_survey
 /// -- --ignored --nocapture`): the largest weight falls at least fourfold (session 30: 3.4e3
 /// at the midpoints, 5.0e2 balanced) and C2 holds.
 #[test]
@@ -570,7 +570,7 @@ fn near_guards_leave_the_passing_models_alone() {
 /// so on flat faces' planes) are moved to the slope 0.02, the apex search clears the overlaps
 /// that makes (14 on mpi_poly), C2 holds, and fewer boundary faces are crossed than with the
 /// clearance off (session 32, 300 rounds: 98 → 49 holes, 9 → 7 j-sheets). Heavy (two builds
-/// and checks, ~1 min in release): `cargo test --release --test inner_mpi -- --ignored`.
+/// and checks, ~1 min in release): `cargo test --release --test suite inner_mpi:: -- --ignored`.
 #[test]
 #[ignore = "heavy: two mpi_poly quintic builds"]
 fn mpi_poly_quintic_tangent_clearance_halves_the_holes() {
@@ -611,7 +611,7 @@ fn scene_with_sign_program() -> (apatch::scene::BuiltScene, apatch::check::Check
 
 /// The scene as it is in the default build, where the sign program is solved by the pure-Rust
 /// interior point method and then again with reweighted costs (sessions 34–35; `cargo test
-/// --release --test inner_mpi interior -- --ignored`, about 10 CPU-min): `apatch check` passes
+/// --release --test suite inner_mpi::interior -- --ignored`, about 10 CPU-min): `apatch check` passes
 /// as a whole (C1/C2 and the jets to issue 8's bounds, no hole, no j-sheet, one sheet per
 /// patch) and the hull verifies. One solve without the reweighting left 3 holes and 1 j-sheet
 /// (session 34: the interior solution is the optimal face's centre, misses spread over many
@@ -632,7 +632,7 @@ fn mpi_poly_quintic_interior_point_sign_program() {
 }
 
 /// The scene as it is, with the sign program (`sign_program`, sessions 33–34; only
-/// with the cargo feature `highs`: `cargo test --release --features highs --test inner_mpi
+/// with the cargo feature `highs`: `cargo test --release --features highs --test suite inner_mpi::
 /// sign_program`, about 70 s): the linear program leaves far fewer weights off their signs
 /// than the solve (3619 → 750, misses on the hull's boundary faces costing
 /// `project::BOUNDARY_COST`), and `apatch check` passes as a whole: C1/C2 and the jets to

@@ -1,6 +1,6 @@
 //! The inner hull (1994) on the polygon and real models of `scenes/models/`: what holds today
 //! (builds, closed T of the right genus, corner guards), and an ignored survey printing every
-//! model's `verify` result (`cargo test --test inner_hull_models -- --ignored --nocapture`).
+//! model's `verify` result (`cargo test --test suite inner_hull_models:: -- --ignored --nocapture`).
 
 use apatch::hull::inner::{self, verify::euler_characteristic, InnerOptions};
 use apatch::mesh::{self, NormalMethod};

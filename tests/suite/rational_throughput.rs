@@ -1,6 +1,6 @@
 //! Build timings on generated ~100k-triangle models (ignored by default; speed figures belong
 //! to `benches/rational.rs`, this prints one build per model with its stage counts).
-//! Run: `cargo test --release --test rational_throughput -- --ignored --nocapture`
+//! Run: `cargo test --release --test suite rational_throughput:: -- --ignored --nocapture`
 //! (each model is built on 1 and then 2 threads in the same process; `APATCH_THREADS=n` for
 //! only n). Besides wall time it prints the
 //! process CPU time of the build (from `/proc/self/stat`, Linux only): on a shared, loaded
@@ -11,8 +11,7 @@
 //! tetrahedra, edge bounds, free values, final edge check, patch emission, freeing), to find
 //! the costly and the serial ones. The load average is printed before and after.
 
-#[path = "rational_support.rs"]
-mod support;
+use crate::rational_support as support;
 
 use apatch::scheme::rational_c1::{build, RationalOptions};
 use std::time::Instant;

@@ -11,10 +11,9 @@
 //! the tests) or else from the venv `.ci/run` creates in `target/mitsuba-venv`. Without either
 //! the tests print `skipped: <reason>` to stderr (uncaptured, so `cargo test` shows it) and pass.
 
+use crate::sphere_scene;
 use apatch::compare::{self, Image};
 use apatch::export::mitsuba::{scene_xml_with, LookAt, Surface};
-#[path = "support/sphere_scene.rs"]
-mod sphere_scene;
 
 use apatch::fixtures::icosahedron;
 use glam::DVec3;

@@ -1,8 +1,7 @@
 //! The rational C¹ scheme on generated models: interpolation, C¹ continuity across every shared
 //! tetrahedron face, at most two patches per face, simple selected roots.
 
-#[path = "rational_support.rs"]
-mod support;
+use crate::rational_support as support;
 
 use apatch::scheme::rational_c1::{build, Free, RationalOptions};
 use support::*;
@@ -211,7 +210,7 @@ fn paper1994_folded_polyhedra_pass_check_with_loop_pre_subdivision() {
 /// `APATCH_SURVEY_MODELS` (comma-separated stems) restricts the models; `APATCH_SURVEY_WELD`
 /// welds first (`mesh::weld`, relative tolerance); `APATCH_SURVEY_ROUNDS`, `APATCH_SURVEY_EPSILON`
 /// set `refine_rounds` and `epsilon`; `APATCH_SURVEY_WORST` lists the folds of 90° or more.
-/// Run: `cargo test --release --test rational_models -- --ignored --nocapture survey`.
+/// Run: `cargo test --release --test suite rational_models::survey -- --ignored --nocapture`.
 #[test]
 #[ignore = "survey of every model and level (minutes); prints a table"]
 fn survey_pre_subdivision() {

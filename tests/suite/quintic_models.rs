@@ -273,8 +273,8 @@ fn c2_of(name: &str, min_group: usize) -> apatch::complex::PatchComplex {
     c
 }
 
-/// Exploration: `SCENE=path cargo test --release --test quintic_models crack_count -- --ignored
-/// --nocapture` prints the back-facing first hits of a scene (`tests/scenes_all.rs` requires
+/// Exploration: `SCENE=path cargo test --release --test suite quintic_models::crack_count -- --ignored
+/// --nocapture` prints the back-facing first hits of a scene (`tests/suite/scenes_all.rs` requires
 /// none on every shipped 1994 scene).
 #[test]
 #[ignore = "exploration: SCENE=path"]

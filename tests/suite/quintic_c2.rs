@@ -1,7 +1,7 @@
 //! C2 quintic scheme (1994 §6) on the trihedral hulls of convex polyhedra: continuity,
 //! interpolation and single-sheetedness measured by the independent checker.
 
-mod common;
+use crate::common;
 
 use apatch::check::{check, CheckOptions};
 use apatch::fixtures::trihedral_hull;

@@ -1,8 +1,7 @@
 //! The rational C¹ scheme on the real test models of `/work/shared/meshes` (Loop limit
 //! normals, as the paper): interpolation, C¹ joins, face sharing, simple selected roots.
 
-#[path = "rational_support.rs"]
-mod support;
+use crate::rational_support as support;
 
 use apatch::mesh::{load, triangulate, vertex_normals, NormalMethod};
 use apatch::scheme::rational_c1::{build, RationalOptions};

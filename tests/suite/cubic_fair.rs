@@ -2,7 +2,7 @@
 //! ([`apatch::scheme::cubic_c1::fairness`], the angle between the surface normal and the blend
 //! of the normals at T's points) of the fair target ([`FreeWeights::Fair`], the default) against
 //! the level rule ([`FreeWeights::Level`], the old default) on the same hull, and `check` on the
-//! fair surfaces. `cargo test --release --test cubic_fair -- --ignored --nocapture` prints the
+//! fair surfaces. `cargo test --release --test suite cubic_fair:: -- --ignored --nocapture` prints the
 //! figure for every cubic scene (the README's survey).
 
 use apatch::check::{check, CheckOptions};

@@ -1,8 +1,7 @@
 //! Whole renders: bit-identical for any thread count, no NaN/inf in any EXR channel, every mode
 //! runs, the EXR carries the documented channels, and a scene file renders end to end.
 
-#[path = "support/sphere_scene.rs"]
-mod sphere_scene;
+use crate::sphere_scene;
 
 use apatch::fixtures::{quadric_complex, Quadric};
 use apatch::scene;

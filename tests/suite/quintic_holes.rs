@@ -24,7 +24,7 @@ fn complex() -> PatchComplex {
 /// Exploration: every crossed boundary face of an edge tetrahedron, with its 21 weights as a
 /// triangle (rows by the opposite point's multiplicity), where F is most negative on it, and
 /// how far the apex-side sign goes.
-/// `SCENE=… CACHE=/tmp/x.json cargo test --release --test quintic_holes edge_hole_faces --
+/// `SCENE=… CACHE=/tmp/x.json cargo test --release --test suite quintic_holes::edge_hole_faces --
 /// --ignored --nocapture`.
 #[test]
 #[ignore = "exploration: SCENE=path [CACHE=json]"]
