@@ -17,6 +17,8 @@
 //! # flatten = 1e-4                # opt-in (cubic-c1, quintic-c2): snap regions of faces within
 //! #                               # this × the diagonal of one plane onto it (rounded files,
 //! #                               # mesh::flatten); set it to the file's rounding, no more
+//! # flatten_min_faces = 100       # with `flatten`: only regions of at least this many faces
+//! #                               # (the model's flat faces, not flat-ish strips; default 2)
 //! # patches = "teapot.json"       # … or a patch complex from `apatch export patches`
 //!
 //! [scheme]
@@ -98,8 +100,9 @@ pub enum Model {
         clean: Option<mesh::CleanOptions>,
         /// Optional flattening (`model.flatten`: the tolerance relative to the bounding-box
         /// diagonal), cubic-c1 and quintic-c2 only, see [`mod@crate::mesh::flatten`]: nearly
-        /// flat regions of a rounded file snapped onto their planes before the hull.
-        flatten: Option<f64>,
+        /// flat regions of a rounded file snapped onto their planes before the hull
+        /// (`model.flatten_min_faces`: only regions of that many faces).
+        flatten: Option<mesh::flatten::FlattenOptions>,
     },
     /// A patch complex JSON file (resolved).
     Patches(PathBuf),
@@ -145,6 +148,7 @@ struct ModelSection {
     clean: Option<f64>,
     clean_coplanar: Option<f64>,
     flatten: Option<f64>,
+    flatten_min_faces: Option<usize>,
 }
 
 /// `model.subdivide = { rule = "loop", levels = N }`.
@@ -495,6 +499,23 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     ));
                 }
             }
+            if let Some(n) = m.flatten_min_faces {
+                if m.flatten.is_none() {
+                    return Err(bad(
+                        "model.flatten_min_faces",
+                        "only applies with `model.flatten`".into(),
+                    ));
+                }
+                if n < mesh::flatten::MIN_FACES {
+                    return Err(bad(
+                        "model.flatten_min_faces",
+                        format!(
+                            "{n} is below {} (a region is at least two faces)",
+                            mesh::flatten::MIN_FACES
+                        ),
+                    ));
+                }
+            }
             Model::Mesh {
                 file: dir.join(f),
                 normals,
@@ -505,7 +526,10 @@ pub fn parse(text: &str, path: &Path) -> anyhow::Result<Scene> {
                     relative,
                     coplanar_angle: m.clean_coplanar.unwrap_or(0.0),
                 }),
-                flatten: m.flatten,
+                flatten: m.flatten.map(|relative| mesh::flatten::FlattenOptions {
+                    relative,
+                    min_faces: m.flatten_min_faces.unwrap_or(mesh::flatten::MIN_FACES),
+                }),
             }
         }
     };
@@ -893,7 +917,7 @@ pub fn polyhedron_1994(
 pub fn polyhedron_1994_with(
     file: &Path,
     clean: Option<mesh::CleanOptions>,
-    flatten: Option<f64>,
+    flatten: Option<mesh::flatten::FlattenOptions>,
 ) -> anyhow::Result<(
     mesh::Mesh,
     mesh::Report,
@@ -901,8 +925,8 @@ pub fn polyhedron_1994_with(
     Option<mesh::flatten::FlattenReport>,
 )> {
     let (mut m, report) = mesh::load(file)?;
-    let flattened = flatten.map(|t| {
-        let (f, changes) = mesh::flatten::flatten(&m, t);
+    let flattened = flatten.map(|options| {
+        let (f, changes) = mesh::flatten::flatten_with(&m, options);
         m = f;
         changes
     });
@@ -1177,8 +1201,26 @@ irradiance = 2.0
         assert!(matches!(s.model, Model::Mesh { clean: Some(c), .. } if c.coplanar_angle == 0.5));
         // `model.flatten`: the 1994 schemes only, in (0, 1e-3] of the diagonal.
         let s = parse(&with("flatten = 1e-4", "quintic-c2"), Path::new("s.toml")).unwrap();
-        assert!(matches!(s.model, Model::Mesh { flatten: Some(t), .. } if t == 1e-4));
+        assert!(matches!(s.model, Model::Mesh { flatten: Some(o), .. }
+            if o.relative == 1e-4 && o.min_faces == mesh::flatten::MIN_FACES));
+        // `model.flatten_min_faces`: with `model.flatten` only, at least 2.
+        let s = parse(
+            &with("flatten = 1e-4\nflatten_min_faces = 100", "cubic-c1"),
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        assert!(matches!(s.model, Model::Mesh { flatten: Some(o), .. } if o.min_faces == 100));
         for (model, scheme, key) in [
+            (
+                "flatten_min_faces = 100",
+                "cubic-c1",
+                "model.flatten_min_faces",
+            ),
+            (
+                "flatten = 1e-4\nflatten_min_faces = 1",
+                "quintic-c2",
+                "model.flatten_min_faces",
+            ),
             ("flatten = 1e-4", "rational-c1", "model.flatten"),
             ("flatten = 0", "cubic-c1", "model.flatten"),
             ("flatten = 0.01", "quintic-c2", "model.flatten"),

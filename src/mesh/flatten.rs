@@ -39,6 +39,23 @@ pub const MAX_RELATIVE: f64 = 1e-3;
 /// a small angle move it further.
 pub const MAX_MOVE: f64 = 2.0;
 
+/// Fewest faces of a region that is flattened unless the scene says otherwise
+/// (`model.flatten_min_faces`).
+pub const MIN_FACES: usize = 2;
+
+/// What [`flatten_with`] flattens: `model.flatten` and `model.flatten_min_faces`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlattenOptions {
+    /// Tolerance, relative to the bounding-box diagonal.
+    pub relative: f64,
+    /// Fewest faces of a region that is flattened (at least 2). Regions of a few faces also
+    /// form where a gently curved tessellation happens to be flat within the tolerance; made
+    /// polygons, they put the inner hull's corner guards among the curved part's centroids,
+    /// where the quintic's star systems become nearly singular (fandisk: `docs/quintic.md`,
+    /// session 39). A larger count keeps only the model's flat faces.
+    pub min_faces: usize,
+}
+
 /// Faces whose unit normals differ by more than this (cosine of 25°) never share a region:
 /// a tiny face can lie within the tolerance of any plane.
 const NORMAL_COS: f64 = 0.9;
@@ -224,6 +241,23 @@ fn nearest_on(p: DVec3, planes: &[(DVec3, DVec3)]) -> DVec3 {
 /// returns the mesh unchanged.
 #[must_use]
 pub fn flatten(mesh: &Mesh, relative: f64) -> (Mesh, FlattenReport) {
+    flatten_with(
+        mesh,
+        FlattenOptions {
+            relative,
+            min_faces: MIN_FACES,
+        },
+    )
+}
+
+/// [`flatten`] of the regions of at least `options.min_faces` faces.
+#[must_use]
+pub fn flatten_with(mesh: &Mesh, options: FlattenOptions) -> (Mesh, FlattenReport) {
+    let FlattenOptions {
+        relative,
+        min_faces,
+    } = options;
+    let min_faces = min_faces.max(MIN_FACES);
     let mut out = mesh.clone();
     let mut report = FlattenReport::default();
     let tol = relative * bbox_diagonal(&mesh.positions);
@@ -233,13 +267,13 @@ pub fn flatten(mesh: &Mesh, relative: f64) -> (Mesh, FlattenReport) {
     let pos = &mesh.positions;
     let mut regions: Vec<Vec<usize>> = grow(mesh, tol)
         .into_iter()
-        .filter(|r| r.len() >= 2)
+        .filter(|r| r.len() >= min_faces)
         .collect();
     let nv = pos.len();
     // Vertices leave their smaller regions until every vertex's planes are well apart.
     let (targets, planes) = loop {
         // Evictions can leave a region pinched or holed: it is then not flattened at all.
-        regions.retain(|r| r.len() >= 2 && is_disk(&mesh.faces, r));
+        regions.retain(|r| r.len() >= min_faces && is_disk(&mesh.faces, r));
         let mut of_vertex: Vec<Vec<usize>> = vec![Vec::new(); nv];
         for (id, r) in regions.iter().enumerate() {
             for &f in r {
@@ -400,6 +434,28 @@ mod tests {
                 assert!(n.dot(merged.positions[v as usize] - o).abs() < 1e-14);
             }
         }
+    }
+
+    /// `min_faces`: the box's sides have 72 triangles each, so at 72 all six are flattened as
+    /// by default and at 73 none is (the mesh comes back bit for bit).
+    #[test]
+    fn min_faces_keeps_only_large_regions() {
+        let m = rounded_box();
+        let at = |min_faces| {
+            flatten_with(
+                &m,
+                FlattenOptions {
+                    relative: 1e-4,
+                    min_faces,
+                },
+            )
+        };
+        let (all, report) = at(72);
+        assert_eq!((report.regions, report.faces), (6, 432));
+        assert_eq!(all, flatten(&m, 1e-4).0);
+        let (none, report) = at(73);
+        assert_eq!((report.regions, report.faces, report.moved), (0, 0, 0));
+        assert_eq!(none, m);
     }
 
     /// A real bump (a side's vertex raised 50× the tolerance) is no rounding: its faces stay

@@ -121,7 +121,10 @@ impl Frame {
 /// coplanarity) whose points of T lie far from a corner (a corner
 /// V farther than [`super::decompose::GUARD_REACH`] × its longer edge from the point its fan
 /// names for the polygon; at least [`MIN_CORNERS`] corners; the polygon one region of `net`,
-/// with one entry in every corner's fan) a zero coplanar guard net (module docs): guard pieces
+/// or pieces that are regions alone (a polygon whose guard assignment failed, which
+/// [`GuardNet::build`] serves by its convex pieces: flattened fandisk's large faces, whose far
+/// pieces' fan triangles overlapped everywhere); the polygon's pieces one run in every
+/// corner's fan, made one entry) a zero coplanar guard net (module docs): guard pieces
 /// (the polygon's own pieces reused first), fans naming them, step (5') cells on its edges.
 /// The interior triangles are added to the hull by [`FlatNets::add_triangles`].
 pub fn spread_guards(net: &mut GuardNet, mesh: &Mesh, merged: &[usize]) -> FlatNets {
@@ -215,21 +218,21 @@ pub fn spread_guards_forced(
             let mut sorted = face.clone();
             sorted.sort_unstable();
             sorted.dedup();
-            // One region holding exactly this polygon's pieces.
+            // One region holding exactly this polygon's pieces, or (a polygon whose guard
+            // assignment failed, [`GuardNet::build`]'s fallback) regions of its pieces alone.
             let r = net.region[own[0] as usize];
-            let region_ok = (0..np).all(|q| (net.region[q] == r) == (net.pieces.parent[q] == f));
+            let own_regions: BTreeSet<u32> = own.iter().map(|&q| net.region[q as usize]).collect();
+            let region_ok = (0..np)
+                .all(|q| own_regions.contains(&net.region[q]) == (net.pieces.parent[q] == f));
             if sorted.len() != face.len() || !region_ok || face.iter().any(|&v| net.inside(v)) {
                 continue;
             }
-            // Every corner's fan holds one of the pieces exactly once.
+            // Every corner's fan holds the pieces in one run, which becomes one entry.
             let fans: Option<Vec<(Fan, usize)>> = face
                 .iter()
                 .map(|&v| {
                     let fan = net.fan(v).filter(|x| x.closed)?;
-                    let at: Vec<usize> = (0..fan.faces.len())
-                        .filter(|&i| own.contains(&fan.faces[i]))
-                        .collect();
-                    (at.len() == 1).then(|| (fan, at[0]))
+                    one_run(&fan, |q| own.contains(&q))
                 })
                 .collect();
             let Some(fans) = fans else { continue };
@@ -344,6 +347,9 @@ pub fn spread_guards_forced(
                     guards.push(q);
                 }
             }
+            for &q in &own {
+                net.region[q as usize] = r;
+            }
             for (i, (&v, (fan, at))) in face.iter().zip(fans).enumerate() {
                 let mut fan = fan;
                 fan.faces[at] = guards[i];
@@ -394,6 +400,42 @@ pub fn spread_guards_forced(
         }
     }
     out
+}
+
+/// `fan` with its faces for which `own` holds, when they form one cyclic run, merged into
+/// one entry (the ring's vertices inside the run, ends of the diagonals between the pieces of
+/// one polygon, dropped), and that entry's index; `None` for no run or several.
+fn one_run(fan: &Fan, own: impl Fn(u32) -> bool) -> Option<(Fan, usize)> {
+    let k = fan.faces.len();
+    let is = |i: usize| own(fan.faces[i % k]);
+    let count = (0..k).filter(|&i| is(i)).count();
+    if count == 0 || count == k {
+        return None;
+    }
+    if count == 1 {
+        return Some((fan.clone(), (0..k).find(|&i| is(i))?));
+    }
+    // The run's first entry: own, after one that is not; a single run when all `count`
+    // entries from there are own.
+    let first = (0..k).find(|&i| is(i) && !is(i + k - 1))?;
+    if !(first..first + count).all(is) {
+        return None;
+    }
+    // Rotate so the run starts at 0: faces[i] lies between ring[i] and ring[i + 1].
+    let faces: Vec<u32> = (0..k).map(|i| fan.faces[(first + i) % k]).collect();
+    let ring: Vec<u32> = (0..k).map(|i| fan.ring[(first + i) % k]).collect();
+    let mut out_faces = vec![faces[0]];
+    out_faces.extend_from_slice(&faces[count..]);
+    let mut out_ring = vec![ring[0]];
+    out_ring.extend_from_slice(&ring[count..]);
+    Some((
+        Fan {
+            ring: out_ring,
+            faces: out_faces,
+            closed: true,
+        },
+        0,
+    ))
 }
 
 /// True when, at some corner V of `face`, the diagonal from the polygon's point of T named in
@@ -723,6 +765,45 @@ impl FlatNets {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A corner whose polygon is split into pieces 10, 11, 12 (faces between ring vertices,
+    /// the pieces' diagonals ending at ring vertices 3 and 4) gets one entry for the polygon
+    /// between the run's outer ring vertices; the other faces keep their neighbours. One piece
+    /// alone leaves the fan as it is; pieces in two runs, or none, give no fan.
+    #[test]
+    fn a_run_of_pieces_becomes_one_entry() {
+        // faces[i] lies between ring[i] and ring[i + 1] (cyclically).
+        let fan = Fan {
+            ring: vec![1, 2, 3, 4, 5, 6],
+            faces: vec![7, 10, 11, 12, 8, 9],
+            closed: true,
+        };
+        let (one, at) = one_run(&fan, |q| q >= 10).unwrap();
+        assert_eq!(one.faces[at], 10);
+        assert_eq!(one.faces, vec![10, 8, 9, 7]);
+        // 10 lies between 2 and 5, as pieces 10–12 did together.
+        assert_eq!(one.ring, vec![2, 5, 6, 1]);
+        assert!(one.closed);
+        // The run may wrap round the fan's start.
+        let wrapped = Fan {
+            ring: vec![1, 2, 3, 4, 5],
+            faces: vec![11, 7, 8, 9, 10],
+            closed: true,
+        };
+        let (one, at) = one_run(&wrapped, |q| q >= 10).unwrap();
+        assert_eq!(
+            (one.faces.clone(), one.ring.clone(), at),
+            (vec![10, 7, 8, 9], vec![5, 2, 3, 4], 0)
+        );
+        let (same, at) = one_run(&fan, |q| q == 11).unwrap();
+        assert_eq!(
+            (same.faces, same.ring, at),
+            (fan.faces.clone(), fan.ring.clone(), 2)
+        );
+        assert!(one_run(&fan, |q| q == 10 || q == 11 || q == 7).is_some());
+        assert!(one_run(&fan, |q| q == 10 || q == 12).is_none());
+        assert!(one_run(&fan, |q| q > 100).is_none());
+    }
 
     /// A strip 0.02 wide with straight corners whose edges are four times its width (fandisk's
     /// face 1313): a quarter of the shorter edge reaches across the strip, so the guards of two
