@@ -203,7 +203,8 @@ write("l_rounded.obj", "L block of three unit cubes (x 0.5), 4 x 4 triangles a u
 # 64-gon each, its coordinates rounded to 4 decimals (fandisk.obj's rounding). Every face stays
 # planar (each side's vertices share x and y per column, the caps z), but the caps' corners lie
 # only within 5e-5 of the circle: the quintic's small reproducer of fandisk's failure
-# (scenes/pending/paper1994/cylinder_rounded_quintic.toml; unrounded it passes).
+# (scenes/paper1994/cylinder_rounded_quintic.toml: unrounded it passes with the defaults, rounded
+# with `joint_stars` and `signs`).
 sides, rows = 64, 8
 cverts = [[round(0.5 * math.cos(2 * math.pi * i / sides), 4),
            round(0.5 * math.sin(2 * math.pi * i / sides), 4),
@@ -218,4 +219,4 @@ cfaces.append(list(reversed(range(sides))))
 cfaces.append([rows * sides + i for i in range(sides)])
 write("cylinder_rounded.obj", "cylinder r=0.5 h=1, 64 sides of 8 rows of triangle pairs, 64-gon caps, coordinates rounded to 4 decimals",
       cverts, cfaces,
-      "planar faces, caps' corners within 5e-5 of the circle (scenes/pending/paper1994/cylinder_rounded_quintic.toml)")
+      "planar faces, caps' corners within 5e-5 of the circle (scenes/paper1994/cylinder_rounded_quintic.toml)")
