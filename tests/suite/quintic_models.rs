@@ -1001,3 +1001,29 @@ fn rounded_cylinder_passes_with_joint_stars_and_pins() {
         "{torn_gap:?} {pinned_gap:?}"
     );
 }
+
+/// The scenes that solve every star with its edge middles and Hessian and pin Theorem 2.1's
+/// signs inside those groups (`joint_stars`, `signs`) meet the theorem weight by weight: no
+/// weight off the sign its tetrahedron asks (k = 1), so every patch is single-sheeted by the
+/// theorem; with the defaults the same hulls leave weights off (the stars' determined
+/// weights) and pass only by the check's sampling.
+#[test]
+fn joint_pinned_scenes_meet_theorem_2_1_weight_by_weight() {
+    for name in ["octahedron", "torus_quad", "torus_quad12x8"] {
+        let path = format!("scenes/paper1994/{name}_quintic.toml");
+        let sc = apatch::scene::load(Path::new(&path)).unwrap();
+        let hull = apatch::scene::inner_hull(&sc).unwrap().unwrap();
+        let apatch::scene::Model::Mesh { scheme, .. } = &sc.model else {
+            panic!("{path}: a mesh scene");
+        };
+        let o = QuinticOptions::from_toml(scheme, &sc.path).unwrap();
+        assert!(o.joint_stars && o.signs, "{path}");
+        let (c, stats) = build_with_stats(&hull, &o).unwrap();
+        assert_eq!(stats.signs.violated(), 0, "{path}: {:?}", stats.signs);
+        let r = check(&c, &CheckOptions::default());
+        assert_c2(&r);
+        assert!(r.passed(), "{path}: {:?}", r.failures());
+        let (_, plain) = build_with_stats(&hull, &QuinticOptions::default()).unwrap();
+        assert!(plain.signs.violated() > 0, "{path}: {:?}", plain.signs);
+    }
+}
