@@ -22,6 +22,7 @@ pub mod signfit;
 pub mod signs;
 pub mod slivers;
 pub mod sparse;
+pub mod supernodal;
 pub mod system;
 
 use crate::complex::{Patch, PatchComplex, SheetRule};

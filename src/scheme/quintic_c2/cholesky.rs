@@ -41,11 +41,13 @@ const REFINE: usize = 4;
 /// pattern, two f64 factors and, where f64 falls short, a double-double one: about 100 bytes
 /// with the work arrays, so 6e7 is ~6 GB, a quarter of the 24 GB machines we run on. The
 /// largest group of a model that passes is fandisk's edge middles (nnz(L) 3.3e6); the group
-/// that exceeded memory was fandisk's quintic with every point relaxed (2.27e8).
+/// that exceeded memory was fandisk's quintic with every point relaxed (2.27e8). The staged
+/// solve hands larger groups to the supernodal factor ([`super::supernodal`]).
 pub const MAX_FACTOR_ENTRIES: usize = 60_000_000;
 
-/// Most rows a group may have for a sparse direct solve to be tried at all: the minimum degree
-/// ordering grows faster than its rows (fandisk: 197322 rows 2 s, 1297197 rows 268 s).
+/// Most rows a group may have for this factor to be tried at all: the minimum degree
+/// ordering grows faster than its rows (fandisk: 197322 rows 2 s, 1297197 rows 268 s). The
+/// staged solve hands larger groups to the supernodal factor ([`super::supernodal`]).
 pub const MAX_FACTOR_ROWS: usize = 1_000_000;
 
 /// The Cholesky factor of a sparse symmetric matrix in elimination order, in f64 or, where
@@ -530,15 +532,68 @@ pub fn solve_near_ordered(
     let m = rows.len();
     debug_assert_eq!(ordering.order.len(), m);
     let unit = UnitRows::new(rows, c);
+    let (d, off) = normal_matrix::<f64>(&unit.rows, n);
+    let drops = [DEPENDENT_PIVOT, RETRY_PIVOT];
+    let made = refine_near(&unit, target, tol, &drops, |drop| {
+        Some(factor(&d, &off, drop, ordering))
+    });
+    let (mut residual, mut x, mut dropped) = made.expect("the in-house factor is always made");
+    if residual > tol {
+        // Still short: the f64 factor's pivots of nearly dependent rows are rounding. The
+        // normal equations in double-double tell dependent rows from independent ones.
+        let precise = Projector::precise(rows, n, c, ordering, PRECISE_PIVOT);
+        let mut y = target.to_vec();
+        let got = precise.meet(&mut y, tol);
+        if got < residual {
+            (residual, x, dropped) = (got, y, precise.dropped);
+        }
+    }
+    Solution {
+        x,
+        rank: m - dropped,
+        residual,
+    }
+}
+
+/// A factor of Â Âᵀ: what [`refine_near`] needs of it.
+pub(super) trait NormalSolve {
+    /// Solves Â Âᵀ y = r in place (dropped, dependent rows get y = 0 or nearly).
+    fn solve_normal(&self, r: &mut [f64]);
+
+    /// x += Âᵀ (Â Âᵀ)⁻¹ r (r is overwritten): the least-norm correction towards the rows.
+    fn correct(&self, arows: &[Vec<(u32, f64)>], r: &mut [f64], x: &mut [f64]) {
+        self.solve_normal(r);
+        add_transposed(arows, r, x);
+    }
+}
+
+impl NormalSolve for Factor {
+    fn solve_normal(&self, r: &mut [f64]) {
+        self.solve(r);
+    }
+}
+
+/// The x closest to `target` with Â x = ĉ (`unit`), from the factors `make` gives for the drop
+/// thresholds `drops` in turn (the next only if the last factor's first correction did not
+/// help; with how many rows each dropped): iterative refinement with each, then
+/// conjugate gradients preconditioned by each, until max |A x − c| ≤ `tol`. Returns the best
+/// (residual, x, rows dropped), or `None` when `make` made no factor.
+pub(super) fn refine_near<F: NormalSolve>(
+    unit: &UnitRows,
+    target: &[f64],
+    tol: f64,
+    drops: &[f64],
+    mut make: impl FnMut(f64) -> Option<(F, usize)>,
+) -> Option<(f64, Vec<f64>, usize)> {
     let arows = &unit.rows;
-    let (d, off) = normal_matrix::<f64>(arows, n);
+    let m = arows.len();
     let residual_of = |x: &[f64], r: &mut [f64]| unit.residual(x, r);
     let mut r = vec![0.0; m];
     let res0 = residual_of(target, &mut r);
     let mut best = (res0, target.to_vec(), 0);
-    let mut factors = Vec::new();
-    for drop in [DEPENDENT_PIVOT, RETRY_PIVOT] {
-        factors.push(factor(&d, &off, drop, ordering));
+    let mut factors: Vec<(F, usize)> = Vec::new();
+    for &drop in drops {
+        factors.push(make(drop)?);
         let &(ref f, dropped) = factors.last().expect("just pushed");
         let mut x = target.to_vec();
         let mut res = residual_of(&x, &mut r);
@@ -547,8 +602,7 @@ pub fn solve_near_ordered(
             if res <= tol {
                 break;
             }
-            f.solve(&mut r);
-            add_transposed(arows, &r, &mut x);
+            f.correct(arows, &mut r, &mut x);
             let before = res;
             res = residual_of(&x, &mut r);
             if step == 0 {
@@ -576,7 +630,7 @@ pub fn solve_near_ordered(
         for (f, dropped) in &factors {
             let mut x = best.1.clone();
             let (got, _) =
-                conjugate_gradients(&unit, &unit.c, &|z| f.solve(z), &mut x, tol, CG_STALL);
+                conjugate_gradients(unit, &unit.c, &|z| f.solve_normal(z), &mut x, tol, CG_STALL);
             if got < best.0 {
                 best = (got, x, *dropped);
             }
@@ -585,22 +639,7 @@ pub fn solve_near_ordered(
             }
         }
     }
-    if best.0 > tol {
-        // Still short: the f64 factor's pivots of nearly dependent rows are rounding. The
-        // normal equations in double-double tell dependent rows from independent ones.
-        let precise = Projector::precise(rows, n, c, ordering, PRECISE_PIVOT);
-        let mut x = target.to_vec();
-        let got = precise.meet(&mut x, tol);
-        if got < best.0 {
-            best = (got, x, precise.dropped);
-        }
-    }
-    let (residual, x, dropped) = best;
-    Solution {
-        x,
-        rank: m - dropped,
-        residual,
-    }
+    Some(best)
 }
 
 /// One group's equations A x = c factored once (Â Âᵀ, dependent rows dropped at
@@ -847,7 +886,7 @@ pub const PRECISE_PIVOT: f64 = 1e-15;
 
 /// x += Âᵀ y with y and the sum in double-double, x rounded once at the end
 /// ([`EitherFactor::correct`] says why).
-fn add_transposed_precise(arows: &[Vec<(u32, f64)>], y: &[Dd], x: &mut [f64]) {
+pub(super) fn add_transposed_precise(arows: &[Vec<(u32, f64)>], y: &[Dd], x: &mut [f64]) {
     let mut acc: Vec<Dd> = x.iter().map(|&v| Dd::of(v)).collect();
     for (row, &yi) in arows.iter().zip(y) {
         if yi.f64() != 0.0 {
@@ -876,7 +915,10 @@ fn add_transposed(arows: &[Vec<(u32, f64)>], y: &[f64], x: &mut [f64]) {
 /// Â Âᵀ of the unit rows `arows` over `n` unknowns: its diagonal and its strictly upper
 /// entries (row, column, value), the input of [`factor`], summed in `T` (exact products in
 /// double-double).
-fn normal_matrix<T: Real>(arows: &[Vec<(u32, f64)>], n: usize) -> (Vec<T>, Vec<(u32, u32, T)>) {
+pub(super) fn normal_matrix<T: Real>(
+    arows: &[Vec<(u32, f64)>],
+    n: usize,
+) -> (Vec<T>, Vec<(u32, u32, T)>) {
     let m = arows.len();
     // Rows of each column.
     let mut by_col: Vec<Vec<(u32, f64)>> = vec![Vec::new(); n];
@@ -1024,7 +1066,11 @@ pub(super) mod tests {
 
     /// Random sparse system with dependent rows, seeded: the dense rows, the sparse rows and
     /// the right-hand side of a consistent system.
-    fn system(m: usize, n: usize, seed: u64) -> (Vec<f64>, Vec<Row>, Vec<f64>, Vec<f64>) {
+    pub(in crate::scheme::quintic_c2) fn system(
+        m: usize,
+        n: usize,
+        seed: u64,
+    ) -> (Vec<f64>, Vec<Row>, Vec<f64>, Vec<f64>) {
         let mut s = seed;
         let mut a = vec![0.0; m * n];
         for i in 0..m - 2 {

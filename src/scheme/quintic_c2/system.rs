@@ -31,7 +31,7 @@
 
 use super::jets::Jet;
 use super::signs::{self, SignStats};
-use super::{cholesky, dense, sparse};
+use super::{cholesky, dense, sparse, supernodal};
 use crate::bb::{multi_indices, Tet};
 use crate::complex::Role;
 use crate::error::{Error, Result};
@@ -1297,9 +1297,8 @@ impl System {
                     }
                     let message = if sol.residual == f64::INFINITY {
                         format!(
-                            "quintic-c2: the C1/C2 system of {what} is too large to solve at once ({m} equations, {n} unknowns; a direct factor is tried up to {} rows and {} entries)",
-                            cholesky::MAX_FACTOR_ROWS,
-                            cholesky::MAX_FACTOR_ENTRIES
+                            "quintic-c2: the C1/C2 system of {what} is too large to solve at once ({m} equations, {n} unknowns; the supernodal factor is tried up to {} values)",
+                            supernodal::MAX_VALUES
                         )
                     } else {
                         format!(
@@ -1680,7 +1679,11 @@ fn solve_rows(
             // Opt-in dump of the large groups for offline solver experiments.
             dump_group(std::path::Path::new(&dir), rows, n, c, tgt, scale);
         }
-        let limits = (cholesky::MAX_FACTOR_ROWS, cholesky::MAX_FACTOR_ENTRIES);
+        let limits = (
+            cholesky::MAX_FACTOR_ROWS,
+            cholesky::MAX_FACTOR_ENTRIES,
+            supernodal::MAX_VALUES,
+        );
         let sol = solve_sparse(rows, n, c, tgt, 1e-13 * scale, limits);
         if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
             // Opt-in timing of the large groups on stderr (exploration; results unaffected).
@@ -1695,21 +1698,23 @@ fn solve_rows(
     }
 }
 
-/// [`cholesky::solve_near`] within `(max rows, max factor entries)`; a group beyond either is
-/// left unsolved (its targets, infinite residual), which the caller reports as too large: a
-/// factor that does not fit in memory would end the process instead of the scene.
+/// [`cholesky::solve_near`] within `(max rows, max factor entries, _)`; a group beyond either
+/// is solved by the supernodal factor ([`supernodal::solve_near`]) within `(_, _, max supernodal values)`, and left unsolved (its targets,
+/// infinite residual) beyond that too, which the caller reports as too large: a factor that
+/// does not fit in memory would end the process instead of the scene.
 fn solve_sparse(
     rows: &[sparse::Row],
     n: usize,
     c: &[f64],
     tgt: &[f64],
     tol: f64,
-    limits: (usize, usize),
+    (max_rows, max_entries, max_values): (usize, usize, usize),
 ) -> dense::Solution {
-    match cholesky::Ordering::within(rows, n, limits) {
-        Some(ordering) => cholesky::solve_near_ordered(rows, n, c, tgt, tol, &ordering),
-        None => dense::Solution::unsolved(tgt),
+    if let Some(o) = cholesky::Ordering::within(rows, n, (max_rows, max_entries)) {
+        return cholesky::solve_near_ordered(rows, n, c, tgt, tol, &o);
     }
+    supernodal::solve_near(rows, n, c, tgt, tol, max_values)
+        .unwrap_or_else(|| dense::Solution::unsolved(tgt))
 }
 
 /// Writes one group (`rows`, `c`, `tgt`, `scale`) as little-endian binary to a new numbered
@@ -1892,23 +1897,33 @@ mod tests {
     }
 
     #[test]
-    fn groups_beyond_the_factor_limits_are_left_unsolved() {
+    fn groups_beyond_the_factor_limits_go_to_the_supernodal_factor_or_are_left_unsolved() {
         // A chain x_i - x_{i+1} = 1: one sparse group whose factor has 2n - 1 entries.
         let n = 50;
         let rows: Vec<sparse::Row> = (0..n - 1).map(|i| vec![(i, 1.0), (i + 1, -1.0)]).collect();
         let c = vec![1.0; n - 1];
         let tgt = vec![0.0; n];
-        let solved = solve_sparse(&rows, n, &c, &tgt, 1e-13, (1000, 1000));
+        let big = usize::MAX;
+        let solved = solve_sparse(&rows, n, &c, &tgt, 1e-13, (1000, 1000, big));
         // Solved: the chain's rows hold to rounding (unit coefficients, values up to 25).
         assert!(solved.residual < 1e-12, "{}", solved.residual);
         assert!(consistent(&solved, 1.0));
         let entries = cholesky::Ordering::of(&rows, n).entries();
         for limits in [(n - 2, 1000), (1000, entries - 1)] {
-            let left = solve_sparse(&rows, n, &c, &tgt, 1e-13, limits);
+            // Beyond the in-house factor: the supernodal one meets the same rows.
+            let (r, e) = limits;
+            let other = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, big));
+            assert!(other.residual < 1e-12, "{limits:?}: {}", other.residual);
+            for (a, b) in other.x.iter().zip(&solved.x) {
+                // The same closest solution; values up to 25, rounding of 49 unit steps.
+                assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+            }
+            // Beyond both: left unsolved.
+            let left = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, 10));
             assert_eq!(left.residual, f64::INFINITY, "{limits:?}");
             assert!(!consistent(&left, 1.0));
         }
-        let fits = solve_sparse(&rows, n, &c, &tgt, 1e-13, (n - 1, entries));
+        let fits = solve_sparse(&rows, n, &c, &tgt, 1e-13, (n - 1, entries, 10));
         assert!(fits.residual < 1e-12);
     }
 

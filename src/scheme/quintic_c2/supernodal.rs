@@ -1,0 +1,402 @@
+//! Minimum-change solves of the groups beyond the in-house factor ([`super::cholesky`]'s
+//! `MAX_FACTOR_ROWS`, `MAX_FACTOR_ENTRIES`): the same normal equations Â Âᵀ y = ĉ − Â·target,
+//! factored by faer's supernodal LDLᵀ in an approximate minimum degree order.
+//!
+//! Why: joint stars (every star with its edge middles and Hessian, `joint_stars`) make one
+//! group of the whole curved part of a model; on fandisk 1.57M equations, on a twisted 96 × 12
+//! torus 0.67M with nnz(L) 2.5e8. The in-house left-looking factor works one column at a time
+//! (memory-bound, and its double-double twin doubles the memory); a supernodal factor does the
+//! same elimination in dense blocks.
+//!
+//! Dependent rows are dropped as [`super::cholesky`] drops them: a pivot below the drop
+//! threshold (the rows have unit norm, so Â Âᵀ has a unit diagonal and the threshold is
+//! absolute) is replaced by [`DROPPED_PIVOT`], which makes that row's multipliers and its y
+//! vanish (faer's dynamic regularization). As there, f64 comes first (drop thresholds
+//! [`cholesky::DEPENDENT_PIVOT`], then [`cholesky::RETRY_PIVOT`]), and where its pivots of
+//! nearly dependent rows are rounding and the rows are missed, the factor runs again in
+//! double-double (faer's `fx128`, rows dropped at [`cholesky::PRECISE_PIVOT`]): the rounded
+//! cylinder's joint group needs it (the f64 factors miss its rows by 5.9e-9, the double-double
+//! one meets them to 3e-14, as the in-house double-double factor does).
+//!
+//! Determinism: the factor and its solves run on one thread (`Par::Seq`), so the bits do not
+//! depend on the thread count; the dense kernels inside each supernode are what make it fast.
+
+use super::cholesky::{self, UnitRows};
+use super::dd::{Dd, Real};
+use super::dense::Solution;
+use super::sparse::Row;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
+    SymbolicCholeskyRaw, SymmetricOrdering,
+};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{fx128, Conj, MatMut, Par, Side};
+
+/// The pivot a dropped (dependent) row gets: its y is its right-hand side over this, and its
+/// column of L the entries over this, both far below the resolution of the others.
+pub const DROPPED_PIVOT: f64 = 1e150;
+
+/// Most values a supernodal factor may hold by default ([`solve_near`]'s `max_values`), with
+/// the zeros its dense blocks carry: in double-double (16 bytes each) 11.2 GB, under half of
+/// the 24 GB machines we run on (fandisk's joint group: 5.0e8 values).
+pub const MAX_VALUES: usize = 700_000_000;
+
+/// The factor's arithmetic: f64, or double-double (faer's `fx128`, a pair hi + lo) for the
+/// groups whose f64 factor cannot tell nearly dependent rows from dependent ones (as
+/// [`cholesky::Projector::precise`] does for the in-house factor).
+pub trait Elem: faer::traits::ComplexField<Real = Self> + Copy {
+    /// The value of a double-double sum of Â Âᵀ.
+    fn of_dd(d: Dd) -> Self;
+    /// The value of an f64.
+    fn of_f64(x: f64) -> Self;
+    /// As our double-double.
+    fn dd(self) -> Dd;
+}
+
+impl Elem for f64 {
+    fn of_dd(d: Dd) -> f64 {
+        d.hi + d.lo
+    }
+    fn of_f64(x: f64) -> f64 {
+        x
+    }
+    fn dd(self) -> Dd {
+        Dd::of(self)
+    }
+}
+
+impl Elem for fx128 {
+    fn of_dd(d: Dd) -> fx128 {
+        fx128 { 0: d.hi, 1: d.lo }
+    }
+    fn of_f64(x: f64) -> fx128 {
+        fx128 { 0: x, 1: 0.0 }
+    }
+    fn dd(self) -> Dd {
+        Dd {
+            hi: self.0,
+            lo: self.1,
+        }
+    }
+}
+
+/// Â Âᵀ of a group, factored in `T`.
+pub struct Supernodal<T: Elem> {
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<T>,
+    /// Rows dropped as dependent.
+    pub dropped: usize,
+}
+
+impl<T: Elem> Supernodal<T> {
+    /// Solves Â Âᵀ y = r in `T` (dropped rows get y ≈ 0).
+    pub fn solve_wide(&self, r: &[f64]) -> Vec<T> {
+        let n = r.len();
+        let par = Par::Seq;
+        let mut y: Vec<T> = r.iter().map(|&v| T::of_f64(v)).collect();
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<T>(1, par));
+        let stack = MemStack::new(&mut mem);
+        let rhs = MatMut::from_column_major_slice_mut(&mut y, n, 1);
+        LdltRef::<usize, T>::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            par,
+            stack,
+        );
+        y
+    }
+}
+
+/// The lower triangle of Â Âᵀ in compressed columns (each column's diagonal first, then its
+/// rows in increasing order), from [`cholesky::normal_matrix`]'s diagonal and upper entries.
+fn lower_columns<T: Elem>(d: &[Dd], off: &[(u32, u32, Dd)]) -> (Vec<usize>, Vec<usize>, Vec<T>) {
+    let m = d.len();
+    let mut ptr = vec![0usize; m + 1];
+    for &(i, _, _) in off {
+        ptr[i as usize + 1] += 1;
+    }
+    for i in 0..m {
+        ptr[i + 1] += ptr[i] + 1;
+    }
+    let mut idx = Vec::with_capacity(m + off.len());
+    let mut val = Vec::with_capacity(m + off.len());
+    // `off` holds each row i's entries (i, k > i) together, k increasing, rows in order.
+    let mut e = 0;
+    for (i, &di) in d.iter().enumerate() {
+        idx.push(i);
+        val.push(T::of_dd(di));
+        while e < off.len() && off[e].0 as usize == i {
+            idx.push(off[e].1 as usize);
+            val.push(T::of_dd(off[e].2));
+            e += 1;
+        }
+        debug_assert_eq!(idx.len(), ptr[i + 1]);
+    }
+    (ptr, idx, val)
+}
+
+/// Factors Â Âᵀ of the unit rows (`n` unknowns, sums in double-double) in `T`, in faer's
+/// approximate minimum degree order, dropping rows whose
+/// pivot falls below `threshold`; `None` when the factor would hold more than `max_values`
+/// values or faer refuses it.
+#[must_use]
+pub fn factor<T: Elem>(
+    arows: &[Vec<(u32, f64)>],
+    n: usize,
+    threshold: f64,
+    max_values: usize,
+) -> Option<Supernodal<T>> {
+    let m = arows.len();
+    let (d, off) = cholesky::normal_matrix::<Dd>(arows, n);
+    let (ptr, idx, val) = lower_columns::<T>(&d, &off);
+    std::mem::drop(off);
+    let sym = SymbolicSparseColMatRef::new_checked(m, m, &ptr, None, &idx);
+    let t = std::time::Instant::now();
+    let symbolic = factorize_symbolic_cholesky(
+        sym,
+        Side::Lower,
+        // Not the in-house minimum degree order: on the twisted 96 × 12 torus's joint group
+        // faer's AMD gives 2.4e8 values against 2.9e8, and the f64 factor in 7.5 s against 18.
+        SymmetricOrdering::Amd,
+        CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        },
+    )
+    .ok()?;
+    let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
+    if trace {
+        // Opt-in timing on stderr (exploration; results unaffected).
+        eprintln!(
+            "quintic-c2 supernodal: {m} rows, symbolic {:.2} s, {} values",
+            t.elapsed().as_secs_f64(),
+            symbolic.len_val()
+        );
+    }
+    if symbolic.len_val() > max_values {
+        return None;
+    }
+    let t = std::time::Instant::now();
+    let mut values = vec![T::of_f64(0.0); symbolic.len_val()];
+    let signs = vec![1i8; m];
+    let par = Par::Seq;
+    let a = SparseColMatRef::new(sym, &val);
+    let mut mem =
+        MemBuffer::new(symbolic.factorize_numeric_ldlt_scratch::<T>(par, Default::default()));
+    let info = symbolic.factorize_numeric_ldlt(
+        &mut values,
+        a,
+        Side::Lower,
+        LdltRegularization {
+            dynamic_regularization_signs: Some(&signs),
+            dynamic_regularization_delta: T::of_f64(DROPPED_PIVOT),
+            dynamic_regularization_epsilon: T::of_f64(threshold),
+        },
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    );
+    if info.is_err() {
+        return None;
+    }
+    // The dropped rows: pivots set to DROPPED_PIVOT, on the diagonals of the supernodes' blocks.
+    let SymbolicCholeskyRaw::Supernodal(raw) = symbolic.raw() else {
+        return None;
+    };
+    let blocks = SupernodalLdltRef::<usize, T>::new(raw, &values);
+    let dropped = (0..raw.n_supernodes())
+        .map(|s| {
+            let v = blocks.supernode(s).val();
+            (0..v.ncols())
+                .filter(|&k| v[(k, k)].dd().hi == DROPPED_PIVOT)
+                .count()
+        })
+        .sum();
+    if trace {
+        eprintln!(
+            "quintic-c2 supernodal: numeric {:.2} s, {dropped} dropped",
+            t.elapsed().as_secs_f64()
+        );
+    }
+    Some(Supernodal {
+        symbolic,
+        values,
+        dropped,
+    })
+}
+
+impl cholesky::NormalSolve for Supernodal<f64> {
+    fn solve_normal(&self, r: &mut [f64]) {
+        r.copy_from_slice(&self.solve_wide(r));
+    }
+}
+
+impl cholesky::NormalSolve for Supernodal<fx128> {
+    fn solve_normal(&self, r: &mut [f64]) {
+        let y = self.solve_wide(r);
+        for (v, y) in r.iter_mut().zip(y) {
+            *v = y.0 + y.1;
+        }
+    }
+
+    /// y in double-double and Âᵀ y summed in double-double, as the in-house precise factor
+    /// does ([`cholesky::add_transposed_precise`] says why).
+    fn correct(&self, arows: &[Vec<(u32, f64)>], r: &mut [f64], x: &mut [f64]) {
+        let y: Vec<Dd> = self.solve_wide(r).into_iter().map(Elem::dd).collect();
+        cholesky::add_transposed_precise(arows, &y, x);
+    }
+}
+
+/// [`cholesky::solve_near`] for a group beyond the in-house factor: the x closest to `target`
+/// with A x = c, refined until max |A x − c| ≤ `tol` (the same refinement and conjugate
+/// gradients): with an f64 factor first, then, if that falls short, a double-double one
+/// dropping rows at [`cholesky::PRECISE_PIVOT`]. `None` when this factor would hold more than
+/// `max_values` values
+/// ([`MAX_VALUES`] in the solves).
+#[must_use]
+pub fn solve_near(
+    rows: &[Row],
+    n: usize,
+    c: &[f64],
+    target: &[f64],
+    tol: f64,
+    max_values: usize,
+) -> Option<Solution> {
+    let unit = UnitRows::new(rows, c);
+    let drops = [cholesky::DEPENDENT_PIVOT, cholesky::RETRY_PIVOT];
+    let mut best = cholesky::refine_near(&unit, target, tol, &drops, |drop| {
+        factor::<f64>(&unit.rows, n, drop, max_values).map(|f| {
+            let dropped = f.dropped;
+            (f, dropped)
+        })
+    })?;
+    if best.0 > tol {
+        let precise =
+            cholesky::refine_near(&unit, target, tol, &[cholesky::PRECISE_PIVOT], |drop| {
+                factor::<fx128>(&unit.rows, n, drop, max_values).map(|f| {
+                    let dropped = f.dropped;
+                    (f, dropped)
+                })
+            });
+        if let Some(p) = precise.filter(|p| p.0 < best.0) {
+            best = p;
+        }
+    }
+    let (residual, x, dropped) = best;
+    Some(Solution {
+        x,
+        rank: rows.len() - dropped,
+        residual,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scheme::quintic_c2::cholesky::tests::system;
+
+    /// Agrees with the dense pivoted QR (an independent factorisation) on random
+    /// underdetermined systems with two dependent rows: the same rank (the two rows dropped,
+    /// not regularised into the solution) and the same closest solution.
+    #[test]
+    fn matches_dense_on_rank_deficient_systems() {
+        for (m, n, seed) in [
+            (30, 50, 12345),
+            (120, 200, 7),
+            (200, 260, 99),
+            (400, 420, 3),
+        ] {
+            let (a, rows, c, target) = system(m, n, seed);
+            let d = crate::scheme::quintic_c2::dense::solve_near(&a, m, n, &c, &target, 1e-11);
+            let s = solve_near(&rows, n, &c, &target, 1e-13, MAX_VALUES)
+                .expect("small enough to factor");
+            assert_eq!(s.rank, d.rank, "rank ({m}×{n})");
+            // Consistent system: rounding-level residual, as asked.
+            assert!(s.residual <= 1e-13, "{}", s.residual);
+            for (x, y) in s.x.iter().zip(&d.x) {
+                // Both are the unique closest solution; entries O(1), modest conditioning.
+                assert!((x - y).abs() < 1e-9, "{x} vs {y}");
+            }
+        }
+    }
+
+    /// The in-house factor and this one give the same closest solution on a group both can
+    /// factor, with more equations than unknowns (consistent, so dependent rows are many).
+    #[test]
+    fn agrees_with_the_in_house_factor_on_overdetermined_groups() {
+        let (m, n) = (300, 240);
+        let (_, rows, c, target) = system(m, n, 2024);
+        // Overdetermined and random: only consistent if the right-hand side is made so.
+        let s =
+            solve_near(&rows, n, &c, &target, 1e-13, MAX_VALUES).expect("small enough to factor");
+        let h = cholesky::solve_near(&rows, n, &c, &target, 1e-13);
+        // 60 dependent rows: in another elimination order a dependent row's pivot, rounding
+        // of order 1e-14, can land on either side of the 1e-13 threshold (seen: one row kept
+        // here, met to 5e-15 all the same); the solutions must agree regardless.
+        assert!(s.rank.abs_diff(h.rank) <= 2, "{} vs {}", s.rank, h.rank);
+        assert!(
+            s.residual <= 1e-13 && h.residual <= 1e-13,
+            "{} {}",
+            s.residual,
+            h.residual
+        );
+        for (x, y) in s.x.iter().zip(&h.x) {
+            // The same unique solution from two factorisations: agreement to rounding of O(1)
+            // entries times a modest condition number.
+            assert!((x - y).abs() < 1e-9, "{x} vs {y}");
+        }
+    }
+
+    /// Two rows t apart in angle, a = (1, 0) and b = (cos t, sin t): b lies sin² t from a's
+    /// span, the pivot of b after a.
+    fn pair(t: f64) -> Vec<Vec<(u32, f64)>> {
+        vec![vec![(0, 1.0)], vec![(0, t.cos()), (1, t.sin())]]
+    }
+
+    /// The double-double factor resolves pivots far below f64's rounding: at t = 1e-9 the
+    /// pivot is 1e-18 (f64 forms 1 − cos² t at its rounding, 1e-16), kept at a threshold of
+    /// 1e-19 and dropped at 1e-17.
+    #[test]
+    fn double_double_pivots_resolve_distances_below_f64_rounding() {
+        let rows = pair(1e-9);
+        let keep = factor::<fx128>(&rows, 2, 1e-19, MAX_VALUES).expect("tiny");
+        assert_eq!(keep.dropped, 0);
+        let drop = factor::<fx128>(&rows, 2, 1e-17, MAX_VALUES).expect("tiny");
+        assert_eq!(drop.dropped, 1);
+        // The kept pivot is the true one: solving Â Âᵀ y = e_b gives y_b = 1 / sin² t.
+        let y = keep.solve_wide(&[0.0, 1.0]);
+        let want = 1.0 / (1e-9_f64.sin() * 1e-9_f64.sin());
+        // Double-double carries ~32 digits against a pivot of 1e-18 (relative error ~1e-14).
+        assert!(
+            (y[1].0 - want).abs() <= 1e-9 * want,
+            "{:e} vs {want:e}",
+            y[1].0
+        );
+    }
+
+    /// A row pair 1e-7 apart (pivot 1e-14: below f64's drop threshold, above the double-double
+    /// one) with consistent data is met, at the unique solution.
+    #[test]
+    fn nearly_dependent_rows_are_met_in_double_double() {
+        let t = 1e-7_f64;
+        let rows: Vec<Row> = pair(t)
+            .into_iter()
+            .map(|r| r.into_iter().map(|(j, a)| (j as usize, a)).collect())
+            .collect();
+        let c = [1.0, t.cos() + 0.25 * t.sin()];
+        let s = solve_near(&rows, 2, &c, &[0.0, 0.0], 1e-13, MAX_VALUES).expect("tiny");
+        assert!(s.residual <= 1e-13, "{:e}", s.residual);
+        assert_eq!(s.rank, 2);
+        // x = (1, 0.25); the pair conditions the solve to ~1e7, so rounding of 1e-16 in the
+        // data grows to ~1e-9 in x.
+        assert!(
+            (s.x[0] - 1.0).abs() < 1e-8 && (s.x[1] - 0.25).abs() < 1e-8,
+            "{:?}",
+            s.x
+        );
+    }
+}
