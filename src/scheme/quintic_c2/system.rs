@@ -1242,6 +1242,16 @@ impl System {
                     } else {
                         where_()
                     };
+                    if n > DENSE_LIMIT
+                        && sol.residual.is_finite()
+                        && std::env::var_os("APATCH_SOLVE_TRACE").is_some()
+                    {
+                        // Opt-in list of a large group's unmet rows on stderr (exploration;
+                        // results unaffected): each row missed by more than 1e-9 of the reach,
+                        // its miss over the reach and the points of T it names (not for a
+                        // group left unsolved, whose every row is missed).
+                        trace_unmet(g, &sol.x, st, np, &self.keys, jets);
+                    }
                     let shown = brief(&pts);
                     let what = match st {
                         1 if global => format!("every weight at hull points {shown}"),
@@ -1623,6 +1633,31 @@ fn unmet_points(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128]) -> Vec<u32
         cols = (0..g.unk.len()).collect();
     }
     group_points(cols.into_iter().map(|j| g.unk[j]), st, np, keys)
+}
+
+/// Prints every row of `g` that `x` misses by more than 1e-9 of the group's reach: the miss
+/// over the reach, the row's length and the points of T it names with their positions
+/// (`APATCH_SOLVE_TRACE`, exploration).
+fn trace_unmet(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128], jets: &[Jet]) {
+    for (i, (row, &c)) in g.rows.iter().zip(&g.c).take(g.m).enumerate() {
+        let r: f64 = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
+        if r.is_nan() || r.abs() > 1e-9 * g.reach {
+            let pts = group_points(row.iter().map(|t| g.unk[t.0]), st, np, keys);
+            let at: Vec<String> = pts
+                .iter()
+                .map(|&p| {
+                    let q = jets.get(p as usize).map_or(DVec3::NAN, |j| j.p);
+                    format!("{p} ({:.4}, {:.4}, {:.4})", q.x, q.y, q.z)
+                })
+                .collect();
+            eprintln!(
+                "quintic-c2 unmet row {i}: miss {:.2e} of the reach, {} terms, points {}",
+                r.abs() / g.reach,
+                row.len(),
+                at.join(" ")
+            );
+        }
+    }
 }
 
 /// The points of T that the slots `slots` of a group at pass stage `st` name, sorted: the
