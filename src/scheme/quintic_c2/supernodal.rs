@@ -90,27 +90,26 @@ impl Elem for fx128 {
     }
 }
 
-/// Â Âᵀ of a group, factored in `T`.
-pub struct Supernodal<T: Elem> {
-    symbolic: SymbolicCholesky<usize>,
+/// Â Âᵀ of a group, factored in `T` (on its [`Normal`]'s symbolic factorisation).
+pub struct Supernodal<'a, T: Elem> {
+    symbolic: &'a SymbolicCholesky<usize>,
     values: Vec<T>,
     /// Rows dropped as dependent.
     pub dropped: usize,
 }
 
-impl<T: Elem> Supernodal<T> {
+impl<T: Elem> Supernodal<'_, T> {
     /// Solves Â Âᵀ y = r in `T` (dropped rows get y ≈ 0).
     pub fn solve_wide(&self, r: &[f64]) -> Vec<T> {
         let n = r.len();
-        let par = PAR;
         let mut y: Vec<T> = r.iter().map(|&v| T::of_f64(v)).collect();
-        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<T>(1, par));
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<T>(1, PAR));
         let stack = MemStack::new(&mut mem);
         let rhs = MatMut::from_column_major_slice_mut(&mut y, n, 1);
-        LdltRef::<usize, T>::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+        LdltRef::<usize, T>::new(self.symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             rhs,
-            par,
+            PAR,
             stack,
         );
         y
@@ -119,7 +118,7 @@ impl<T: Elem> Supernodal<T> {
 
 /// The lower triangle of Â Âᵀ in compressed columns (each column's diagonal first, then its
 /// rows in increasing order), from [`cholesky::normal_matrix`]'s diagonal and upper entries.
-fn lower_columns<T: Elem>(d: &[Dd], off: &[(u32, u32, Dd)]) -> (Vec<usize>, Vec<usize>, Vec<T>) {
+fn lower_columns(d: &[Dd], off: &[(u32, u32, Dd)]) -> (Vec<usize>, Vec<usize>, Vec<Dd>) {
     let m = d.len();
     let mut ptr = vec![0usize; m + 1];
     for &(i, _, _) in off {
@@ -134,10 +133,10 @@ fn lower_columns<T: Elem>(d: &[Dd], off: &[(u32, u32, Dd)]) -> (Vec<usize>, Vec<
     let mut e = 0;
     for (i, &di) in d.iter().enumerate() {
         idx.push(i);
-        val.push(T::of_dd(di));
+        val.push(di);
         while e < off.len() && off[e].0 as usize == i {
             idx.push(off[e].1 as usize);
-            val.push(T::of_dd(off[e].2));
+            val.push(off[e].2);
             e += 1;
         }
         debug_assert_eq!(idx.len(), ptr[i + 1]);
@@ -145,103 +144,124 @@ fn lower_columns<T: Elem>(d: &[Dd], off: &[(u32, u32, Dd)]) -> (Vec<usize>, Vec<
     (ptr, idx, val)
 }
 
-/// Factors Â Âᵀ of the unit rows (`n` unknowns, sums in double-double) in `T`, in faer's
-/// approximate minimum degree order, dropping rows whose
-/// pivot falls below `threshold`; `None` when the factor would hold more than `max_values`
-/// values or faer refuses it.
-#[must_use]
-pub fn factor<T: Elem>(
-    arows: &[Vec<(u32, f64)>],
-    n: usize,
-    threshold: f64,
-    max_values: usize,
-) -> Option<Supernodal<T>> {
-    let m = arows.len();
-    let (d, off) = cholesky::normal_matrix::<Dd>(arows, n);
-    let (ptr, idx, val) = lower_columns::<T>(&d, &off);
-    std::mem::drop(off);
-    let sym = SymbolicSparseColMatRef::new_checked(m, m, &ptr, None, &idx);
-    let t = std::time::Instant::now();
-    let symbolic = factorize_symbolic_cholesky(
-        sym,
-        Side::Lower,
-        // Not the in-house minimum degree order: on the twisted 96 × 12 torus's joint group
-        // faer's AMD gives 2.4e8 values against 2.9e8, and the f64 factor in 7.5 s against 18.
-        SymmetricOrdering::Amd,
-        CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        },
-    )
-    .ok()?;
-    let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
-    if trace {
-        // Opt-in timing on stderr (exploration; results unaffected).
-        eprintln!(
-            "quintic-c2 supernodal: {m} rows, symbolic {:.2} s, {} values",
-            t.elapsed().as_secs_f64(),
-            symbolic.len_val()
-        );
-    }
-    if symbolic.len_val() > max_values {
-        return None;
-    }
-    let t = std::time::Instant::now();
-    let mut values = vec![T::of_f64(0.0); symbolic.len_val()];
-    let signs = vec![1i8; m];
-    let par = PAR;
-    let a = SparseColMatRef::new(sym, &val);
-    let mut mem =
-        MemBuffer::new(symbolic.factorize_numeric_ldlt_scratch::<T>(par, Default::default()));
-    let info = symbolic.factorize_numeric_ldlt(
-        &mut values,
-        a,
-        Side::Lower,
-        LdltRegularization {
-            dynamic_regularization_signs: Some(&signs),
-            dynamic_regularization_delta: T::of_f64(DROPPED_PIVOT),
-            dynamic_regularization_epsilon: T::of_f64(threshold),
-        },
-        par,
-        MemStack::new(&mut mem),
-        Default::default(),
-    );
-    if info.is_err() {
-        return None;
-    }
-    // The dropped rows: pivots set to DROPPED_PIVOT, on the diagonals of the supernodes' blocks.
-    let SymbolicCholeskyRaw::Supernodal(raw) = symbolic.raw() else {
-        return None;
-    };
-    let blocks = SupernodalLdltRef::<usize, T>::new(raw, &values);
-    let dropped = (0..raw.n_supernodes())
-        .map(|s| {
-            let v = blocks.supernode(s).val();
-            (0..v.ncols())
-                .filter(|&k| v[(k, k)].dd().hi == DROPPED_PIVOT)
-                .count()
-        })
-        .sum();
-    if trace {
-        eprintln!(
-            "quintic-c2 supernodal: numeric {:.2} s, {dropped} dropped",
-            t.elapsed().as_secs_f64()
-        );
-    }
-    Some(Supernodal {
-        symbolic,
-        values,
-        dropped,
-    })
+/// Â Âᵀ of a group's unit rows (summed in double-double) in compressed lower columns, and its
+/// symbolic factorisation in faer's approximate minimum degree order: what every numeric
+/// factor of one solve shares, whatever its drop threshold or arithmetic.
+pub struct Normal {
+    ptr: Vec<usize>,
+    idx: Vec<usize>,
+    val: Vec<Dd>,
+    symbolic: SymbolicCholesky<usize>,
 }
 
-impl cholesky::NormalSolve for Supernodal<f64> {
+impl Normal {
+    /// Forms and orders Â Âᵀ of the unit rows `arows` (`n` unknowns); `None` when its factor
+    /// would hold more than `max_values` values or faer refuses it.
+    #[must_use]
+    pub fn of(arows: &[Vec<(u32, f64)>], n: usize, max_values: usize) -> Option<Normal> {
+        let m = arows.len();
+        let (d, off) = cholesky::normal_matrix::<Dd>(arows, n);
+        let (ptr, idx, val) = lower_columns(&d, &off);
+        std::mem::drop(off);
+        let t = std::time::Instant::now();
+        let symbolic = factorize_symbolic_cholesky(
+            SymbolicSparseColMatRef::new_checked(m, m, &ptr, None, &idx),
+            Side::Lower,
+            // Not the in-house minimum degree order: on the twisted 96 × 12 torus's joint group
+            // faer's AMD gives 2.4e8 values against 2.9e8, and the f64 factor in 7.5 s against 18.
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .ok()?;
+        if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
+            // Opt-in timing on stderr (exploration; results unaffected).
+            eprintln!(
+                "quintic-c2 supernodal: {m} rows, symbolic {:.2} s, {} values",
+                t.elapsed().as_secs_f64(),
+                symbolic.len_val()
+            );
+        }
+        (symbolic.len_val() <= max_values).then_some(Normal {
+            ptr,
+            idx,
+            val,
+            symbolic,
+        })
+    }
+
+    /// The numeric factor in `T`, dropping rows whose pivot falls below `threshold`; `None`
+    /// when faer refuses it.
+    #[must_use]
+    pub fn factor<T: Elem>(&self, threshold: f64) -> Option<Supernodal<'_, T>> {
+        let m = self.ptr.len() - 1;
+        let t = std::time::Instant::now();
+        let sym = SymbolicSparseColMatRef::new_checked(m, m, &self.ptr, None, &self.idx);
+        let val: Vec<T> = self.val.iter().map(|&v| T::of_dd(v)).collect();
+        let symbolic = &self.symbolic;
+        let mut values = vec![T::of_f64(0.0); symbolic.len_val()];
+        let signs = vec![1i8; m];
+        let mut mem =
+            MemBuffer::new(symbolic.factorize_numeric_ldlt_scratch::<T>(PAR, Default::default()));
+        let info = symbolic.factorize_numeric_ldlt(
+            &mut values,
+            SparseColMatRef::new(sym, &val),
+            Side::Lower,
+            LdltRegularization {
+                dynamic_regularization_signs: Some(&signs),
+                dynamic_regularization_delta: T::of_f64(DROPPED_PIVOT),
+                dynamic_regularization_epsilon: T::of_f64(threshold),
+            },
+            PAR,
+            MemStack::new(&mut mem),
+            Default::default(),
+        );
+        if info.is_err() {
+            return None;
+        }
+        // The dropped rows: pivots set to DROPPED_PIVOT, on the diagonals of the supernodes'
+        // blocks.
+        let SymbolicCholeskyRaw::Supernodal(raw) = symbolic.raw() else {
+            return None;
+        };
+        let blocks = SupernodalLdltRef::<usize, T>::new(raw, &values);
+        let dropped = (0..raw.n_supernodes())
+            .map(|s| {
+                let v = blocks.supernode(s).val();
+                (0..v.ncols())
+                    .filter(|&k| v[(k, k)].dd().hi == DROPPED_PIVOT)
+                    .count()
+            })
+            .sum();
+        if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
+            eprintln!(
+                "quintic-c2 supernodal: numeric {:.2} s, {dropped} dropped",
+                t.elapsed().as_secs_f64()
+            );
+        }
+        Some(Supernodal {
+            symbolic,
+            values,
+            dropped,
+        })
+    }
+}
+
+/// A factor with its dropped rows, as [`cholesky::refine_near`] takes them.
+fn with_dropped<T: Elem>(f: Supernodal<'_, T>) -> (Supernodal<'_, T>, usize) {
+    let dropped = f.dropped;
+    (f, dropped)
+}
+
+impl cholesky::NormalSolve for Supernodal<'_, f64> {
     fn solve_normal(&self, r: &mut [f64]) {
         r.copy_from_slice(&self.solve_wide(r));
     }
 }
 
-impl cholesky::NormalSolve for Supernodal<fx128> {
+impl cholesky::NormalSolve for Supernodal<'_, fx128> {
     fn solve_normal(&self, r: &mut [f64]) {
         let y = self.solve_wide(r);
         for (v, y) in r.iter_mut().zip(y) {
@@ -260,8 +280,8 @@ impl cholesky::NormalSolve for Supernodal<fx128> {
 /// [`cholesky::solve_near`] for a group beyond the in-house factor: the x closest to `target`
 /// with A x = c, refined until max |A x − c| ≤ `tol` (the same refinement and conjugate
 /// gradients): with an f64 factor first, then, if that falls short, a double-double one
-/// dropping rows at [`cholesky::PRECISE_PIVOT`]. `None` when this factor would hold more than
-/// `max_values` values
+/// dropping rows at [`cholesky::PRECISE_PIVOT`]; Â Âᵀ is formed and ordered once for all of
+/// them ([`Normal`]). `None` when this factor would hold more than `max_values` values
 /// ([`MAX_VALUES`] in the solves).
 #[must_use]
 pub fn solve_near(
@@ -273,20 +293,15 @@ pub fn solve_near(
     max_values: usize,
 ) -> Option<Solution> {
     let unit = UnitRows::new(rows, c);
+    let normal = Normal::of(&unit.rows, n, max_values)?;
     let drops = [cholesky::DEPENDENT_PIVOT, cholesky::RETRY_PIVOT];
     let mut best = cholesky::refine_near(&unit, target, tol, &drops, |drop| {
-        factor::<f64>(&unit.rows, n, drop, max_values).map(|f| {
-            let dropped = f.dropped;
-            (f, dropped)
-        })
+        normal.factor::<f64>(drop).map(with_dropped)
     })?;
     if best.0 > tol {
         let precise =
             cholesky::refine_near(&unit, target, tol, &[cholesky::PRECISE_PIVOT], |drop| {
-                factor::<fx128>(&unit.rows, n, drop, max_values).map(|f| {
-                    let dropped = f.dropped;
-                    (f, dropped)
-                })
+                normal.factor::<fx128>(drop).map(with_dropped)
             });
         if let Some(p) = precise.filter(|p| p.0 < best.0) {
             best = p;
@@ -369,9 +384,10 @@ mod tests {
     #[test]
     fn double_double_pivots_resolve_distances_below_f64_rounding() {
         let rows = pair(1e-9);
-        let keep = factor::<fx128>(&rows, 2, 1e-19, MAX_VALUES).expect("tiny");
+        let normal = Normal::of(&rows, 2, MAX_VALUES).expect("tiny");
+        let keep = normal.factor::<fx128>(1e-19).expect("tiny");
         assert_eq!(keep.dropped, 0);
-        let drop = factor::<fx128>(&rows, 2, 1e-17, MAX_VALUES).expect("tiny");
+        let drop = normal.factor::<fx128>(1e-17).expect("tiny");
         assert_eq!(drop.dropped, 1);
         // The kept pivot is the true one: solving Â Âᵀ y = e_b gives y_b = 1 / sin² t.
         let y = keep.solve_wide(&[0.0, 1.0]);
@@ -434,8 +450,9 @@ mod tests {
                 .build()
                 .expect("pool");
             pool.install(|| {
-                let f = factor::<f64>(&rows, n, 1e-13, MAX_VALUES).expect("small");
-                let d = factor::<fx128>(&rows, n, 1e-15, MAX_VALUES).expect("small");
+                let normal = Normal::of(&rows, n, MAX_VALUES).expect("small");
+                let f = normal.factor::<f64>(1e-13).expect("small");
+                let d = normal.factor::<fx128>(1e-15).expect("small");
                 let r: Vec<f64> = (0..m).map(|i| (i as f64).sin()).collect();
                 let y: Vec<(f64, f64)> = d.solve_wide(&r).iter().map(|v| (v.0, v.1)).collect();
                 (f.values.clone(), y)

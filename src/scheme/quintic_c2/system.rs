@@ -1620,12 +1620,10 @@ fn brief(pts: &[u32]) -> String {
 /// that `x` misses by more than [`consistent`] allows, sorted; all of the group's points if
 /// none does (a non-finite solution).
 fn unmet_points(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128]) -> Vec<u32> {
-    let tol = 1e-9 * g.reach;
     let finite = x.iter().all(|v| v.is_finite());
     let mut cols: Vec<usize> = Vec::new();
-    for (row, &c) in g.rows.iter().zip(&g.c).take(g.m) {
-        let r: f64 = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
-        if !finite || r.is_nan() || r.abs() > tol {
+    for (i, row) in g.rows.iter().take(g.m).enumerate() {
+        if !finite || unmet_row(g, x, i).is_some() {
             cols.extend(row.iter().map(|t| t.0));
         }
     }
@@ -1635,13 +1633,19 @@ fn unmet_points(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128]) -> Vec<u32
     group_points(cols.into_iter().map(|j| g.unk[j]), st, np, keys)
 }
 
-/// Prints every row of `g` that `x` misses by more than 1e-9 of the group's reach: the miss
-/// over the reach, the row's length and the points of T it names with their positions
-/// (`APATCH_SOLVE_TRACE`, exploration).
+/// How far `x` misses row `i` of group `g` (A x − c), if by more than [`consistent`] allows
+/// (1e-9 of the group's reach) or by NaN.
+fn unmet_row(g: &Group, x: &[f64], i: usize) -> Option<f64> {
+    let r: f64 = g.rows[i].iter().map(|&(j, k)| k * x[j]).sum::<f64>() - g.c[i];
+    (r.is_nan() || r.abs() > 1e-9 * g.reach).then_some(r)
+}
+
+/// Prints every row of `g` that `x` misses by more than 1e-9 of the group's reach
+/// ([`unmet_row`]): the miss over the reach, the row's length and the points of T it names
+/// with their positions (`APATCH_SOLVE_TRACE`, exploration).
 fn trace_unmet(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128], jets: &[Jet]) {
-    for (i, (row, &c)) in g.rows.iter().zip(&g.c).take(g.m).enumerate() {
-        let r: f64 = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
-        if r.is_nan() || r.abs() > 1e-9 * g.reach {
+    for (i, row) in g.rows.iter().take(g.m).enumerate() {
+        if let Some(r) = unmet_row(g, x, i) {
             let pts = group_points(row.iter().map(|t| g.unk[t.0]), st, np, keys);
             let at: Vec<String> = pts
                 .iter()
@@ -1734,9 +1738,10 @@ fn solve_rows(
 }
 
 /// [`cholesky::solve_near`] within `(max rows, max factor entries, _)`; a group beyond either
-/// is solved by the supernodal factor ([`supernodal::solve_near`]) within `(_, _, max supernodal values)`, and left unsolved (its targets,
-/// infinite residual) beyond that too, which the caller reports as too large: a factor that
-/// does not fit in memory would end the process instead of the scene.
+/// is solved by the supernodal factor ([`supernodal::solve_near`]) within `(_, _, max
+/// supernodal values)`, and left unsolved (its targets, infinite residual) beyond that too,
+/// which the caller reports as too large: a factor that does not fit in memory would end the
+/// process instead of the scene.
 fn solve_sparse(
     rows: &[sparse::Row],
     n: usize,
