@@ -87,6 +87,7 @@ pub mod fan;
 pub mod flatnet;
 pub mod guardnet;
 pub mod nearguard;
+pub mod netmesh;
 pub mod normals;
 pub mod overlapnet;
 pub mod planar;
@@ -164,6 +165,12 @@ pub struct InnerOptions {
     /// faces are split into convex pieces with guards far from the corners they serve
     /// (mpi_poly cleaned by `model.clean`: its U-shaped faces).
     pub all_flat_nets: bool,
+    /// Smallest angle (degrees) the triangles of every flat net should reach: points of T are
+    /// added inside the nets' guard polygons until they do where they can ([`netmesh`]; 0 =
+    /// off, the default: the nets triangulate their guards only). A guard polygon with long
+    /// sides sampled finely along one of them (flattened fandisk) is otherwise a fan of
+    /// needles, which the quintic's C2 conditions extrapolate by hundreds of their sizes.
+    pub flat_net_angle: f64,
 }
 
 impl Default for InnerOptions {
@@ -180,13 +187,14 @@ impl Default for InnerOptions {
             corner_search: false,
             apex_search: false,
             all_flat_nets: false,
+            flat_net_angle: 0.0,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 10] = [
+    pub const KEYS: [&'static str; 11] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
@@ -197,12 +205,14 @@ impl InnerOptions {
         "corner_search",
         "apex_search",
         "all_flat_nets",
+        "flat_net_angle",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
     /// (number in [0, 1]), `merge_close` (number in [0, 0.05]), `split_search`, `corner_search`,
-    /// `apex_search` and `all_flat_nets` (booleans) from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
+    /// `apex_search` and `all_flat_nets` (booleans), `flat_net_angle` (degrees in [0, 30])
+    /// from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
     /// # Errors
@@ -261,6 +271,16 @@ impl InnerOptions {
                 )));
             }
             o.merge_close = t;
+        }
+        if let Some(a) = number("flat_net_angle")? {
+            // Ruppert's refinement is proven to end below about 20.7°; the nets' kept edges
+            // stop it earlier anyway, and beyond 30° it would only spend points.
+            if !(0.0..=30.0).contains(&a) {
+                return Err(bad(format!(
+                    "`scheme.flat_net_angle` = {a}: must lie in [0, 30] (degrees; 0 = off)"
+                )));
+            }
+            o.flat_net_angle = a;
         }
         match table.get("planar_tolerance") {
             None => {}
@@ -691,6 +711,7 @@ fn build_with(
         Some(normals),
         nets,
         options.all_flat_nets,
+        options.flat_net_angle,
     );
     report.flat_nets = flat.groups.len();
     report.flat_net_candidates.clone_from(&flat.eligible);

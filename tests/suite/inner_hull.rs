@@ -346,7 +346,11 @@ fn options_from_scene_table() {
         (o.alpha, o.trihedral_level, o.fix_normals),
         (0.25, 1.0, false)
     );
+    assert_eq!(parse("flat_net_angle = 20").unwrap().flat_net_angle, 20.0);
     for (bad, key) in [
+        ("flat_net_angle = 45.0", "scheme.flat_net_angle"),
+        ("flat_net_angle = -1", "scheme.flat_net_angle"),
+        ("flat_net_angle = true", "scheme.flat_net_angle"),
         ("alpha = 1.0", "scheme.alpha"),
         ("alpha = 0", "scheme.alpha"),
         ("alpha = \"half\"", "scheme.alpha"),

@@ -430,7 +430,10 @@ fn needle_survey() {
 
 /// Details (ignored; prints only) for `APATCH_NEEDLES=scene.toml`: the triangles of T with the
 /// largest extrapolation factors, their angles, their neighbours across each edge and the fold
-/// to each.
+/// to each. With `APATCH_NEEDLE_NETS=1` instead: per flat net (triangles whose points are all
+/// guards of one face), its triangles, smallest angle, needles below 5° and largest factor; with
+/// `APATCH_NEEDLE_POINTS=i,j,…`: every triangle of T at those points (the points an unmet row
+/// of `APATCH_SOLVE_TRACE` names), with angles, edge lengths, factor and origins.
 #[test]
 #[ignore]
 fn needle_details() {
@@ -450,6 +453,83 @@ fn needle_details() {
         let v = hull.triangles[t].map(|i| hull.points[i as usize]);
         (v[1] - v[0]).cross(v[2] - v[0]).normalize()
     };
+    if std::env::var("APATCH_NEEDLE_NETS").is_ok() {
+        let mut worst: std::collections::HashMap<u32, f64> = std::collections::HashMap::new();
+        for &(f, face, _) in &ex {
+            let w = worst.entry(face).or_insert(0.0);
+            *w = w.max(f);
+        }
+        let mut per: std::collections::BTreeMap<u32, (usize, f64, usize, f64)> = Default::default();
+        for (t, tri) in hull.triangles.iter().enumerate() {
+            let faces: Vec<Option<u32>> = tri
+                .iter()
+                .map(|&i| match hull.origins[i as usize] {
+                    apatch::hull::simplicial::PointOrigin::CornerGuard { face } => Some(face),
+                    _ => None,
+                })
+                .collect();
+            let Some(f) = faces[0] else { continue };
+            if faces.iter().any(|g| *g != Some(f)) {
+                continue;
+            }
+            let v = tri.map(|i| hull.points[i as usize]);
+            let a = (0..3)
+                .map(|k| {
+                    (v[(k + 1) % 3] - v[k])
+                        .angle_between(v[(k + 2) % 3] - v[k])
+                        .to_degrees()
+                })
+                .fold(f64::INFINITY, f64::min);
+            let e = per.entry(f).or_insert((0, f64::INFINITY, 0, 0.0));
+            e.0 += 1;
+            e.1 = e.1.min(a);
+            e.2 += usize::from(a < 5.0);
+            e.3 = e.3.max(worst.get(&(t as u32)).copied().unwrap_or(0.0));
+        }
+        for (f, (n, a, few, w)) in per {
+            if n >= 10 {
+                println!("net face {f}: {n} triangles, min angle {a:.2}°, < 5°: {few}, max factor {w:.1}");
+            }
+        }
+        return;
+    }
+    if let Ok(list) = std::env::var("APATCH_NEEDLE_POINTS") {
+        let pts: Vec<u32> = list.split(',').map(|x| x.trim().parse().unwrap()).collect();
+        let mut worst: std::collections::HashMap<u32, f64> = std::collections::HashMap::new();
+        for &(f, face, _) in &ex {
+            let w = worst.entry(face).or_insert(0.0);
+            *w = w.max(f);
+        }
+        for &p in &pts {
+            println!(
+                "point {p} {:?} origin {:?}",
+                hull.points[p as usize], hull.origins[p as usize]
+            );
+            for (t, tri) in hull.triangles.iter().enumerate() {
+                if !tri.contains(&p) {
+                    continue;
+                }
+                let v = tri.map(|i| hull.points[i as usize]);
+                let ang: Vec<String> = (0..3)
+                    .map(|k| {
+                        let a = v[(k + 1) % 3] - v[k];
+                        let b = v[(k + 2) % 3] - v[k];
+                        format!("{:.2}", a.angle_between(b).to_degrees())
+                    })
+                    .collect();
+                let lens: Vec<String> = (0..3)
+                    .map(|k| format!("{:.4}", (v[(k + 1) % 3] - v[k]).length()))
+                    .collect();
+                println!(
+                    "   tri {t} {tri:?} elem {} angles {ang:?} lens {lens:?} factor {:.1} origins {:?}",
+                    hull.element[t],
+                    worst.get(&(t as u32)).copied().unwrap_or(0.0),
+                    tri.map(|i| hull.origins[i as usize])
+                );
+            }
+        }
+        return;
+    }
     let mut seen = std::collections::HashSet::new();
     for &(f, face, edge) in ex.iter().take(40) {
         if !seen.insert(face) {

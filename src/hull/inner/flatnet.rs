@@ -95,6 +95,8 @@ pub struct FlatGroup {
     pub corners: Vec<u32>,
     /// Guard of each corner (points of T = piece indices).
     pub guards: Vec<u32>,
+    /// Points of T inside the guard polygon ([`super::netmesh`]; empty unless asked for).
+    pub inner: Vec<u32>,
     /// Triangles of T inside the guard polygon.
     pub triangles: Vec<[u32; 3]>,
 }
@@ -172,7 +174,7 @@ pub fn spread_guards_folded(
     merged: &[usize],
     normals: Option<&[DVec3]>,
 ) -> FlatNets {
-    spread_guards_forced(net, mesh, merged, normals, &BTreeSet::new(), false)
+    spread_guards_forced(net, mesh, merged, normals, &BTreeSet::new(), false, 0.0)
 }
 
 /// [`spread_guards_folded`], also giving a flat net to every merged polygon whose input face
@@ -180,7 +182,9 @@ pub fn spread_guards_folded(
 /// earlier build, [`super::overlapnet`]), when it has the structure a net needs (several
 /// input faces, at least [`MIN_CORNERS`] corners, one region, a guard polygon). With
 /// `everywhere` (`InnerOptions::all_flat_nets`) every polygon with that structure qualifies,
-/// merged or not, near or far.
+/// merged or not, near or far. With `min_angle` > 0 (degrees, `InnerOptions::flat_net_angle`)
+/// each net gets points inside its guard polygon until its triangles' angles reach it where
+/// they can ([`super::netmesh`]).
 pub fn spread_guards_forced(
     net: &mut GuardNet,
     mesh: &Mesh,
@@ -188,6 +192,7 @@ pub fn spread_guards_forced(
     normals: Option<&[DVec3]>,
     forced: &BTreeSet<u32>,
     everywhere: bool,
+    min_angle: f64,
 ) -> FlatNets {
     let pos = &mesh.positions;
     let mut out = FlatNets::default();
@@ -325,11 +330,18 @@ pub fn spread_guards_forced(
                 v: n.cross(u),
                 n,
             };
-            let Some((gpos, tris)) = place_guards(&frame, pos, &face) else {
+            let Some((mut gpos, mut tris)) = place_guards(&frame, pos, &face) else {
                 continue;
             };
-            // Guard pieces: the polygon's own first (every point of T stays used), new ones after.
-            let mut guards = Vec::with_capacity(k);
+            if min_angle > 0.0 {
+                let flat: Vec<DVec2> = gpos.iter().map(|&g| frame.flat(g)).collect();
+                let refined = super::netmesh::refine(&flat, &tris, min_angle);
+                gpos.extend(refined.points[k..].iter().map(|&q| frame.lift(q)));
+                tris = refined.triangles;
+            }
+            // Guard pieces: the polygon's own first (every point of T stays used), new ones
+            // after; then the net's inner points (pieces of the face too, in no corner's fan).
+            let mut guards = Vec::with_capacity(gpos.len());
             for (i, &g) in gpos.iter().enumerate() {
                 let g = g - frame.n.dot(g - mean) * frame.n;
                 if let Some(&q) = own.get(i) {
@@ -359,7 +371,8 @@ pub fn spread_guards_forced(
                 piece: own[0],
                 face: f,
                 corners: face.clone(),
-                guards: guards.clone(),
+                guards: guards[..k].to_vec(),
+                inner: guards[k..].to_vec(),
                 triangles: tris.iter().map(|t| t.map(|i| guards[i as usize])).collect(),
             });
             done.insert(f);
@@ -758,6 +771,7 @@ impl FlatNets {
         debug_assert!(self.groups.iter().all(|g| g
             .guards
             .iter()
+            .chain(&g.inner)
             .all(|&q| matches!(hull.origins[q as usize], PointOrigin::CornerGuard { .. }))));
     }
 }
