@@ -227,6 +227,7 @@ fn hull_steps(r: &apatch::hull::inner::InnerReport) -> Vec<(&'static str, usize)
         ("polygons_split_convex", r.split_faces.len()),
         ("star_polygons", r.star_faces.len()),
         ("flat_nets", r.flat_nets),
+        ("straight_corners", r.straight_corners),
         ("unseparable_corners", r.unseparable.len()),
         ("degenerate_apexes_rebuilt", r.degenerate_repaired),
         ("ring_normals_turned", r.ring_normals),

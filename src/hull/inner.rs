@@ -109,6 +109,7 @@ use crate::error::{Error, Result};
 use crate::hull::simplicial::{PointOrigin, SimplicialHull};
 use crate::mesh::Mesh;
 use glam::DVec3;
+use std::collections::HashMap;
 use std::path::Path;
 
 /// Shape-control parameters of the hull (§7.1).
@@ -171,6 +172,12 @@ pub struct InnerOptions {
     /// sides sampled finely along one of them (flattened fandisk) is otherwise a fan of
     /// needles, which the quintic's C2 conditions extrapolate by hundreds of their sizes.
     pub flat_net_angle: f64,
+    /// Keep the vertices on a straight edge between two flat nets as corners of both polygons
+    /// (default false: [`coplanar`] drops every vertex between only two polygons): they get a
+    /// guard in each net and step (5') cells on their edges, no corner triangles. Otherwise the
+    /// edge is as long as the whole crease (flattened fandisk: 0.81 and 0.52, their neighbours
+    /// 0.019), and the nets' triangles and cells on it are needles.
+    pub straight_corners: bool,
 }
 
 impl Default for InnerOptions {
@@ -188,13 +195,14 @@ impl Default for InnerOptions {
             apex_search: false,
             all_flat_nets: false,
             flat_net_angle: 0.0,
+            straight_corners: false,
         }
     }
 }
 
 impl InnerOptions {
     /// The `[scheme]` keys [`InnerOptions::from_toml`] reads.
-    pub const KEYS: [&'static str; 11] = [
+    pub const KEYS: [&'static str; 12] = [
         "alpha",
         "trihedral_level",
         "fix_normals",
@@ -206,12 +214,14 @@ impl InnerOptions {
         "apex_search",
         "all_flat_nets",
         "flat_net_angle",
+        "straight_corners",
     ];
 
     /// Reads `alpha` (number in (0, 1)), `trihedral_level` (number in [0, 1]), `fix_normals`
     /// (boolean), `planar_tolerance` (number ≥ 0, or `false` for no split) and `ring_normals`
     /// (number in [0, 1]), `merge_close` (number in [0, 0.05]), `split_search`, `corner_search`,
-    /// `apex_search` and `all_flat_nets` (booleans), `flat_net_angle` (degrees in [0, 30])
+    /// `apex_search`, `all_flat_nets` and `straight_corners` (booleans), `flat_net_angle`
+    /// (degrees in [0, 30])
     /// from a scene's `[scheme]` table (and sets [`InnerOptions::min_volume`] from its `type`); absent keys keep their defaults, other keys
     /// are ignored (the scheme checks for unknown keys, see [`InnerOptions::KEYS`]).
     ///
@@ -318,6 +328,7 @@ impl InnerOptions {
             ("corner_search", &mut o.corner_search),
             ("apex_search", &mut o.apex_search),
             ("all_flat_nets", &mut o.all_flat_nets),
+            ("straight_corners", &mut o.straight_corners),
         ] {
             match table.get(key) {
                 None => {}
@@ -385,6 +396,8 @@ pub struct InnerReport {
     pub reapex: reapex::Search,
     /// Flat polygons given a guard per corner and a zero coplanar group ([`flatnet`]).
     pub flat_nets: usize,
+    /// Corners kept on straight edges between two flat nets (`straight_corners`).
+    pub straight_corners: usize,
     /// Input faces of the merged polygons that could take a flat net but have none
     /// ([`flatnet::FlatNets::eligible`]).
     pub flat_net_candidates: Vec<u32>,
@@ -699,21 +712,75 @@ fn build_with(
     };
     let nv = mesh.positions.len();
     let line = |v: usize| mesh.vertex_lines.get(v).copied().unwrap_or(0);
-    let (merged, merged_counts) = coplanar::merge_coplanar_counted(mesh);
+    let (mut merged, mut merged_counts) = coplanar::merge_coplanar_counted(mesh);
+    let mut forced = nets.clone();
+    let mut straight = std::collections::BTreeSet::new();
+    if options.straight_corners {
+        // The polygons that get flat nets with the straight vertices dropped keep those
+        // between two of them, and get their nets again.
+        let mut probe = guardnet::GuardNet::build(&merged, decompose::convex_pieces(&merged)?);
+        let netted: std::collections::BTreeSet<u32> = flatnet::spread_guards_forced(
+            &mut probe,
+            &merged,
+            &merged_counts,
+            Some(normals),
+            nets,
+            options.all_flat_nets,
+            0.0,
+        )
+        .groups
+        .iter()
+        .map(|g| merged.face_parent[g.face as usize])
+        .collect();
+        let (kept, counts) = coplanar::merge_coplanar_keeping(mesh, |a, b| {
+            netted.contains(&a) && netted.contains(&b)
+        });
+        let mut polygons: HashMap<u32, usize> = HashMap::new();
+        for face in &kept.faces {
+            for &v in face {
+                *polygons.entry(v).or_default() += 1;
+            }
+        }
+        straight = polygons
+            .into_iter()
+            .filter(|&(_, n)| n == 2)
+            .map(|(v, _)| v)
+            .collect();
+        report.straight_corners = straight.len();
+        (merged, merged_counts) = (kept, counts);
+        forced.extend(netted);
+    }
     let mesh = &merged;
     // Algorithm 2 step (1): regions with several pieces get a corner guard net.
     let mut net = guardnet::GuardNet::build(mesh, decompose::convex_pieces(mesh)?);
+    net.straight = straight;
     // Appendix B: large flat polygons get a guard per corner and a zero coplanar group.
     let flat = flatnet::spread_guards_forced(
         &mut net,
         mesh,
         &merged_counts,
         Some(normals),
-        nets,
+        &forced,
         options.all_flat_nets,
         options.flat_net_angle,
     );
     report.flat_nets = flat.groups.len();
+    // A straight corner needs both its polygons' nets (their guards and cells stand in for its
+    // corner triangles).
+    if !net.straight.is_empty() {
+        let netted: std::collections::BTreeSet<u32> = flat.groups.iter().map(|g| g.face).collect();
+        for &v in &net.straight {
+            if let Some(f) = (0..mesh.faces.len() as u32)
+                .find(|&f| mesh.faces[f as usize].contains(&v) && !netted.contains(&f))
+            {
+                return Err(Error::Invalid(format!(
+                    "vertex {v} (line {}): kept as a straight corner (`straight_corners`) but its face {} got no flat net",
+                    line(v as usize),
+                    mesh.face_parent[f as usize]
+                )));
+            }
+        }
+    }
     report.flat_net_candidates.clone_from(&flat.eligible);
     report.overlap_nets = nets.iter().copied().collect();
     // Star faces' corners served from far where the face folds nearly flat into a neighbour.
@@ -753,6 +820,9 @@ fn build_with(
     for v in 0..nv {
         if topo.vertex_corners(v as u32).is_empty() || net.inside(v as u32) {
             continue; // unreferenced, or inside one region: no corner of the polyhedron
+        }
+        if net.straight.contains(&(v as u32)) {
+            continue; // a straight corner between two flat nets: their cells meet there
         }
         let fan = match net.fan(v as u32) {
             Some(f) if f.closed => f,

@@ -347,10 +347,12 @@ fn options_from_scene_table() {
         (0.25, 1.0, false)
     );
     assert_eq!(parse("flat_net_angle = 20").unwrap().flat_net_angle, 20.0);
+    assert!(parse("straight_corners = true").unwrap().straight_corners);
     for (bad, key) in [
         ("flat_net_angle = 45.0", "scheme.flat_net_angle"),
         ("flat_net_angle = -1", "scheme.flat_net_angle"),
         ("flat_net_angle = true", "scheme.flat_net_angle"),
+        ("straight_corners = 1", "scheme.straight_corners"),
         ("alpha = 1.0", "scheme.alpha"),
         ("alpha = 0", "scheme.alpha"),
         ("alpha = \"half\"", "scheme.alpha"),

@@ -36,6 +36,17 @@ pub fn merge_coplanar(mesh: &Mesh) -> Mesh {
 /// (1 for a face kept as it was; [`super::flatnet`] treats only merged regions).
 #[must_use]
 pub fn merge_coplanar_counted(mesh: &Mesh) -> (Mesh, Vec<usize>) {
+    merge_coplanar_keeping(mesh, |_, _| false)
+}
+
+/// [`merge_coplanar_counted`], keeping the vertices on a straight edge between two polygons
+/// whose representative input faces (`face_parent`) `keep` accepts: corners of both polygons
+/// with a straight angle, which the hull gives no corner triangles, only guards and step (5')
+/// cells ([`super::flatnet`], `InnerOptions::straight_corners`): between two flat nets a
+/// straight edge otherwise becomes one edge as long as the whole crease (flattened fandisk:
+/// 0.81, its neighbours 0.019), and each net's triangles on it are needles.
+#[must_use]
+pub fn merge_coplanar_keeping(mesh: &Mesh, keep: impl Fn(u32, u32) -> bool) -> (Mesh, Vec<usize>) {
     let nf = mesh.faces.len();
     let normals: Vec<Option<DVec3>> = mesh
         .faces
@@ -114,11 +125,15 @@ pub fn merge_coplanar_counted(mesh: &Mesh) -> (Mesh, Vec<usize>) {
             }
         }
     }
+    let kept_straight = |v: &u32| {
+        let fs = &count[v];
+        fs.len() == 2 && keep(reps[fs[0]], reps[fs[1]])
+    };
     for face in &mut faces {
         let kept: Vec<u32> = face
             .iter()
             .copied()
-            .filter(|v| count[v].len() > 2)
+            .filter(|v| count[v].len() > 2 || kept_straight(v))
             .collect();
         if kept.len() >= 3 {
             *face = kept;
@@ -160,6 +175,53 @@ pub fn same_plane(positions: &[DVec3], f: &[u32], nf: DVec3, g: &[u32], ng: DVec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 2 × 1 × 1 box whose four long sides are each two unit squares: merged, each side is
+    /// one polygon and the four vertices of the middle ring (each between only two sides) are
+    /// dropped, leaving quadrilaterals; kept for the sides `keep` names, those sides keep them
+    /// as straight corners (hexagons), the others still drop them.
+    #[test]
+    fn straight_vertices_are_kept_between_the_polygons_asked_for() {
+        let mut positions = Vec::new();
+        for x in [0.0, 1.0, 2.0] {
+            for (y, z) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                positions.push(DVec3::new(x, y, z));
+            }
+        }
+        // Ring r, corner c: index 4r + c; outward orientation.
+        let v = |r: u32, c: u32| 4 * r + c % 4;
+        let mut faces = vec![
+            vec![v(0, 0), v(0, 3), v(0, 2), v(0, 1)],
+            vec![v(2, 0), v(2, 1), v(2, 2), v(2, 3)],
+        ];
+        for r in 0..2 {
+            for c in 0..4 {
+                faces.push(vec![v(r, c), v(r, c + 1), v(r + 1, c + 1), v(r + 1, c)]);
+            }
+        }
+        let m = Mesh::new(positions, faces);
+        let (dropped, counts) = merge_coplanar_counted(&m);
+        let mut sizes: Vec<usize> = dropped.faces.iter().map(Vec::len).collect();
+        sizes.sort_unstable();
+        assert_eq!(sizes, vec![4; 6]);
+        assert_eq!(counts.iter().filter(|&&c| c == 2).count(), 4);
+        let (kept, _) = merge_coplanar_keeping(&m, |_, _| true);
+        let mut sizes: Vec<usize> = kept.faces.iter().map(Vec::len).collect();
+        sizes.sort_unstable();
+        assert_eq!(sizes, vec![4, 4, 6, 6, 6, 6]);
+        // Only the vertex between the sides whose first squares are faces 2 and 3 (y = 1,
+        // z = 0 at x = 1: vertex 5) is kept when only that pair is asked for.
+        let (one, _) = merge_coplanar_keeping(&m, |a, b| a.min(b) == 2 && a.max(b) == 3);
+        let holding: Vec<usize> = (0..one.faces.len())
+            .filter(|&f| one.faces[f].contains(&5))
+            .collect();
+        assert_eq!(holding.len(), 2);
+        assert!(holding.iter().all(|&f| one.faces[f].len() == 5));
+        assert!(!one
+            .faces
+            .iter()
+            .any(|f| f.contains(&4) || f.contains(&6) || f.contains(&7)));
+    }
 
     /// The triangulated hallway corner (an L-shaped block) becomes the L prism: two hexagons
     /// and six quadrilaterals, same vertices.

@@ -79,6 +79,9 @@ pub struct GuardNet {
     pub fallback: Vec<u32>,
     /// Those regions' groups (first original piece), for the second pass of [`GuardNet::build`].
     failed: Vec<usize>,
+    /// Corners on a straight edge between two flat nets (`InnerOptions::straight_corners`):
+    /// no corner triangles; the step (5') cells on their edges stand in for them.
+    pub straight: std::collections::BTreeSet<u32>,
 }
 
 /// One boundary corner of a region.
@@ -376,6 +379,7 @@ impl GuardNet {
             nets,
             fallback,
             failed,
+            straight: std::collections::BTreeSet::new(),
         }
     }
 
@@ -419,9 +423,19 @@ impl GuardNet {
                     .map(|&t| hull.apexes[t].iter().flatten().copied().collect())
                     .unwrap_or_default()
             };
-            // V_1's triangle holds G_3 → G_1, V_2's holds G_2 → G_4.
-            let q1 = apexes_of((g3, g1));
-            let q2 = apexes_of((g2, g4));
+            // V_1's triangle holds G_3 → G_1, V_2's holds G_2 → G_4. A straight corner has no
+            // triangle: its apex is the corner itself, as a trihedral corner's (Algorithm 1
+            // step (3)), so the cells on either side of it share their edge tetrahedra's
+            // point s on the edge.
+            let corner_apexes = |key: (u32, u32), v: u32| -> Vec<DVec3> {
+                if self.straight.contains(&v) {
+                    vec![positions[v as usize]]
+                } else {
+                    apexes_of(key)
+                }
+            };
+            let q1 = corner_apexes((g3, g1), cell.v[0]);
+            let q2 = corner_apexes((g2, g4), cell.v[1]);
             let lifted = |g: u32| -> DVec3 {
                 let v1 = positions[cell.v[0] as usize];
                 v1 + slide[ci] * (positions[cell.v[1] as usize] - v1)
