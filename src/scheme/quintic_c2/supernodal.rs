@@ -47,9 +47,10 @@ const PAR: Par = Par::Seq;
 pub const DROPPED_PIVOT: f64 = 1e150;
 
 /// Most values a supernodal factor may hold by default ([`solve_near`]'s `max_values`), with
-/// the zeros its dense blocks carry: in double-double (16 bytes each) 11.2 GB, under half of
-/// the 24 GB machines we run on (fandisk's joint group: 5.0e8 values).
-pub const MAX_VALUES: usize = 700_000_000;
+/// the zeros its dense blocks carry: in double-double (16 bytes each) 12.8 GB, on the 24 GB
+/// machines we run on. fandisk's joint group: 5.0e8 values (11.6 GB resident in all); on
+/// its hull with `flat_net_angle` and `straight_corners`, 7.26e8 (16.5 GB resident).
+pub const MAX_VALUES: usize = 800_000_000;
 
 /// The factor's arithmetic: f64, or double-double (faer's `fx128`, a pair hi + lo) for the
 /// groups whose f64 factor cannot tell nearly dependent rows from dependent ones (as
