@@ -918,16 +918,36 @@ fn net_angles(
             continue;
         }
         let v = tri.map(|i| hull.points[i as usize]);
-        let a = (0..3)
-            .map(|k| {
-                (v[(k + 1) % 3] - v[k])
-                    .angle_between(v[(k + 2) % 3] - v[k])
-                    .to_degrees()
-            })
+        let a = crate::common::corner_angles(v)
+            .into_iter()
             .fold(f64::INFINITY, f64::min);
         out.entry(f).or_default().push(a);
     }
     out
+}
+
+/// fandisk flattened as its pending quintic scene's best run is (6e-5 of the diagonal,
+/// regions of 20 faces or more), with its angle-weighted normals.
+fn flattened_fandisk() -> (Mesh, Vec<DVec3>) {
+    let (m, _) = fandisk();
+    let (m, _) = mesh::flatten::flatten_with(
+        &m,
+        mesh::flatten::FlattenOptions {
+            relative: 6e-5,
+            min_faces: 20,
+        },
+    );
+    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    (m, normals)
+}
+
+/// The flat nets' needles: their triangles with an angle below 5°.
+fn needles(h: &apatch::hull::simplicial::SimplicialHull) -> usize {
+    net_angles(h)
+        .values()
+        .flatten()
+        .filter(|&&a| a < 5.0)
+        .count()
 }
 
 /// `flat_net_angle`: fandisk flattened as its pending quintic scene is (6e-5 of the diagonal,
@@ -943,15 +963,7 @@ fn net_angles(
 #[test]
 fn flat_net_angle_removes_most_needles_of_flattened_fandisk() {
     use apatch::hull::simplicial::PointOrigin;
-    let (m, _) = fandisk();
-    let (m, _) = mesh::flatten::flatten_with(
-        &m,
-        mesh::flatten::FlattenOptions {
-            relative: 6e-5,
-            min_faces: 20,
-        },
-    );
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (m, normals) = flattened_fandisk();
     let plain = InnerOptions::default();
     let refined = InnerOptions {
         flat_net_angle: 20.0,
@@ -960,13 +972,6 @@ fn flat_net_angle_removes_most_needles_of_flattened_fandisk() {
     let (h0, r0) = inner::build_with_report(&m, &normals, &plain).unwrap();
     let (h1, r1) = inner::build_with_report(&m, &normals, &refined).unwrap();
     assert_eq!(r0.flat_nets, r1.flat_nets);
-    let needles = |h: &apatch::hull::simplicial::SimplicialHull| {
-        net_angles(h)
-            .values()
-            .flatten()
-            .filter(|&&a| a < 5.0)
-            .count()
-    };
     let (n0, n1) = (needles(&h0), needles(&h1));
     eprintln!(
         "needles {n0} -> {n1}, points {} -> {}",
@@ -1013,19 +1018,11 @@ fn flat_net_angle_removes_most_needles_of_flattened_fandisk() {
 /// edges 0.81 and 0.52 long beside edges of 0.019: the nets' triangles and the step (5') cells
 /// on them are needles that no inner point can mend (52 left with `flat_net_angle = 20`). Kept
 /// as corners of both nets (with a guard in each and cells, no corner triangles), no net
-/// triangle is below 5° any more, and the hull stays closed and of genus 0 with no more violations (`verify`, before the apex
-/// search) than without.
+/// triangle is below 5° any more, and the hull stays closed and of genus 0 with no more
+/// violations (`verify`, before the apex search) than without.
 #[test]
 fn straight_corners_split_fandisks_long_creases() {
-    let (m, _) = fandisk();
-    let (m, _) = mesh::flatten::flatten_with(
-        &m,
-        mesh::flatten::FlattenOptions {
-            relative: 6e-5,
-            min_faces: 20,
-        },
-    );
-    let normals = mesh::vertex_normals(&m, NormalMethod::Angle).unwrap();
+    let (m, normals) = flattened_fandisk();
     let refined = InnerOptions {
         flat_net_angle: 20.0,
         ..InnerOptions::default()
@@ -1039,13 +1036,6 @@ fn straight_corners_split_fandisks_long_creases() {
     // The two creases' inner vertices, one every 0.019: about 42 and 26; more on the shorter
     // creases between nets (measured 120 in all).
     assert!(r1.straight_corners >= 60, "{}", r1.straight_corners);
-    let needles = |h: &apatch::hull::simplicial::SimplicialHull| {
-        net_angles(h)
-            .values()
-            .flatten()
-            .filter(|&&a| a < 5.0)
-            .count()
-    };
     let (n0, n1) = (needles(&h0), needles(&h1));
     // Measured 52 -> 0.
     assert!(n0 > 40 && n1 == 0, "needles {n0} -> {n1}");

@@ -473,12 +473,8 @@ fn needle_details() {
                 continue;
             }
             let v = tri.map(|i| hull.points[i as usize]);
-            let a = (0..3)
-                .map(|k| {
-                    (v[(k + 1) % 3] - v[k])
-                        .angle_between(v[(k + 2) % 3] - v[k])
-                        .to_degrees()
-                })
+            let a = common::corner_angles(v)
+                .into_iter()
                 .fold(f64::INFINITY, f64::min);
             let e = per.entry(f).or_insert((0, f64::INFINITY, 0, 0.0));
             e.0 += 1;
@@ -510,13 +506,7 @@ fn needle_details() {
                     continue;
                 }
                 let v = tri.map(|i| hull.points[i as usize]);
-                let ang: Vec<String> = (0..3)
-                    .map(|k| {
-                        let a = v[(k + 1) % 3] - v[k];
-                        let b = v[(k + 2) % 3] - v[k];
-                        format!("{:.2}", a.angle_between(b).to_degrees())
-                    })
-                    .collect();
+                let ang = common::corner_angles(v).map(|a| format!("{a:.2}"));
                 let lens: Vec<String> = (0..3)
                     .map(|k| format!("{:.4}", (v[(k + 1) % 3] - v[k]).length()))
                     .collect();
@@ -537,13 +527,7 @@ fn needle_details() {
         }
         let t = hull.triangles[face as usize];
         let v = t.map(|i| hull.points[i as usize]);
-        let ang: Vec<String> = (0..3)
-            .map(|k| {
-                let a = v[(k + 1) % 3] - v[k];
-                let b = v[(k + 2) % 3] - v[k];
-                format!("{:.2}", a.angle_between(b).to_degrees())
-            })
-            .collect();
+        let ang = common::corner_angles(v).map(|a| format!("{a:.2}"));
         println!(
             "face {face} {t:?} elem {} origins {:?} angles {ang:?} factor {f:.1} (edge {:?})",
             hull.element[face as usize],

@@ -8,3 +8,12 @@ pub fn set_scheme(scene: &mut apatch::scene::Scene, key: &str, value: impl Into<
     };
     scheme.insert(key.into(), value.into());
 }
+
+/// The angles (degrees) of triangle `v` at its three corners, in order.
+pub fn corner_angles(v: [glam::DVec3; 3]) -> [f64; 3] {
+    std::array::from_fn(|k| {
+        (v[(k + 1) % 3] - v[k])
+            .angle_between(v[(k + 2) % 3] - v[k])
+            .to_degrees()
+    })
+}
