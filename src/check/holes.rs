@@ -19,7 +19,7 @@
 //! each shooting line is surface, so F may change sign on their boundary faces beyond it.
 
 use super::eval::PatchEval;
-use super::{HoleStats, Location};
+use super::{CrossedFace, HoleStats, Location};
 use crate::bb::index_of;
 use crate::complex::SheetRule;
 use glam::DVec3;
@@ -71,6 +71,21 @@ pub(super) fn measure(evals: &[PatchEval<'_>], boundary: &[(u32, u8)]) -> HoleSt
                     .insert(e.patch.role.name().to_string(), 1);
                 s.worst = v.depth;
                 s.crossing_at = Some(Location::new(&[e], v.point, None));
+                let tet = e.patch.tet_points();
+                let mut corners = [[0.0; 3]; 3];
+                for (c, k) in corners
+                    .iter_mut()
+                    .zip((0..4).filter(|&k| k != usize::from(opp)))
+                {
+                    *c = tet[k].to_array();
+                }
+                s.faces.push(CrossedFace {
+                    patch: e.id,
+                    element: format!("{} {}", e.patch.role.name(), e.patch.element),
+                    corners,
+                    depth: v.depth,
+                    point: v.point,
+                });
             } else if v.certified {
                 s.certified += 1;
             } else {
@@ -88,6 +103,8 @@ fn merge(a: HoleStats, b: HoleStats) -> HoleStats {
     } else {
         (a.worst, a.crossing_at)
     };
+    let mut faces = a.faces;
+    faces.extend(b.faces);
     let mut crossing_by_role = a.crossing_by_role;
     for (k, v) in b.crossing_by_role {
         *crossing_by_role.entry(k).or_insert(0) += v;
@@ -101,6 +118,7 @@ fn merge(a: HoleStats, b: HoleStats) -> HoleStats {
         skipped: a.skipped + b.skipped,
         worst,
         crossing_at,
+        faces,
     }
 }
 

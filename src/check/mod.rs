@@ -279,6 +279,27 @@ pub struct HoleStats {
     /// The worst crossing face's patch and a point of F's minority sign on it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub crossing_at: Option<Location>,
+    /// Every crossed face, in the order the boundary faces are examined (`apatch check --holes
+    /// FILE` writes them). Not in the
+    /// report's JSON: a model with thousands of holes would drown the measures.
+    #[serde(skip)]
+    pub faces: Vec<CrossedFace>,
+}
+
+/// One boundary face the surface crosses (a hole), for locating the holes of a model.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CrossedFace {
+    /// The patch whose face it is.
+    pub patch: usize,
+    /// The patch's hull role and mesh element, e.g. "face 12".
+    pub element: String,
+    /// The face's corners (world coordinates), in the patch's vertex order.
+    pub corners: [[f64; 3]; 3],
+    /// min(max F, −min F) on the face over the patch's largest weight: how deep the surface
+    /// reaches past the face.
+    pub depth: f64,
+    /// A point of the face where F has the minority sign.
+    pub point: [f64; 3],
 }
 
 /// Everything [`check`] measured, with the options used.

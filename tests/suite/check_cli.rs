@@ -583,3 +583,113 @@ fn scene_mesh(scene: &Path) -> (apatch::mesh::Mesh, Vec<DVec3>, toml::Table) {
     let vn = apatch::mesh::vertex_normals(&m, normals.parse().unwrap()).unwrap();
     (m, vn, scheme.clone())
 }
+
+/// `--holes FILE` lists every crossed boundary face. The rounded cylinder's quintic without
+/// `joint_stars` and `signs` crosses the outer faces of the edge tetrahedra at its caps' rims
+/// (128, docs/quintic.md, "Small reproducers"). Independent truth, from the exported patches:
+/// each listed face is a face of its patch that no other patch has, F has a strict sign at the
+/// listed point and the opposite one somewhere on a lattice of the face, and the list is as
+/// long as the report's count. A path in a missing directory is a clear error (exit 2) and
+/// leaves no file.
+#[test]
+fn holes_file_lists_every_crossed_face() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = tmp("holes_cylinder.toml");
+    let model = root.join("scenes/models/cylinder_rounded.obj");
+    let text = std::fs::read_to_string(root.join("scenes/paper1994/cylinder_rounded_quintic.toml"))
+        .unwrap()
+        .replace(
+            "\"../models/cylinder_rounded.obj\"",
+            &format!("{:?}", model.display().to_string()),
+        )
+        .replace("joint_stars = true", "")
+        .replace("signs = true", "");
+    std::fs::write(&scene, text).unwrap();
+    let patches = tmp("holes_cylinder.json");
+    let o = apatch(&[
+        "export",
+        "patches",
+        scene.to_str().unwrap(),
+        "-o",
+        patches.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let holes = tmp("holes_cylinder_holes.json");
+    let _ = std::fs::remove_file(&holes);
+    let o = apatch(&[
+        "check",
+        patches.to_str().unwrap(),
+        "--json",
+        "--holes",
+        holes.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
+    let report: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let count = report["holes"]["crossing"].as_u64().unwrap() as usize;
+    assert!(count > 0, "{report}");
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&holes).unwrap()).unwrap();
+    assert_eq!(doc["format"], "apatch-holes");
+    assert_eq!(doc["crossing"].as_u64().unwrap() as usize, count);
+    let faces = doc["faces"].as_array().unwrap();
+    assert_eq!(faces.len(), count);
+
+    let complex = apatch::complex_io::read_json_file(&patches).unwrap();
+    let key = |p: [f64; 3]| p.map(f64::to_bits);
+    let mut corner_sets = std::collections::HashMap::new();
+    for p in &complex.patches {
+        for skip in 0..4 {
+            let mut f: Vec<[u64; 3]> = (0..4)
+                .filter(|&k| k != skip)
+                .map(|k| key(p.tet[k]))
+                .collect();
+            f.sort_unstable();
+            *corner_sets.entry(f).or_insert(0) += 1;
+        }
+    }
+    let xyz = |v: &serde_json::Value| -> [f64; 3] {
+        let a = v.as_array().unwrap();
+        [0, 1, 2].map(|i| a[i].as_f64().unwrap())
+    };
+    for face in faces {
+        let patch = &complex.patches[face["patch"].as_u64().unwrap() as usize];
+        let corners: Vec<[f64; 3]> = face["corners"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(xyz)
+            .collect();
+        assert!(corners.iter().all(|c| patch.tet.contains(c)), "{face}");
+        let mut f: Vec<[u64; 3]> = corners.iter().map(|&c| key(c)).collect();
+        f.sort_unstable();
+        assert_eq!(corner_sets[&f], 1, "not a boundary face: {face}");
+        // 1e-12 of the largest weight: `check`'s own zero (far above the weights' rounding).
+        let zero = 1e-12 * patch.weights.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
+        let at = patch.value(DVec3::from_array(xyz(&face["point"])));
+        assert!(at.abs() > zero, "{face}: F = {at:e}");
+        let c = corners
+            .iter()
+            .map(|&c| DVec3::from_array(c))
+            .collect::<Vec<_>>();
+        let steps = 24;
+        let opposite = (0..=steps).any(|i| {
+            (0..=steps - i).any(|j| {
+                let (u, v) = (i as f64 / steps as f64, j as f64 / steps as f64);
+                let p = c[0] * (1.0 - u - v) + c[1] * u + c[2] * v;
+                patch.value(p) * at.signum() < -zero
+            })
+        });
+        assert!(opposite, "F keeps one sign on {face}");
+    }
+
+    let bad = tmp("no_such_dir").join("holes.json");
+    let o = apatch(&[
+        "check",
+        patches.to_str().unwrap(),
+        "--holes",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no_such_dir"), "{}", stderr(&o));
+    assert!(!bad.exists());
+}

@@ -294,6 +294,12 @@ fn torus_holes_are_found_and_closed() {
     let rb = check(&before.complex, &CheckOptions::default());
     assert!(rb.failures().contains(&"holes"), "{rb}");
     assert!(rb.holes.crossing >= 24, "{rb}");
+    // Every crossing is listed once, the worst one among them.
+    assert_eq!(rb.holes.faces.len(), rb.holes.crossing, "{rb}");
+    assert!(
+        rb.holes.faces.iter().any(|f| f.depth == rb.holes.worst),
+        "{rb}"
+    );
     let at = rb.holes.crossing_at.as_ref().unwrap();
     assert_eq!(at.patches.len(), 1, "{rb}");
 
@@ -305,6 +311,7 @@ fn torus_holes_are_found_and_closed() {
         "{ra}"
     );
     assert_eq!(ra.holes.crossing, 0, "{ra}");
+    assert!(ra.holes.faces.is_empty(), "{ra}");
     assert_eq!(ra.faces.overshared, 0, "{ra}");
     assert!(
         ra.sheets.j_lines > 0 && ra.sheets.j_multi_lines == 0,
