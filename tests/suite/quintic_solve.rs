@@ -206,3 +206,25 @@ fn quintic_solve_is_the_same_on_one_and_two_threads() {
         "the complex differs between one and two threads"
     );
 }
+
+/// `[scheme] sign_targets` is read as a number of medians (integers too), 0 by default, and
+/// a negative or non-numeric value is an error naming the scene and the key.
+#[test]
+fn sign_targets_key_is_read_and_checked() {
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert_eq!(read("").unwrap().sign_targets, 0.0);
+    assert_eq!(read("sign_targets = 1.5").unwrap().sign_targets, 1.5);
+    assert_eq!(read("sign_targets = 2").unwrap().sign_targets, 2.0);
+    for bad in [
+        "sign_targets = -1",
+        "sign_targets = \"x\"",
+        "sign_targets = 1e3",
+    ] {
+        let e = read(bad).unwrap_err().to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("sign_targets"),
+            "{e}"
+        );
+    }
+}

@@ -188,6 +188,9 @@ pub struct System {
     /// left singular vectors u of a star whose σ ≤ this × σ_max give conditions uᵀc = 0 on
     /// the weights solved before it, so the star does not amplify their noise by 1/σ.
     pub star_tau: f64,
+    /// Margin, in medians of their |target|, by which the targets of a group's signed weights
+    /// are moved into their sign before it is solved (`QuinticOptions::sign_targets`, 0 = off).
+    pub sign_targets: f64,
 }
 
 /// Builds the slots and the C1/C2 equations of every shared face.
@@ -297,6 +300,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         req,
         boundary,
         star_tau: 0.0,
+        sign_targets: 0.0,
     })
 }
 
@@ -1414,14 +1418,46 @@ impl System {
         eqs_of: &[Vec<u32>],
         pin: bool,
     ) -> GroupSolution {
+        if self.sign_targets > 0.0 {
+            self.move_targets_into_signs(g);
+        }
         let mut sol = solve_rows(&g.rows, g.unk.len(), &g.c, &g.tgt, g.scale);
         let (mut pinned, mut given_up) = (0, 0);
-        if pin && consistent(&sol, g.reach) {
+        // Beyond the in-house factor a group goes to the supernodal one, and every pin round
+        // would factor it again (fandisk's joint group: 17 minutes, 16.5 GB each).
+        if pin && g.unk.len() <= PIN_MAX_UNKNOWNS && consistent(&sol, g.reach) {
             let conds = self.sign_conditions(&g.unk, &g.col, value, known, stage_of, st, eqs_of);
             (pinned, given_up) =
                 pin_signs(&mut sol, &mut g.rows, &mut g.c, &conds, &g.tgt, g.scale);
         }
         (sol, pinned, given_up)
+    }
+
+    /// Moves the targets of `g`'s weights that Theorem 2.1 asks a sign of to at least
+    /// [`System::sign_targets`] × the median of their |target| on that side (the sign box of
+    /// `project`, applied to the targets instead of the solution).
+    fn move_targets_into_signs(&self, g: &mut Group) {
+        let signed: Vec<(usize, f64)> = g
+            .unk
+            .iter()
+            .enumerate()
+            .filter_map(|(j, &s)| {
+                let r = self.req[s as usize];
+                (r == 1 || r == -1).then_some((j, f64::from(r)))
+            })
+            .collect();
+        let mut size: Vec<f64> = signed.iter().map(|&(j, _)| g.tgt[j].abs()).collect();
+        if size.is_empty() {
+            return;
+        }
+        let mid = size.len() / 2;
+        let median = *size.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let margin = self.sign_targets * median;
+        for (j, sign) in signed {
+            if sign * g.tgt[j] < margin {
+                g.tgt[j] = sign * margin;
+            }
+        }
     }
 
     /// A solved star's near-null conditions (`tau`: `star_tau`): the left singular vectors u
@@ -1791,6 +1827,10 @@ fn dump_group(
         }
     }
 }
+
+/// Largest group (unknowns) whose signs are pinned: the in-house factor's row limit. Larger
+/// groups are solved by the supernodal factor, whose every pin round is another full factor.
+const PIN_MAX_UNKNOWNS: usize = cholesky::MAX_FACTOR_ROWS;
 
 /// Rounds of [`pin_signs`] per group.
 const PIN_ROUNDS: usize = 8;
