@@ -534,7 +534,7 @@ pub fn solve_near_ordered(
     let unit = UnitRows::new(rows, c);
     let (d, off) = normal_matrix::<f64>(&unit.rows, n);
     let drops = [DEPENDENT_PIVOT, RETRY_PIVOT];
-    let made = refine_near(&unit, target, tol, &drops, |drop| {
+    let made = refine_near(&unit, target, tol, &drops, false, |drop| {
         Some(factor(&d, &off, drop, ordering))
     });
     let (mut residual, mut x, mut dropped) = made.expect("the in-house factor is always made");
@@ -565,6 +565,22 @@ pub(super) trait NormalSolve {
         self.solve_normal(r);
         add_transposed(arows, r, x);
     }
+
+    /// Each p ← Π p, its projection onto the kept rows' null space (p − Âᵀ (Â Âᵀ)⁻¹ Â p).
+    fn project(&self, arows: &[Vec<(u32, f64)>], ps: &mut [Vec<f64>]) {
+        for p in ps.iter_mut() {
+            let mut r = minus_rows_times(arows, p);
+            self.correct(arows, &mut r, p);
+        }
+    }
+}
+
+/// −Â p.
+pub(super) fn minus_rows_times(arows: &[Vec<(u32, f64)>], p: &[f64]) -> Vec<f64> {
+    arows
+        .iter()
+        .map(|row| -row.iter().map(|&(j, a)| a * p[j as usize]).sum::<f64>())
+        .collect()
 }
 
 impl NormalSolve for Factor {
@@ -583,6 +599,7 @@ pub(super) fn refine_near<F: NormalSolve>(
     target: &[f64],
     tol: f64,
     drops: &[f64],
+    meet: bool,
     mut make: impl FnMut(f64) -> Option<(F, usize)>,
 ) -> Option<(f64, Vec<f64>, usize)> {
     let arows = &unit.rows;
@@ -639,7 +656,164 @@ pub(super) fn refine_near<F: NormalSolve>(
             }
         }
     }
+    if meet && best.0 > tol {
+        // The rows still missed are dropped ones, nearly dependent on the kept rows: met by a
+        // move in the kept rows' null space ([`meet_dropped`]), with the factor that gave `best`.
+        if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
+            let mut x = best.1.clone();
+            let got = meet_dropped(unit, f, &mut x, tol);
+            if got < best.0 {
+                best = (got, x, best.2);
+            }
+        }
+    }
     Some(best)
+}
+
+/// Most missed rows [`meet_dropped`] takes in one round (one solve with the factor each).
+const MEET_ROWS: usize = 32;
+/// Rounds of [`meet_dropped`].
+const MEET_ROUNDS: usize = 4;
+/// Rows [`meet_dropped`] takes in a round: those missed by more than this fraction of the
+/// largest miss (and the tolerance), so that each round takes the residual down by about this.
+const MEET_FRACTION: f64 = 1e-2;
+/// Smallest distance of a missed row from the kept rows' span that [`meet_dropped`] moves
+/// along: 1e-12 (a pivot of 1e-24) is far above the double-double projection's rounding
+/// (~1e-16 of the row) and far below the rows a drop threshold of 1e-15 drops (≤ 3.2e-8).
+const MEET_MIN_DISTANCE: f64 = 1e-12;
+/// Largest move of [`meet_dropped`] per round, in units of the largest |x|: a nearly dependent
+/// row whose data disagrees with its neighbours' would otherwise be met by an arbitrarily
+/// large move (its miss over its distance).
+const MEET_GROWTH: f64 = 10.0;
+
+/// Meets the rows a factor dropped but x misses: rows off the kept rows' span by δ (pivot δ²
+/// below the drop threshold) are missed by δ times x's distance from the exact solution along
+/// them. For the missed rows M (the worst [`MEET_ROWS`]), their projections p_m = Π a_m onto
+/// the kept rows' null space (one solve with the factor each, [`NormalSolve::correct`]) span
+/// the move: the least-norm dx in that span with a_m · dx = ĉ_m − a_m · x leaves every kept
+/// row as it was, so x + dx is the solution closest to the targets of the kept rows and M.
+/// A few rounds of refinement follow (the projections' rounding, amplified by 1/δ), and rounds
+/// repeat while the residual falls. Returns max |A x − c| (x is left at the best round).
+pub(super) fn meet_dropped<F: NormalSolve>(
+    unit: &UnitRows,
+    f: &F,
+    x: &mut Vec<f64>,
+    tol: f64,
+) -> f64 {
+    let arows = &unit.rows;
+    let (m, n) = (arows.len(), x.len());
+    let mut r = vec![0.0; m];
+    let mut res = unit.residual(x, &mut r);
+    let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
+    for round in 0..MEET_ROUNDS {
+        if res <= tol {
+            break;
+        }
+        let t = std::time::Instant::now();
+        // The worst rows first: those missed by more than a fraction of the largest miss.
+        let bar = tol.max(MEET_FRACTION * res);
+        let mut missed: Vec<usize> = (0..m)
+            .filter(|&i| r[i].abs() * unit.scale[i] > bar)
+            .collect();
+        missed.sort_by(|&a, &b| {
+            (r[b].abs() * unit.scale[b])
+                .total_cmp(&(r[a].abs() * unit.scale[a]))
+                .then(a.cmp(&b))
+        });
+        missed.truncate(MEET_ROWS);
+        let mut ps: Vec<Vec<f64>> = missed
+            .iter()
+            .map(|&i| {
+                let mut p = vec![0.0; n];
+                for &(j, a) in &arows[i] {
+                    p[j as usize] = a;
+                }
+                p
+            })
+            .collect();
+        // Twice: the first projection's Â p is rounded to ~1e-17 of the row, which is 1e-9 of
+        // a projection 1e-8 long; the second removes what that left in the kept span.
+        f.project(arows, &mut ps);
+        f.project(arows, &mut ps);
+        // Orthonormal basis q of the missed rows' projections (Gram–Schmidt, twice).
+        let mut q: Vec<Vec<f64>> = Vec::new();
+        let mut rows_used = Vec::new();
+        for (&i, mut p) in missed.iter().zip(ps) {
+            let norm0 = dot(&p, &p).sqrt();
+            if norm0 < MEET_MIN_DISTANCE {
+                continue;
+            }
+            for _ in 0..2 {
+                for qk in &q {
+                    let h = dot(qk, &p);
+                    p.iter_mut().zip(qk).for_each(|(v, w)| *v -= h * w);
+                }
+            }
+            let norm = dot(&p, &p).sqrt();
+            if norm < 1e-3 * norm0 {
+                continue;
+            }
+            p.iter_mut().for_each(|v| *v /= norm);
+            q.push(p);
+            rows_used.push(i);
+        }
+        if q.is_empty() {
+            break;
+        }
+        // a_i · (Q u) = ĉ_i − a_i · x for the rows used: a small dense system in u.
+        let k = q.len();
+        let mut b = vec![0.0; k * k];
+        for (a, &i) in rows_used.iter().enumerate() {
+            for (col, qk) in q.iter().enumerate() {
+                b[a * k + col] = arows[i].iter().map(|&(j, v)| v * qk[j as usize]).sum();
+            }
+        }
+        let rhs: Vec<f64> = rows_used.iter().map(|&i| r[i]).collect();
+        let u = super::dense::solve_near(&b, k, k, &rhs, &vec![0.0; k], 1e-10).x;
+        let reach = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let mut y = x.clone();
+        for (qk, uk) in q.iter().zip(&u) {
+            y.iter_mut().zip(qk).for_each(|(v, w)| *v += uk * w);
+        }
+        let moved = y
+            .iter()
+            .zip(x.iter())
+            .fold(0.0_f64, |a, (p, q)| a.max((p - q).abs()));
+        if moved.is_nan() || moved > MEET_GROWTH * reach.max(f64::MIN_POSITIVE) {
+            break;
+        }
+        let mut ry = vec![0.0; m];
+        let mut got = unit.residual(&y, &mut ry);
+        for _ in 0..REFINE {
+            if got <= tol {
+                break;
+            }
+            let mut z = y.clone();
+            f.correct(arows, &mut ry, &mut z);
+            let mut rz = vec![0.0; m];
+            let next = unit.residual(&z, &mut rz);
+            if next >= got {
+                break;
+            }
+            (y, ry, got) = (z, rz, next);
+        }
+        if trace {
+            eprintln!(
+                "quintic-c2 meet dropped, round {round}: {} rows missed, {k} met along their projections, move {moved:.2e}, residual {res:.2e} -> {got:.2e}, {:.1} s",
+                missed.len(),
+                t.elapsed().as_secs_f64()
+            );
+        }
+        if got.is_nan() || got >= res {
+            break;
+        }
+        (*x, r, res) = (y, ry, got);
+    }
+    res
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// One group's equations A x = c factored once (Â Âᵀ, dependent rows dropped at
