@@ -720,6 +720,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
                 .total_cmp(&(r[a].abs() * unit.scale[a]))
                 .then(a.cmp(&b))
         });
+        let all_missed = missed.len();
         missed.truncate(MEET_ROWS);
         let mut ps: Vec<Vec<f64>> = missed
             .iter()
@@ -738,6 +739,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
         // Orthonormal basis q of the missed rows' projections (Gram–Schmidt, twice).
         let mut q: Vec<Vec<f64>> = Vec::new();
         let mut rows_used = Vec::new();
+        let mut nearest = f64::INFINITY;
         for (&i, mut p) in missed.iter().zip(ps) {
             let norm0 = dot(&p, &p).sqrt();
             if norm0 < MEET_MIN_DISTANCE {
@@ -756,6 +758,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             p.iter_mut().for_each(|v| *v /= norm);
             q.push(p);
             rows_used.push(i);
+            nearest = nearest.min(norm0);
         }
         if q.is_empty() {
             break;
@@ -799,7 +802,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
         }
         if trace {
             eprintln!(
-                "quintic-c2 meet dropped, round {round}: {} rows missed, {k} met along their projections, move {moved:.2e}, residual {res:.2e} -> {got:.2e}, {:.1} s",
+                "quintic-c2 meet dropped, round {round}: {all_missed} rows missed, {k} of the worst {} met along their projections (nearest {nearest:.1e} off the kept span), move {moved:.2e}, residual {res:.2e} -> {got:.2e}, {:.1} s",
                 missed.len(),
                 t.elapsed().as_secs_f64()
             );
