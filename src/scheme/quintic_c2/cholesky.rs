@@ -1261,19 +1261,34 @@ pub(super) mod tests {
             a[(m - 1) * n + j] = a[2 * n + j] - a[3 * n + j];
         }
         let x0: Vec<f64> = (0..n).map(|_| lcg(&mut s)).collect();
-        let c: Vec<f64> = (0..m)
-            .map(|i| (0..n).map(|j| a[i * n + j] * x0[j]).sum())
-            .collect();
+        let c = times(&a, m, n, &x0);
         let target: Vec<f64> = (0..n).map(|_| lcg(&mut s)).collect();
-        let rows: Vec<Row> = (0..m)
+        let rows = sparse_rows(&a, m, n);
+        (a, rows, c, target)
+    }
+
+    /// A x for the `m`×`n` row-major A: the right-hand side that makes x a solution.
+    pub(in crate::scheme::quintic_c2) fn times(
+        a: &[f64],
+        m: usize,
+        n: usize,
+        x: &[f64],
+    ) -> Vec<f64> {
+        (0..m)
+            .map(|i| (0..n).map(|j| a[i * n + j] * x[j]).sum())
+            .collect()
+    }
+
+    /// The nonzeros of the `m`×`n` row-major A as sparse rows.
+    pub(in crate::scheme::quintic_c2) fn sparse_rows(a: &[f64], m: usize, n: usize) -> Vec<Row> {
+        (0..m)
             .map(|i| {
                 (0..n)
                     .filter(|&j| a[i * n + j] != 0.0)
                     .map(|j| (j, a[i * n + j]))
                     .collect()
             })
-            .collect();
-        (a, rows, c, target)
+            .collect()
     }
 
     /// Agrees with the dense pivoted QR (an independent factorisation) on random

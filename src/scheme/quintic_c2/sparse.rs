@@ -156,6 +156,7 @@ pub fn solve_near(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scheme::quintic_c2::cholesky::tests::{sparse_rows, times};
 
     /// Agrees with the dense solve on a random underdetermined, rank-deficient but consistent
     /// system (two dependent rows), seeded.
@@ -183,18 +184,9 @@ mod tests {
             a[(m - 1) * n + j] = a[2 * n + j] - a[3 * n + j];
         }
         let x0: Vec<f64> = (0..n).map(|_| rnd()).collect();
-        let c: Vec<f64> = (0..m)
-            .map(|i| (0..n).map(|j| a[i * n + j] * x0[j]).sum())
-            .collect();
+        let c = times(&a, m, n, &x0);
         let target: Vec<f64> = (0..n).map(|_| rnd()).collect();
-        let rows: Vec<Row> = (0..m)
-            .map(|i| {
-                (0..n)
-                    .filter(|&j| a[i * n + j] != 0.0)
-                    .map(|j| (j, a[i * n + j]))
-                    .collect()
-            })
-            .collect();
+        let rows = sparse_rows(&a, m, n);
         let d = crate::scheme::quintic_c2::dense::solve_near(&a, m, n, &c, &target, 1e-11);
         let s = solve_near(&rows, n, &c, &target, 1e-13, 10_000);
         // Consistent system: rounding-level residual, as asked.

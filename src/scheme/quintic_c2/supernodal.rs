@@ -354,7 +354,7 @@ pub fn solve_near(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scheme::quintic_c2::cholesky::tests::system;
+    use crate::scheme::quintic_c2::cholesky::tests::{sparse_rows, system, times};
 
     /// Reads a group written by `APATCH_SOLVE_DUMP` (`system::dump_group`'s format): rows, n,
     /// c, target, scale.
@@ -538,6 +538,14 @@ mod tests {
         vec![vec![(0, 1.0)], vec![(0, t.cos()), (1, t.sin())]]
     }
 
+    /// [`pair`] as the solves' sparse rows.
+    fn pair_rows(t: f64) -> Vec<Row> {
+        pair(t)
+            .into_iter()
+            .map(|r| r.into_iter().map(|(j, a)| (j as usize, a)).collect())
+            .collect()
+    }
+
     /// The double-double factor resolves pivots far below f64's rounding: at t = 1e-9 the
     /// pivot is 1e-18 (f64 forms 1 − cos² t at its rounding, 1e-16), kept at a threshold of
     /// 1e-19 and dropped at 1e-17.
@@ -565,10 +573,7 @@ mod tests {
     #[test]
     fn nearly_dependent_rows_are_met_in_double_double() {
         let t = 1e-7_f64;
-        let rows: Vec<Row> = pair(t)
-            .into_iter()
-            .map(|r| r.into_iter().map(|(j, a)| (j as usize, a)).collect())
-            .collect();
+        let rows = pair_rows(t);
         let c = [1.0, t.cos() + 0.25 * t.sin()];
         let s = solve_near(&rows, 2, &c, &[0.0, 0.0], 1e-13, MAX_VALUES).expect("tiny");
         assert!(s.residual <= 1e-13, "{:e}", s.residual);
@@ -600,17 +605,8 @@ mod tests {
                 }
             }
             let x0: Vec<f64> = (0..n).map(|_| lcg(&mut s)).collect();
-            let c: Vec<f64> = (0..m)
-                .map(|i| (0..n).map(|j| a[i * n + j] * x0[j]).sum())
-                .collect();
-            let rows: Vec<Row> = (0..m)
-                .map(|i| {
-                    (0..n)
-                        .filter(|&j| a[i * n + j] != 0.0)
-                        .map(|j| (j, a[i * n + j]))
-                        .collect()
-                })
-                .collect();
+            let c = times(&a, m, n, &x0);
+            let rows = sparse_rows(&a, m, n);
             let s = solve_near(&rows, n, &c, &target, 1e-13, MAX_VALUES).expect("small");
             // Dropping the two rows alone would miss them by ~1e-9 × the move along them (O(1)).
             assert!(s.residual <= 1e-13, "({m}×{n}) residual {:e}", s.residual);
@@ -629,10 +625,7 @@ mod tests {
     #[test]
     fn contradicting_dropped_rows_are_not_met_by_huge_moves() {
         let t = 1e-11_f64;
-        let rows: Vec<Row> = pair(t)
-            .into_iter()
-            .map(|r| r.into_iter().map(|(j, a)| (j as usize, a)).collect())
-            .collect();
+        let rows = pair_rows(t);
         let c = [1.0, t.cos() + 1e-3];
         let s = solve_near(&rows, 2, &c, &[0.0, 0.0], 1e-13, MAX_VALUES).expect("tiny");
         assert!(s.x.iter().all(|v| v.abs() < 10.0), "{:?}", s.x);
