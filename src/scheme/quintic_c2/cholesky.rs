@@ -673,7 +673,10 @@ pub(super) fn refine_near<F: NormalSolve>(
 /// Most missed rows [`meet_dropped`] takes in one round (one solve with the factor each).
 const MEET_ROWS: usize = 32;
 /// Rounds of [`meet_dropped`].
-const MEET_ROUNDS: usize = 4;
+const MEET_ROUNDS: usize = 6;
+/// Most projections [`meet_dropped`] keeps over its rounds: each is a vector of all the
+/// unknowns (fandisk's joint group: 1.9M, so 160 of them are 2.4 GB beside its 12 GB factor).
+const MEET_BASIS: usize = 160;
 /// Rows [`meet_dropped`] takes in a round: those missed by more than this fraction of the
 /// largest miss (and the tolerance), so that each round takes the residual down by about this.
 const MEET_FRACTION: f64 = 1e-2;
@@ -681,6 +684,11 @@ const MEET_FRACTION: f64 = 1e-2;
 /// along: 1e-12 (a pivot of 1e-24) is far above the double-double projection's rounding
 /// (~1e-16 of the row) and far below the rows a drop threshold of 1e-15 drops (≤ 3.2e-8).
 const MEET_MIN_DISTANCE: f64 = 1e-12;
+/// A unit row sees a unit direction q of the kept rows' null space when |a · q| is above this:
+/// a kept row sees only q's rounding (~1e-16 after two projections), a dropped row within
+/// [`MEET_MIN_DISTANCE`] of the span sees at most that distance, and rows seeing less than
+/// 1e-14 of a move of O(1) miss by less than the tolerances asked (1e-13).
+const MEET_SEEN: f64 = 1e-14;
 /// Largest move of [`meet_dropped`] per round, in units of the largest |x|: a nearly dependent
 /// row whose data disagrees with its neighbours' would otherwise be met by an arbitrarily
 /// large move (its miss over its distance).
@@ -688,12 +696,16 @@ const MEET_GROWTH: f64 = 10.0;
 
 /// Meets the rows a factor dropped but x misses: rows off the kept rows' span by δ (pivot δ²
 /// below the drop threshold) are missed by δ times x's distance from the exact solution along
-/// them. For the missed rows M (the worst [`MEET_ROWS`]), their projections p_m = Π a_m onto
-/// the kept rows' null space (one solve with the factor each, [`NormalSolve::correct`]) span
-/// the move: the least-norm dx in that span with a_m · dx = ĉ_m − a_m · x leaves every kept
-/// row as it was, so x + dx is the solution closest to the targets of the kept rows and M.
-/// A few rounds of refinement follow (the projections' rounding, amplified by 1/δ), and rounds
-/// repeat while the residual falls. Returns max |A x − c| (x is left at the best round).
+/// them. Each round takes the worst missed rows (at most [`MEET_ROWS`]) and projects them onto
+/// the kept rows' null space, p = Π a (a multi-column solve with the factor,
+/// [`NormalSolve::project`]); the projections of every round so far (an orthonormal basis Q,
+/// at most [`MEET_BASIS`]) span the move. A move dx = Q u leaves every kept row as it was but
+/// is seen by every dropped row near the span, not only by the rows it was made for, so u is
+/// the least-squares fit of all the rows that see Q ([`MEET_SEEN`]) in their own scale:
+/// a round meets its new rows without undoing the earlier rounds' or missing the others more.
+/// A few rounds of refinement follow each move (the projections' rounding, amplified by 1/δ);
+/// a round that does not lower the residual is not taken, but its rows stay in Q for the next.
+/// Returns max |A x − c| (x is left at the best round).
 pub(super) fn meet_dropped<F: NormalSolve>(
     unit: &UnitRows,
     f: &F,
@@ -705,15 +717,19 @@ pub(super) fn meet_dropped<F: NormalSolve>(
     let mut r = vec![0.0; m];
     let mut res = unit.residual(x, &mut r);
     let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
+    // Q, the rows whose projections made it, and for each q the rows that see it (a · q).
+    let mut q: Vec<Vec<f64>> = Vec::new();
+    let mut used = vec![false; m];
+    let mut seen: Vec<Vec<(usize, f64)>> = Vec::new();
     for round in 0..MEET_ROUNDS {
-        if res <= tol {
+        if res <= tol || q.len() >= MEET_BASIS {
             break;
         }
         let t = std::time::Instant::now();
-        // The worst rows first: those missed by more than a fraction of the largest miss.
+        // The worst rows not used yet: those missed by more than a fraction of the largest miss.
         let bar = tol.max(MEET_FRACTION * res);
         let mut missed: Vec<usize> = (0..m)
-            .filter(|&i| r[i].abs() * unit.scale[i] > bar)
+            .filter(|&i| r[i].abs() * unit.scale[i] > bar && !used[i])
             .collect();
         missed.sort_by(|&a, &b| {
             (r[b].abs() * unit.scale[b])
@@ -721,7 +737,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
                 .then(a.cmp(&b))
         });
         let all_missed = missed.len();
-        missed.truncate(MEET_ROWS);
+        missed.truncate(MEET_ROWS.min(MEET_BASIS - q.len()));
         let mut ps: Vec<Vec<f64>> = missed
             .iter()
             .map(|&i| {
@@ -736,9 +752,8 @@ pub(super) fn meet_dropped<F: NormalSolve>(
         // a projection 1e-8 long; the second removes what that left in the kept span.
         f.project(arows, &mut ps);
         f.project(arows, &mut ps);
-        // Orthonormal basis q of the missed rows' projections (Gram–Schmidt, twice).
-        let mut q: Vec<Vec<f64>> = Vec::new();
-        let mut rows_used = Vec::new();
+        // Extend the orthonormal basis Q (Gram–Schmidt against all of it, twice).
+        let mut added = 0;
         let mut nearest = f64::INFINITY;
         for (&i, mut p) in missed.iter().zip(ps) {
             let norm0 = dot(&p, &p).sqrt();
@@ -756,23 +771,49 @@ pub(super) fn meet_dropped<F: NormalSolve>(
                 continue;
             }
             p.iter_mut().for_each(|v| *v /= norm);
+            seen.push(
+                arows
+                    .par_iter()
+                    .enumerate()
+                    .filter_map(|(i, row)| {
+                        let a: f64 = row.iter().map(|&(j, v)| v * p[j as usize]).sum();
+                        (a.abs() > MEET_SEEN).then_some((i, a))
+                    })
+                    .collect(),
+            );
             q.push(p);
-            rows_used.push(i);
+            used[i] = true;
+            added += 1;
             nearest = nearest.min(norm0);
         }
-        if q.is_empty() {
+        if added == 0 {
             break;
         }
-        // a_i · (Q u) = ĉ_i − a_i · x for the rows used: a small dense system in u.
-        let k = q.len();
-        let mut b = vec![0.0; k * k];
-        for (a, &i) in rows_used.iter().enumerate() {
-            for (col, qk) in q.iter().enumerate() {
-                b[a * k + col] = arows[i].iter().map(|&(j, v)| v * qk[j as usize]).sum();
+        // min Σ s_i² (a_i · Q u − r_i)² over the rows S that see Q (s_i their scale).
+        let mut rows_seen: Vec<usize> = seen.iter().flatten().map(|t| t.0).collect();
+        rows_seen.sort_unstable();
+        rows_seen.dedup();
+        let (k, ms) = (q.len(), rows_seen.len());
+        let mut bt = vec![0.0; k * ms];
+        for (col, list) in seen.iter().enumerate() {
+            for &(i, a) in list {
+                let s = rows_seen.binary_search(&i).expect("a seen row");
+                bt[col * ms + s] = a * unit.scale[i];
             }
         }
-        let rhs: Vec<f64> = rows_used.iter().map(|&i| r[i]).collect();
-        let u = super::dense::solve_near(&b, k, k, &rhs, &vec![0.0; k], 1e-10).x;
+        let rhs: Vec<f64> = rows_seen.iter().map(|&i| r[i] * unit.scale[i]).collect();
+        let u = if ms >= k {
+            super::dense::least_squares(&bt, k, ms, &rhs, 1e-10)
+        } else {
+            // Fewer rows than directions: the least-norm u that meets them all.
+            let mut b = vec![0.0; ms * k];
+            for col in 0..k {
+                for s in 0..ms {
+                    b[s * k + col] = bt[col * ms + s];
+                }
+            }
+            super::dense::solve_near(&b, ms, k, &rhs, &vec![0.0; k], 1e-10).x
+        };
         let reach = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         let mut y = x.clone();
         for (qk, uk) in q.iter().zip(&u) {
@@ -783,7 +824,10 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             .zip(x.iter())
             .fold(0.0_f64, |a, (p, q)| a.max((p - q).abs()));
         if moved.is_nan() || moved > MEET_GROWTH * reach.max(f64::MIN_POSITIVE) {
-            break;
+            if trace {
+                eprintln!("quintic-c2 meet dropped, round {round}: move {moved:.2e} refused");
+            }
+            continue;
         }
         let mut ry = vec![0.0; m];
         let mut got = unit.residual(&y, &mut ry);
@@ -802,15 +846,14 @@ pub(super) fn meet_dropped<F: NormalSolve>(
         }
         if trace {
             eprintln!(
-                "quintic-c2 meet dropped, round {round}: {all_missed} rows missed, {k} of the worst {} met along their projections (nearest {nearest:.1e} off the kept span), move {moved:.2e}, residual {res:.2e} -> {got:.2e}, {:.1} s",
+                "quintic-c2 meet dropped, round {round}: {all_missed} rows missed, {added} of the worst {} added (nearest {nearest:.1e} off the kept span), {k} directions fitted to the {ms} rows that see them, move {moved:.2e}, residual {res:.2e} -> {got:.2e}, {:.1} s",
                 missed.len(),
                 t.elapsed().as_secs_f64()
             );
         }
-        if got.is_nan() || got >= res {
-            break;
+        if got < res {
+            (*x, r, res) = (y, ry, got);
         }
-        (*x, r, res) = (y, ry, got);
     }
     res
 }

@@ -141,6 +141,45 @@ pub fn solve_near(
     Solution { x, rank, residual }
 }
 
+/// The least-squares solution of B u ≈ c for B given by its columns as the rows of `bt`
+/// (`n`×`m`, row-major: column j of B is `bt[j*m..(j+1)*m]`, m ≥ n rows): u minimizes
+/// |B u − c|. Columns whose pivot falls below `rank_tol` × the largest column norm are left out
+/// (their u is 0), so nearly parallel columns do not give huge, cancelling coefficients.
+#[must_use]
+pub fn least_squares(bt: &[f64], n: usize, m: usize, c: &[f64], rank_tol: f64) -> Vec<f64> {
+    debug_assert_eq!(bt.len(), n * m);
+    debug_assert_eq!(c.len(), m);
+    // factor(bt) is the pivoted QR of M = btᵀ = B: B Π = Q R.
+    let PivotedQr {
+        cols,
+        perm,
+        reflectors,
+        rank,
+    } = factor(bt, n, m, rank_tol);
+    // Qᵀ c = H_{r−1} … H_0 c.
+    let mut y = c.to_vec();
+    for (k, (v, beta)) in reflectors.iter().enumerate() {
+        let s: f64 = beta * v.iter().zip(&y[k..]).map(|(a, b)| a * b).sum::<f64>();
+        for (yi, vi) in y[k..].iter_mut().zip(v) {
+            *yi -= s * vi;
+        }
+    }
+    // R w = (Qᵀ c)[..rank], R[i][k] = cols[k][i]; u = Π w.
+    let mut w = vec![0.0; rank];
+    for p in (0..rank).rev() {
+        let mut s = y[p];
+        for (j, wj) in w.iter().enumerate().skip(p + 1) {
+            s -= cols[j][p] * wj;
+        }
+        w[p] = s / cols[p][p];
+    }
+    let mut u = vec![0.0; n];
+    for (p, wp) in w.into_iter().enumerate() {
+        u[perm[p]] = wp;
+    }
+    u
+}
+
 /// The dependencies among the rows of A (`m`×`n`, row-major): vectors y with yᵀA = 0, one per
 /// row beyond the numerical rank (pivots below `rank_tol` × the largest row norm, as in
 /// [`solve_near`]). A x = c is consistent exactly when yᵀc = 0 for each of them.
@@ -360,6 +399,47 @@ mod tests {
         // Inconsistent dependent row shows in the residual.
         let s = solve_near(&a, 2, 2, &[2.0, 5.0], &[0.0, 0.0], 1e-12);
         assert!(s.residual > 0.1);
+    }
+
+    /// Least squares on a tall random B: the residual B u − c is orthogonal to B's columns
+    /// (the normal equations hold), and a c in B's range is fitted exactly; a repeated column
+    /// is left out (u 0 there) with the same fit.
+    #[test]
+    fn least_squares_fits_and_skips_repeated_columns() {
+        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
+        let (m, n) = (40, 6);
+        let mut seed = 3_u64;
+        let mut bt: Vec<f64> = (0..n * m).map(|_| lcg(&mut seed)).collect();
+        let c: Vec<f64> = (0..m).map(|_| lcg(&mut seed)).collect();
+        let times = |bt: &[f64], n: usize, u: &[f64]| -> Vec<f64> {
+            (0..m)
+                .map(|i| (0..n).map(|j| bt[j * m + i] * u[j]).sum())
+                .collect()
+        };
+        let u = least_squares(&bt, n, m, &c, 1e-12);
+        let r: Vec<f64> = times(&bt, n, &u)
+            .iter()
+            .zip(&c)
+            .map(|(a, b)| a - b)
+            .collect();
+        for j in 0..n {
+            let g: f64 = (0..m).map(|i| bt[j * m + i] * r[i]).sum();
+            // Rounding of a 40×6 QR with O(1) entries (|r| ~ 5, |B| ~ 4).
+            assert!(g.abs() < 1e-12, "column {j}: Bᵀr = {g:e}");
+        }
+        let u0 = [1.0, -2.0, 0.5, 3.0, 0.0, -1.0];
+        let exact = times(&bt, n, &u0);
+        let u = least_squares(&bt, n, m, &exact, 1e-12);
+        for (a, b) in u.iter().zip(u0) {
+            // Rounding only (B is well conditioned).
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+        // Column 6 repeats column 0: one of the two gets 0 and the fit is the same.
+        bt.extend_from_within(0..m);
+        let u = least_squares(&bt, n + 1, m, &exact, 1e-12);
+        assert!(u[0] == 0.0 || u[n] == 0.0, "{u:?}");
+        let fit = times(&bt, n + 1, &u);
+        assert!(fit.iter().zip(&exact).all(|(a, b)| (a - b).abs() < 1e-12));
     }
 
     /// U·diag(3, 1e-9, 0)·Vᵀ (row-major) with U, V rotations: U (rotating axes 0, 1), the

@@ -620,6 +620,54 @@ mod tests {
         }
     }
 
+    /// Many more nearly dependent rows than one round of `cholesky::meet_dropped` takes
+    /// (`MEET_ROWS` = 32), each 1e-9 to 1e-11 off the span of the others and seeing the moves
+    /// made for the rest: the rounds keep their earlier directions and fit every row that sees
+    /// them, so all are met, at the dense pivoted QR's solution.
+    #[test]
+    fn many_nearly_dependent_rows_are_met_over_rounds() {
+        let (base, near, n) = (240, 90, 400);
+        let mut s = 23_u64;
+        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
+        let pick = |s: &mut u64, k: usize| ((lcg(s) + 1.0) * 0.5 * k as f64) as usize % k;
+        let m = base + near;
+        let mut a = vec![0.0; m * n];
+        for i in 0..base {
+            for _ in 0..6 {
+                let j = pick(&mut s, n);
+                a[i * n + j] = lcg(&mut s);
+            }
+        }
+        // Each near row: two base rows that share a neighbourhood, plus 1e-9..1e-11 off them.
+        for k in 0..near {
+            let i = base + k;
+            let (r0, r1) = (pick(&mut s, base), pick(&mut s, base));
+            let w = lcg(&mut s);
+            for j in 0..n {
+                a[i * n + j] = a[r0 * n + j] + w * a[r1 * n + j];
+            }
+            let delta = 10f64.powf(-9.0 - 2.0 * (k as f64 / near as f64));
+            for _ in 0..3 {
+                let j = pick(&mut s, n);
+                a[i * n + j] += delta * lcg(&mut s);
+            }
+        }
+        let x0: Vec<f64> = (0..n).map(|_| lcg(&mut s)).collect();
+        let target: Vec<f64> = (0..n).map(|_| lcg(&mut s)).collect();
+        let c = times(&a, m, n, &x0);
+        let rows = sparse_rows(&a, m, n);
+        let got = solve_near(&rows, n, &c, &target, 1e-13, MAX_VALUES).expect("small");
+        // Without the new directions each near row is missed by its δ times the move along it.
+        assert!(got.residual <= 1e-13, "residual {:e}", got.residual);
+        let d = crate::scheme::quintic_c2::dense::solve_near(&a, m, n, &c, &target, 1e-13);
+        assert_eq!(d.rank, m, "QR keeps every near row");
+        for (x, y) in got.x.iter().zip(&d.x) {
+            // The data's rounding (1e-16) amplified by 1/δ ≤ 1e11 along the nearest rows is
+            // 1e-5; 1e-3 is a margin over that.
+            assert!((x - y).abs() < 1e-3, "{x} vs {y}");
+        }
+    }
+
     /// A dropped row whose data contradict the kept rows (1e-3 off, at distance 1e-11 from
     /// their span: met only by a move of 1e8) is left missed rather than met by that move.
     #[test]
