@@ -802,6 +802,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             }
         }
         let rhs: Vec<f64> = rows_seen.iter().map(|&i| r[i] * unit.scale[i]).collect();
+        let tf = std::time::Instant::now();
         let u = if ms >= k {
             super::dense::least_squares(&bt, k, ms, &rhs, 1e-10)
         } else {
@@ -814,6 +815,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             }
             super::dense::solve_near(&b, ms, k, &rhs, &vec![0.0; k], 1e-10).x
         };
+        let fit_time = tf.elapsed().as_secs_f64();
         let reach = x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         let mut y = x.clone();
         for (qk, uk) in q.iter().zip(&u) {
@@ -831,6 +833,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
         }
         let mut ry = vec![0.0; m];
         let mut got = unit.residual(&y, &mut ry);
+        let moved_to = got;
         for _ in 0..REFINE {
             if got <= tol {
                 break;
@@ -845,9 +848,28 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             (y, ry, got) = (z, rz, next);
         }
         if trace {
+            // What the fit promised on the rows that see Q, what the move gave before the
+            // refinement, and the worst row after: one of Q's, one that sees Q, or neither.
+            let fitted = (0..ms).fold(0.0_f64, |a, s| {
+                let e = (0..k).map(|col| bt[col * ms + s] * u[col]).sum::<f64>() - rhs[s];
+                a.max(e.abs())
+            });
+            let worst = (0..m)
+                .max_by(|&a, &b| {
+                    (ry[a].abs() * unit.scale[a]).total_cmp(&(ry[b].abs() * unit.scale[b]))
+                })
+                .unwrap_or(0);
+            let role = if used[worst] {
+                "one of Q's rows"
+            } else if rows_seen.binary_search(&worst).is_ok() {
+                "a row that sees Q"
+            } else {
+                "a row that does not see Q"
+            };
             eprintln!(
-                "quintic-c2 meet dropped, round {round}: {all_missed} rows missed, {added} of the worst {} added (nearest {nearest:.1e} off the kept span), {k} directions fitted to the {ms} rows that see them, move {moved:.2e}, residual {res:.2e} -> {got:.2e}, {:.1} s",
+                "quintic-c2 meet dropped, round {round}: {all_missed} rows missed, {added} of the worst {} added (nearest {nearest:.1e} off the kept span), {k} directions fitted to the {ms} rows that see them (fit {fitted:.2e}, {:.1} s), move {moved:.2e}, residual {res:.2e} -> {moved_to:.2e} -> {got:.2e} refined (worst: row {worst}, {role}), {:.1} s",
                 missed.len(),
+                fit_time,
                 t.elapsed().as_secs_f64()
             );
         }
