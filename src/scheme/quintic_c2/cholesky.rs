@@ -675,7 +675,8 @@ const MEET_ROWS: usize = 32;
 /// Rounds of [`meet_dropped`].
 const MEET_ROUNDS: usize = 6;
 /// Most projections [`meet_dropped`] keeps over its rounds: each is a vector of all the
-/// unknowns (fandisk's joint group: 1.9M, so 160 of them are 2.4 GB beside its 12 GB factor).
+/// unknowns (fandisk's joint group: 1.83M, so 160 of them are 2.3 GB beside its 11.6 GB
+/// double-double factor; 113 of them took its run from 16.7 to 18.1 GB resident).
 const MEET_BASIS: usize = 160;
 /// Rows [`meet_dropped`] takes in a round: those missed by more than this fraction of the
 /// largest miss (and the tolerance), so that each round takes the residual down by about this.
