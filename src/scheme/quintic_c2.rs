@@ -105,6 +105,13 @@ pub struct QuinticOptions {
     /// so targets inside the sign box leave fewer weights off their sign at no extra solve:
     /// the one lever on groups too large to pin (fandisk's joint group: holes 9016 → 3533).
     pub sign_targets: f64,
+    /// With `signs`: rounds of alternating projections between Theorem 2.1's signs and the
+    /// equations in each group too large to pin (beyond the in-house factor, as fandisk's
+    /// joint group), all with the group's one factor (0 = off, the default). The signed
+    /// weights are clamped into the box of `sign_targets` (or 1) medians of their |target| and
+    /// moved back onto the equations, round after round; the round with the fewest weights
+    /// off their sign is kept.
+    pub joint_sign_rounds: usize,
     /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2, and the
     /// stars one ring in) of the tetrahedra around every boundary face the surface crosses (a
     /// hole) and every patch it crosses twice along a j-line (a j-sheet), with all their
@@ -148,6 +155,7 @@ impl Default for QuinticOptions {
             joint_stars: false,
             star_tau: 0.0,
             sign_targets: 0.0,
+            joint_sign_rounds: 0,
             relax_stars: true,
             consistent_stars: false,
             hessian_signs: false,
@@ -244,6 +252,17 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "joint_sign_rounds" => {
+                    o.joint_sign_rounds = v
+                        .as_integer()
+                        .and_then(|i| usize::try_from(i).ok())
+                        .ok_or_else(|| {
+                            anyhow::anyhow!(
+                                "{}: `scheme.joint_sign_rounds` must be a whole number ≥ 0, got {v}",
+                                scene.display()
+                            )
+                        })?;
+                }
                 "signs" => o.signs = flag()?,
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
@@ -256,7 +275,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -385,6 +404,7 @@ pub fn build_prepared(
     let mut sys = system::assemble(&tets, np)?;
     sys.star_tau = options.star_tau;
     sys.sign_targets = options.sign_targets;
+    sys.joint_sign_rounds = options.joint_sign_rounds;
     if !zero_points.is_empty() {
         sys.require_zero_bases(&tets, &flat::zero_triangles(hull, zero_points));
     }

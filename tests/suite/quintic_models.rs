@@ -15,7 +15,7 @@ use std::path::Path;
 /// as they are, `BALANCE=1` the balanced edge points and `SIGN_ROUNDS` the sign projection's
 /// rounds, `SIGN_PROGRAM=1` its linear program (HiGHS with the feature `highs`, else the
 /// interior point method), `TANGENT_CLEARANCE` the quintic's `tangent_clearance`,
-/// `SIGN_TARGETS` its `sign_targets` (to explore).
+/// `SIGN_TARGETS` its `sign_targets`, `JOINT_SIGN_ROUNDS` its `joint_sign_rounds` (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -46,6 +46,10 @@ fn options() -> QuinticOptions {
         repair_hessians: std::env::var("REPAIR_HESSIANS").map_or(true, |s| s != "0"),
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
         balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
+        joint_sign_rounds: std::env::var("JOINT_SIGN_ROUNDS")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(0),
         sign_rounds: std::env::var("SIGN_ROUNDS")
             .ok()
             .and_then(|x| x.parse().ok())

@@ -207,6 +207,30 @@ fn quintic_solve_is_the_same_on_one_and_two_threads() {
     );
 }
 
+/// `[scheme] joint_sign_rounds` is a whole number of rounds, 0 by default; anything else is
+/// an error naming the scene and the key.
+#[test]
+fn joint_sign_rounds_key_is_read_and_checked() {
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert_eq!(read("").unwrap().joint_sign_rounds, 0);
+    assert_eq!(
+        read("joint_sign_rounds = 20").unwrap().joint_sign_rounds,
+        20
+    );
+    for bad in [
+        "joint_sign_rounds = -1",
+        "joint_sign_rounds = 1.5",
+        "joint_sign_rounds = \"x\"",
+    ] {
+        let e = read(bad).unwrap_err().to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("joint_sign_rounds"),
+            "{e}"
+        );
+    }
+}
+
 /// `[scheme] sign_targets` is read as a number of medians (integers too), 0 by default, and
 /// a negative or non-numeric value is an error naming the scene and the key.
 #[test]

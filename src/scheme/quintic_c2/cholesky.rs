@@ -534,7 +534,7 @@ pub fn solve_near_ordered(
     let unit = UnitRows::new(rows, c);
     let (d, off) = normal_matrix::<f64>(&unit.rows, n);
     let drops = [DEPENDENT_PIVOT, RETRY_PIVOT];
-    let made = refine_near(&unit, target, tol, &drops, false, |drop| {
+    let made = refine_near(&unit, target, tol, &drops, false, None, |drop| {
         Some(factor(&d, &off, drop, ordering))
     });
     let (mut residual, mut x, mut dropped) = made.expect("the in-house factor is always made");
@@ -594,12 +594,14 @@ impl NormalSolve for Factor {
 /// help; with how many rows each dropped): iterative refinement with each, then
 /// conjugate gradients preconditioned by each, until max |A x − c| ≤ `tol`. Returns the best
 /// (residual, x, rows dropped), or `None` when `make` made no factor.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn refine_near<F: NormalSolve>(
     unit: &UnitRows,
     target: &[f64],
     tol: f64,
     drops: &[f64],
     meet: bool,
+    signs: Option<&SignBox>,
     mut make: impl FnMut(f64) -> Option<(F, usize)>,
 ) -> Option<(f64, Vec<f64>, usize)> {
     let arows = &unit.rows;
@@ -656,6 +658,15 @@ pub(super) fn refine_near<F: NormalSolve>(
             }
         }
     }
+    if let Some(sb) = signs.filter(|_| meet || best.0 <= tol) {
+        // Theorem 2.1's signs by alternating projections with the factor that gave `best`
+        // (only where this is the last solve: with the precise factor, or one that met `tol`).
+        if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
+            let mut x = best.1.clone();
+            best.0 = sign_rounds(unit, f, &mut x, tol, sb);
+            best.1 = x;
+        }
+    }
     if meet && best.0 > tol {
         // The rows still missed are dropped ones, nearly dependent on the kept rows: met by a
         // move in the kept rows' null space ([`meet_dropped`]), with the factor that gave `best`.
@@ -668,6 +679,104 @@ pub(super) fn refine_near<F: NormalSolve>(
         }
     }
     Some(best)
+}
+
+/// Theorem 2.1's signs on a group's own weights, for [`sign_rounds`]: each weight of `signed`
+/// (column, ±1) is clamped to at least `margin` on its side, for at most `rounds` rounds.
+#[derive(Clone, Debug, Default)]
+pub struct SignBox {
+    /// The group's columns with a sign condition, with that sign (±1).
+    pub signed: Vec<(usize, f64)>,
+    /// How far on its side a clamped weight is put.
+    pub margin: f64,
+    /// Most rounds of [`sign_rounds`].
+    pub rounds: usize,
+}
+
+impl SignBox {
+    /// Weights of `x` off their sign by more than `tiny`.
+    #[must_use]
+    pub fn off(&self, x: &[f64], tiny: f64) -> usize {
+        self.signed
+            .iter()
+            .filter(|&&(j, s)| s * x[j] < -tiny)
+            .count()
+    }
+
+    /// Clamps every signed weight of `x` to at least the margin on its side; how many moved.
+    fn clamp(&self, x: &mut [f64]) -> usize {
+        let mut moved = 0;
+        for &(j, s) in &self.signed {
+            if s * x[j] < self.margin {
+                x[j] = s * self.margin;
+                moved += 1;
+            }
+        }
+        moved
+    }
+}
+
+/// Alternating projections between the sign box `sb` and the rows (the least-norm move back
+/// onto them, refined with the factor `f` as [`refine_near`] does), the last move onto the
+/// rows: each round is two Euclidean projections onto convex sets, so the distance to their
+/// intersection never grows, and where it is empty (the signs are sufficient, not necessary)
+/// the weights still move towards it. What pins do for small groups, with one factor for all
+/// rounds instead of one per round: for groups where a factor takes minutes
+/// (`QuinticOptions::joint_sign_rounds`). x is left at the round with the fewest weights off
+/// their sign among those that meet the rows about as well as x did; returns max |A x − c|.
+pub(super) fn sign_rounds<F: NormalSolve>(
+    unit: &UnitRows,
+    f: &F,
+    x: &mut Vec<f64>,
+    tol: f64,
+    sb: &SignBox,
+) -> f64 {
+    let arows = &unit.rows;
+    let m = arows.len();
+    let mut r = vec![0.0; m];
+    let start = unit.residual(x, &mut r);
+    // A start that met `tol` must still meet it; one that did not (dropped rows, met after
+    // this by [`meet_dropped`]) may miss by a little more.
+    let bound = if start <= tol { tol } else { 10.0 * start };
+    // Weights this small are zero up to the solves' rounding (as `project`).
+    let tiny = 1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
+    let mut best = (sb.off(x, tiny), start, x.clone());
+    let before = best.0;
+    let mut y = x.clone();
+    for round in 0..sb.rounds {
+        let t = std::time::Instant::now();
+        let clamped = sb.clamp(&mut y);
+        if clamped == 0 {
+            break;
+        }
+        let mut res = unit.residual(&y, &mut r);
+        for _ in 0..REFINE {
+            if res <= tol {
+                break;
+            }
+            let mut z = y.clone();
+            f.correct(arows, &mut r.clone(), &mut z);
+            let mut rz = vec![0.0; m];
+            let next = unit.residual(&z, &mut rz);
+            if next >= res {
+                break;
+            }
+            (y, r, res) = (z, rz, next);
+        }
+        let off = sb.off(&y, tiny);
+        if trace {
+            eprintln!(
+                "quintic-c2 sign rounds, round {round}: {clamped} clamped, residual {res:.2e}, {off} off their sign (was {before}), {:.1} s",
+                t.elapsed().as_secs_f64()
+            );
+        }
+        if res <= bound && off < best.0 {
+            best = (off, res, y.clone());
+        }
+    }
+    *x = best.2;
+    best.1
 }
 
 /// Most missed rows [`meet_dropped`] takes in one round (one solve with the factor each).

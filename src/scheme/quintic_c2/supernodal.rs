@@ -324,10 +324,25 @@ pub fn solve_near(
     tol: f64,
     max_values: usize,
 ) -> Option<Solution> {
+    solve_near_signed(rows, n, c, target, tol, max_values, None)
+}
+
+/// [`solve_near`], then with `signs` alternating projections between Theorem 2.1's signs and
+/// the rows with the same factor ([`cholesky::sign_rounds`]), before the dropped rows are met.
+#[must_use]
+pub fn solve_near_signed(
+    rows: &[Row],
+    n: usize,
+    c: &[f64],
+    target: &[f64],
+    tol: f64,
+    max_values: usize,
+    signs: Option<&cholesky::SignBox>,
+) -> Option<Solution> {
     let unit = UnitRows::new(rows, c);
     let normal = Normal::of(&unit.rows, n, max_values)?;
     let drops = [cholesky::DEPENDENT_PIVOT, cholesky::RETRY_PIVOT];
-    let mut best = cholesky::refine_near(&unit, target, tol, &drops, false, |drop| {
+    let mut best = cholesky::refine_near(&unit, target, tol, &drops, false, signs, |drop| {
         normal.factor::<f64>(drop).map(with_dropped)
     })?;
     if best.0 > tol {
@@ -337,6 +352,7 @@ pub fn solve_near(
             tol,
             &[cholesky::PRECISE_PIVOT],
             true,
+            signs,
             |drop| normal.factor::<fx128>(drop).map(with_dropped),
         );
         if let Some(p) = precise.filter(|p| p.0 < best.0) {
@@ -432,6 +448,7 @@ mod tests {
                 1e-13 * scale,
                 &[cholesky::DEPENDENT_PIVOT],
                 false,
+                None,
                 |d| normal.factor::<f64>(d).map(with_dropped),
             );
             report("f64 1e-13", got, t.elapsed().as_secs_f64());
@@ -444,6 +461,7 @@ mod tests {
                 1e-13 * scale,
                 &[drop],
                 std::env::var_os("MEET").is_some(),
+                None,
                 |d| {
                     let f = normal.factor::<fx128>(d)?;
                     let SymbolicCholeskyRaw::Supernodal(raw) = normal.symbolic.raw() else {
@@ -709,6 +727,7 @@ mod tests {
                 1e-13,
                 &[cholesky::PRECISE_PIVOT],
                 false,
+                None,
                 |_| factor(),
             )
             .expect("small");
@@ -726,6 +745,58 @@ mod tests {
                 "seed {seed}: both {both:e}, plain {plain:e}, ×10 {own:e}"
             );
         }
+    }
+
+    /// Alternating projections between a sign box and the rows, with the group's one factor
+    /// (`cholesky::sign_rounds`): where a point meets both (x*, its signed weights 0.5–1.5 on
+    /// their side, margin 0.1), the rounds end with every weight on its side and the rows met,
+    /// while the plain solve closest to random targets leaves many off.
+    #[test]
+    fn sign_rounds_reach_the_signs_where_the_rows_allow_them() {
+        let (m, n) = (300, 600);
+        let mut s = 5_u64;
+        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
+        let pick = |s: &mut u64, k: usize| ((lcg(s) + 1.0) * 0.5 * k as f64) as usize % k;
+        let mut a = vec![0.0; m * n];
+        for i in 0..m {
+            for _ in 0..8 {
+                let j = pick(&mut s, n);
+                a[i * n + j] = lcg(&mut s);
+            }
+        }
+        // Every third column signed, alternately + and −.
+        let signed: Vec<(usize, f64)> = (0..n)
+            .step_by(3)
+            .map(|j| (j, if j % 2 == 0 { 1.0 } else { -1.0 }))
+            .collect();
+        let mut star: Vec<f64> = (0..n).map(|_| lcg(&mut s)).collect();
+        for &(j, sign) in &signed {
+            star[j] = sign * (1.0 + 0.5 * lcg(&mut s));
+        }
+        let c = times(&a, m, n, &star);
+        let target: Vec<f64> = (0..n).map(|_| 2.0 * lcg(&mut s)).collect();
+        let rows = sparse_rows(&a, m, n);
+        let tol = 1e-12;
+        let sb = cholesky::SignBox {
+            signed,
+            margin: 0.1,
+            rounds: 300,
+        };
+        let plain = solve_near(&rows, n, &c, &target, tol, MAX_VALUES).expect("small");
+        let signed_sol =
+            solve_near_signed(&rows, n, &c, &target, tol, MAX_VALUES, Some(&sb)).expect("small");
+        let (before, after) = (sb.off(&plain.x, 0.0), sb.off(&signed_sol.x, 0.0));
+        assert!(before > 20, "the targets leave weights off: {before}");
+        assert_eq!(after, 0, "{before} off before the rounds");
+        // The last move of every round is onto the rows, refined to `tol`.
+        assert!(signed_sol.residual <= tol, "{:e}", signed_sol.residual);
+        let r = times(&a, m, n, &signed_sol.x);
+        let miss = r
+            .iter()
+            .zip(&c)
+            .fold(0.0_f64, |w, (p, q)| w.max((p - q).abs()));
+        // Unit rows of ≤ 8 entries of |a| ≤ 1: the unscaled miss is at most √8 × the unit one.
+        assert!(miss <= 3.0 * tol, "{miss:e}");
     }
 
     /// A dropped row whose data contradict the kept rows (1e-3 off, at distance 1e-11 from

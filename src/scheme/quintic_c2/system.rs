@@ -191,6 +191,10 @@ pub struct System {
     /// Margin, in medians of their |target|, by which the targets of a group's signed weights
     /// are moved into their sign before it is solved (`QuinticOptions::sign_targets`, 0 = off).
     pub sign_targets: f64,
+    /// Rounds of alternating projections between Theorem 2.1's signs and the equations of each
+    /// group too large to pin, with its one factor (`QuinticOptions::joint_sign_rounds`, 0 =
+    /// off).
+    pub joint_sign_rounds: usize,
 }
 
 /// Builds the slots and the C1/C2 equations of every shared face.
@@ -301,6 +305,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         boundary,
         star_tau: 0.0,
         sign_targets: 0.0,
+        joint_sign_rounds: 0,
     })
 }
 
@@ -1421,7 +1426,11 @@ impl System {
         if self.sign_targets > 0.0 {
             self.move_targets_into_signs(g);
         }
-        let mut sol = solve_rows(&g.rows, g.unk.len(), &g.c, &g.tgt, g.scale);
+        // Groups too large to pin: the signs by alternating projections with their one factor.
+        let signs = (pin && self.joint_sign_rounds > 0 && g.unk.len() > PIN_MAX_UNKNOWNS)
+            .then(|| self.sign_box(g));
+        let mut sol =
+            solve_rows_signed(&g.rows, g.unk.len(), &g.c, &g.tgt, g.scale, signs.as_ref());
         let (mut pinned, mut given_up) = (0, 0);
         // Beyond the in-house factor a group goes to the supernodal one, and every pin round
         // would factor it again (fandisk's joint group: 17 minutes, 16.5 GB each).
@@ -1431,6 +1440,38 @@ impl System {
                 pin_signs(&mut sol, &mut g.rows, &mut g.c, &conds, &g.tgt, g.scale);
         }
         (sol, pinned, given_up)
+    }
+
+    /// The sign box of `g`'s own weights that Theorem 2.1 asks a sign of, its margin
+    /// [`System::sign_targets`] (or 1 where that is off) × the median of their |target|, as
+    /// [`System::move_targets_into_signs`] (the box the targets were moved into).
+    fn sign_box(&self, g: &Group) -> cholesky::SignBox {
+        let signed: Vec<(usize, f64)> = g
+            .unk
+            .iter()
+            .enumerate()
+            .filter_map(|(j, &s)| {
+                let r = self.req[s as usize];
+                (r == 1 || r == -1).then_some((j, f64::from(r)))
+            })
+            .collect();
+        let mut size: Vec<f64> = signed.iter().map(|&(j, _)| g.tgt[j].abs()).collect();
+        let median = if size.is_empty() {
+            0.0
+        } else {
+            let mid = size.len() / 2;
+            *size.select_nth_unstable_by(mid, f64::total_cmp).1
+        };
+        let per = if self.sign_targets > 0.0 {
+            self.sign_targets
+        } else {
+            1.0
+        };
+        cholesky::SignBox {
+            signed,
+            margin: per * median,
+            rounds: self.joint_sign_rounds,
+        }
     }
 
     /// Moves the targets of `g`'s weights that Theorem 2.1 asks a sign of to at least
@@ -1737,6 +1778,19 @@ fn solve_rows(
     tgt: &[f64],
     scale: f64,
 ) -> dense::Solution {
+    solve_rows_signed(rows, n, c, tgt, scale, None)
+}
+
+/// [`solve_rows`], with Theorem 2.1's `signs` taken by alternating projections where the group
+/// goes to the supernodal factor ([`supernodal::solve_near_signed`]).
+fn solve_rows_signed(
+    rows: &[sparse::Row],
+    n: usize,
+    c: &[f64],
+    tgt: &[f64],
+    scale: f64,
+    signs: Option<&cholesky::SignBox>,
+) -> dense::Solution {
     let m = rows.len();
     if n <= DENSE_LIMIT {
         let mut a = vec![0.0; m * n];
@@ -1759,7 +1813,7 @@ fn solve_rows(
             cholesky::MAX_FACTOR_ENTRIES,
             supernodal::MAX_VALUES,
         );
-        let sol = solve_sparse(rows, n, c, tgt, 1e-13 * scale, limits);
+        let sol = solve_sparse(rows, n, c, tgt, 1e-13 * scale, limits, signs);
         if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
             // Opt-in timing of the large groups on stderr (exploration; results unaffected).
             eprintln!(
@@ -1785,11 +1839,12 @@ fn solve_sparse(
     tgt: &[f64],
     tol: f64,
     (max_rows, max_entries, max_values): (usize, usize, usize),
+    signs: Option<&cholesky::SignBox>,
 ) -> dense::Solution {
     if let Some(o) = cholesky::Ordering::within(rows, n, (max_rows, max_entries)) {
         return cholesky::solve_near_ordered(rows, n, c, tgt, tol, &o);
     }
-    supernodal::solve_near(rows, n, c, tgt, tol, max_values)
+    supernodal::solve_near_signed(rows, n, c, tgt, tol, max_values, signs)
         .unwrap_or_else(|| dense::Solution::unsolved(tgt))
 }
 
@@ -1984,7 +2039,7 @@ mod tests {
         let c = vec![1.0; n - 1];
         let tgt = vec![0.0; n];
         let big = usize::MAX;
-        let solved = solve_sparse(&rows, n, &c, &tgt, 1e-13, (1000, 1000, big));
+        let solved = solve_sparse(&rows, n, &c, &tgt, 1e-13, (1000, 1000, big), None);
         // Solved: the chain's rows hold to rounding (unit coefficients, values up to 25).
         assert!(solved.residual < 1e-12, "{}", solved.residual);
         assert!(consistent(&solved, 1.0));
@@ -1992,18 +2047,18 @@ mod tests {
         for limits in [(n - 2, 1000), (1000, entries - 1)] {
             // Beyond the in-house factor: the supernodal one meets the same rows.
             let (r, e) = limits;
-            let other = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, big));
+            let other = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, big), None);
             assert!(other.residual < 1e-12, "{limits:?}: {}", other.residual);
             for (a, b) in other.x.iter().zip(&solved.x) {
                 // The same closest solution; values up to 25, rounding of 49 unit steps.
                 assert!((a - b).abs() < 1e-12, "{a} vs {b}");
             }
             // Beyond both: left unsolved.
-            let left = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, 10));
+            let left = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, 10), None);
             assert_eq!(left.residual, f64::INFINITY, "{limits:?}");
             assert!(!consistent(&left, 1.0));
         }
-        let fits = solve_sparse(&rows, n, &c, &tgt, 1e-13, (n - 1, entries, 10));
+        let fits = solve_sparse(&rows, n, &c, &tgt, 1e-13, (n - 1, entries, 10), None);
         assert!(fits.residual < 1e-12);
     }
 
