@@ -805,22 +805,17 @@ const MEET_SEEN: f64 = 1e-14;
 /// row whose data disagrees with its neighbours' would otherwise be met by an arbitrarily
 /// large move (its miss over its distance).
 const MEET_GROWTH: f64 = 10.0;
-/// Weights of the rows Q was made for in [`meet_dropped`]'s fit, against the other rows that
-/// see Q, tried in turn each round; the first is kept unless a later one lowers the residual
-/// [`MEET_PREFER`]-fold. In the plain least-squares fit (weight 1) the worst missed rows trade
-/// against the ~30000 rows that see the move, and on fandisk's joint group one of them held the
-/// residual at 1.23e-11 from round 3 on, whether the later rounds chose weight 1 or 10 (the
-/// lower residual each round: the plain fit's path). Weighted ×10 from the start they are met
-/// first while the others still shape the move (5.9e-12 at round 5 and still falling, moves ≤
-/// 1.9e-2 of |x|; a minimax fit, which meets them exactly, moved by up to 0.5 and worsened every
-/// later check). Where the basis, not the trade, limits the rounds (more near rows than
-/// [`MEET_BASIS`]), weight 1 does better (`supernodal`'s tests: ×10 alone ends 1.7–2.5× above).
-pub(super) const MEET_OWN_WEIGHTS: [f64; 2] = [10.0, 1.0];
-/// How much lower a later weight's residual must be for [`meet_dropped`] to leave the first
-/// of [`MEET_OWN_WEIGHTS`]: a round's residual is not the end's (fandisk's ×10 path is above
-/// the plain fit's by 1.2× at round 1 and below it by 2.1× at round 5), so the path that
-/// meets Q's own rows is kept unless the other does much better now.
-const MEET_PREFER: f64 = 2.0;
+/// Weight of the rows Q was made for in [`meet_dropped`]'s fit, against the other rows that
+/// see Q. In the plain least-squares fit (weight 1) the worst missed rows trade against the
+/// ~30000 rows that see the move, and on fandisk's joint group one of them held the residual
+/// at 1.23e-11 from round 3 on. Weighted ×10 they are met first while the others still shape
+/// the move: 5.9e-12 at round 5 and still falling, moves ≤ 1.9e-2 of |x| (a minimax fit, which
+/// meets them exactly, moved by up to 0.5 and worsened every later check). Choosing the weight
+/// round by round (the lower residual of 1 and 10, or 10 unless 1 is 2× lower) led back onto
+/// the plain fit's path and its 1.23e-11: the ×10 path's round 3 is worse (3.7e-11, not
+/// taken), and its rounds 4–5 build on that. Where the basis, not the trade, limits the rounds
+/// (more near rows than [`MEET_BASIS`]), the plain fit ends lower (`supernodal`'s tests).
+pub(super) const MEET_OWN_WEIGHTS: [f64; 1] = [10.0];
 
 /// Meets the rows a factor dropped but x misses: rows off the kept rows' span by δ (pivot δ²
 /// below the drop threshold) are missed by δ times x's distance from the exact solution along
@@ -830,9 +825,8 @@ const MEET_PREFER: f64 = 2.0;
 /// at most [`MEET_BASIS`]) span the move. A move dx = Q u leaves every kept row as it was but
 /// is seen by every dropped row near the span, not only by the rows it was made for, so u is
 /// the least-squares fit of all the rows that see Q ([`MEET_SEEN`]) in their own scale, the
-/// rows Q was made for weighted by each of `own_weights` in turn, the first preferred
-/// ([`MEET_OWN_WEIGHTS`], [`MEET_PREFER`]): a round meets its new rows without undoing the
-/// earlier rounds' or missing the others more.
+/// rows Q was made for weighted up ([`MEET_OWN_WEIGHTS`]): a round meets its new rows without
+/// undoing the earlier rounds' or missing the others more.
 /// A few rounds of refinement follow each move (the projections' rounding, amplified by 1/δ);
 /// a round that does not lower the residual is not taken, but its rows stay in Q for the next.
 /// Returns max |A x − c| (x is left at the best round).
@@ -921,8 +915,8 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             break;
         }
         // min Σ (w_i s_i)² (a_i · Q u − r_i)² over the rows S that see Q (s_i their scale, w_i
-        // the weight of Q's own rows or 1), for each weight; the first weight's move is taken
-        // unless another meets the rows MEET_PREFER times better.
+        // the weight of Q's own rows or 1), for each weight given (one but in tests); the move
+        // that meets the rows best is taken.
         let mut rows_seen: Vec<usize> = seen.iter().flatten().map(|t| t.0).collect();
         rows_seen.sort_unstable();
         rows_seen.dedup();
@@ -973,7 +967,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             }
             let mut ry = vec![0.0; m];
             let got = unit.residual(&y, &mut ry);
-            if chosen.as_ref().is_none_or(|c| got * MEET_PREFER < c.got) {
+            if chosen.as_ref().is_none_or(|c| got < c.got) {
                 // What the fit promised on the rows that see Q, in their own scale.
                 let fitted = (0..ms).fold(0.0_f64, |a, s| {
                     let e = (0..k).map(|col| bt[col * ms + s] * u[col]).sum::<f64>() - rhs[s];
