@@ -1478,22 +1478,7 @@ impl System {
     /// [`System::sign_targets`] × the median of their |target| on that side (the sign box of
     /// `project`, applied to the targets instead of the solution).
     fn move_targets_into_signs(&self, g: &mut Group) {
-        let signed: Vec<(usize, f64)> = g
-            .unk
-            .iter()
-            .enumerate()
-            .filter_map(|(j, &s)| {
-                let r = self.req[s as usize];
-                (r == 1 || r == -1).then_some((j, f64::from(r)))
-            })
-            .collect();
-        let mut size: Vec<f64> = signed.iter().map(|&(j, _)| g.tgt[j].abs()).collect();
-        if size.is_empty() {
-            return;
-        }
-        let mid = size.len() / 2;
-        let median = *size.select_nth_unstable_by(mid, f64::total_cmp).1;
-        let margin = self.sign_targets * median;
+        let cholesky::SignBox { signed, margin, .. } = self.sign_box(g);
         for (j, sign) in signed {
             if sign * g.tgt[j] < margin {
                 g.tgt[j] = sign * margin;
