@@ -750,20 +750,8 @@ pub(super) fn sign_rounds<F: NormalSolve>(
         if clamped == 0 {
             break;
         }
-        let mut res = unit.residual(&y, &mut r);
-        for _ in 0..REFINE {
-            if res <= tol {
-                break;
-            }
-            let mut z = y.clone();
-            f.correct(arows, &mut r.clone(), &mut z);
-            let mut rz = vec![0.0; m];
-            let next = unit.residual(&z, &mut rz);
-            if next >= res {
-                break;
-            }
-            (y, r, res) = (z, rz, next);
-        }
+        let res = unit.residual(&y, &mut r);
+        let res = refine_kept(unit, f, &mut y, &mut r, res, tol);
         let off = sb.off(&y, tiny);
         if trace {
             eprintln!(
@@ -777,6 +765,35 @@ pub(super) fn sign_rounds<F: NormalSolve>(
     }
     *x = best.2;
     best.1
+}
+
+/// At most [`REFINE`] corrections of y towards the rows with the factor `f`, each kept only if
+/// it lowers max |A y − c| (`res`, with `r` y's residual), until `tol` is met; returns the
+/// max, with `r` left y's residual whether or not the last correction was kept. The rounds
+/// after ([`meet_dropped`]'s next missed rows, its trace) read r: a factor's `correct` may
+/// overwrite the r it is given with (Â Âᵀ)⁻¹ r, so it is given a copy.
+fn refine_kept<F: NormalSolve>(
+    unit: &UnitRows,
+    f: &F,
+    y: &mut Vec<f64>,
+    r: &mut Vec<f64>,
+    mut res: f64,
+    tol: f64,
+) -> f64 {
+    for _ in 0..REFINE {
+        if res <= tol {
+            break;
+        }
+        let mut z = y.clone();
+        f.correct(&unit.rows, &mut r.clone(), &mut z);
+        let mut rz = vec![0.0; r.len()];
+        let next = unit.residual(&z, &mut rz);
+        if next >= res {
+            break;
+        }
+        (*y, *r, res) = (z, rz, next);
+    }
+    res
 }
 
 /// Most missed rows [`meet_dropped`] takes in one round (one solve with the factor each).
@@ -996,19 +1013,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             continue;
         };
         let moved_to = got;
-        for _ in 0..REFINE {
-            if got <= tol {
-                break;
-            }
-            let mut z = y.clone();
-            f.correct(arows, &mut ry, &mut z);
-            let mut rz = vec![0.0; m];
-            let next = unit.residual(&z, &mut rz);
-            if next >= got {
-                break;
-            }
-            (y, ry, got) = (z, rz, next);
-        }
+        got = refine_kept(unit, f, &mut y, &mut ry, got, tol);
         if trace {
             // What the chosen fit promised on the rows that see Q, what the move gave before
             // the refinement, and the worst row after: one of Q's, one that sees Q, or neither.
@@ -1594,6 +1599,34 @@ pub(super) mod tests {
         assert!(iterations <= CG_STALL + 1, "{iterations}");
         // Never worse than where it started; the contradiction (0.5) stays far above rounding.
         assert!(res <= s.residual && res > 1e-3, "{res} vs {}", s.residual);
+    }
+
+    /// [`refine_kept`] leaves r the residual of the y it returns, also when its last correction
+    /// did not help and was not kept: on an inconsistent system (one dependent row contradicted
+    /// by 0.5) refinement with the f64 factor stops helping at once, and that factor's
+    /// `correct` overwrites the r it is handed with (Â Âᵀ)⁻¹ r.
+    #[test]
+    fn refinement_leaves_the_residual_of_what_it_returns() {
+        let (m, n) = (40, 60);
+        let (_, rows, mut c, target) = system(m, n, 3);
+        c[39] += 0.5;
+        let unit = UnitRows::new(&rows, &c);
+        let ordering = Ordering::of(&rows, n);
+        let (d, off) = normal_matrix::<f64>(&unit.rows, n);
+        let (f, dropped) = factor(&d, &off, DEPENDENT_PIVOT, &ordering);
+        assert!(dropped >= 1, "the dependent row is dropped");
+        let mut y = target.clone();
+        let mut r = vec![0.0; m];
+        let start = unit.residual(&y, &mut r);
+        // tol 0: never met, so every step is tried until one does not help.
+        let got = refine_kept(&unit, &f, &mut y, &mut r, start, 0.0);
+        let mut fresh = vec![0.0; m];
+        let again = unit.residual(&y, &mut fresh);
+        // The same y and the same arithmetic: equal to the bit.
+        assert_eq!(got.to_bits(), again.to_bits());
+        assert_eq!(r, fresh);
+        // The contradiction stays (0.5 against rows of norm 1), and some step helped.
+        assert!(got > 1e-3 && got <= start, "{got} from {start}");
     }
 
     /// The double-double factor resolves a squared distance far below f64's rounding: row b
