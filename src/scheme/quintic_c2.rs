@@ -20,6 +20,7 @@ mod pinned;
 pub mod project;
 pub mod signfit;
 pub mod signs;
+mod signsplit;
 pub mod slivers;
 pub mod sparse;
 pub mod supernodal;
@@ -112,6 +113,12 @@ pub struct QuinticOptions {
     /// moved back onto the equations, round after round; the round with the fewest weights
     /// off their sign is kept.
     pub joint_sign_rounds: usize,
+    /// With `signs`: rounds of the sign program (the fewest weights off Theorem 2.1's signs,
+    /// as `sign_program`) in each group too large to pin, split so that a round is one solve
+    /// with the group's factor (ADMM, `signsplit`), after its dropped rows are met and moving
+    /// orthogonally to what met them (0 = off, the default). The round with the fewest
+    /// weights off is kept if the rows stay met within 2× the solve's residual.
+    pub joint_sign_fit: usize,
     /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2, and the
     /// stars one ring in) of the tetrahedra around every boundary face the surface crosses (a
     /// hole) and every patch it crosses twice along a j-line (a j-sheet), with all their
@@ -156,6 +163,7 @@ impl Default for QuinticOptions {
             star_tau: 0.0,
             sign_targets: 0.0,
             joint_sign_rounds: 0,
+            joint_sign_fit: 0,
             relax_stars: true,
             consistent_stars: false,
             hessian_signs: false,
@@ -263,6 +271,17 @@ impl QuinticOptions {
                             )
                         })?;
                 }
+                "joint_sign_fit" => {
+                    o.joint_sign_fit = v
+                        .as_integer()
+                        .and_then(|i| usize::try_from(i).ok())
+                        .ok_or_else(|| {
+                            anyhow::anyhow!(
+                                "{}: `scheme.joint_sign_fit` must be a whole number ≥ 0, got {v}",
+                                scene.display()
+                            )
+                        })?;
+                }
                 "signs" => o.signs = flag()?,
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
@@ -275,7 +294,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -405,6 +424,7 @@ pub fn build_prepared(
     sys.star_tau = options.star_tau;
     sys.sign_targets = options.sign_targets;
     sys.joint_sign_rounds = options.joint_sign_rounds;
+    sys.joint_sign_fit = options.joint_sign_fit;
     if !zero_points.is_empty() {
         sys.require_zero_bases(&tets, &flat::zero_triangles(hull, zero_points));
     }

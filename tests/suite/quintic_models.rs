@@ -15,7 +15,8 @@ use std::path::Path;
 /// as they are, `BALANCE=1` the balanced edge points and `SIGN_ROUNDS` the sign projection's
 /// rounds, `SIGN_PROGRAM=1` its linear program (HiGHS with the feature `highs`, else the
 /// interior point method), `TANGENT_CLEARANCE` the quintic's `tangent_clearance`,
-/// `SIGN_TARGETS` its `sign_targets`, `JOINT_SIGN_ROUNDS` its `joint_sign_rounds` (to explore).
+/// `SIGN_TARGETS` its `sign_targets`, `JOINT_SIGN_ROUNDS` its `joint_sign_rounds`,
+/// `JOINT_SIGN_FIT` its `joint_sign_fit` (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -47,6 +48,10 @@ fn options() -> QuinticOptions {
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
         balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
         joint_sign_rounds: std::env::var("JOINT_SIGN_ROUNDS")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(0),
+        joint_sign_fit: std::env::var("JOINT_SIGN_FIT")
             .ok()
             .and_then(|x| x.parse().ok())
             .unwrap_or(0),

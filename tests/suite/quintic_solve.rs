@@ -207,27 +207,26 @@ fn quintic_solve_is_the_same_on_one_and_two_threads() {
     );
 }
 
-/// `[scheme] joint_sign_rounds` is a whole number of rounds, 0 by default; anything else is
-/// an error naming the scene and the key.
+/// `[scheme] joint_sign_rounds` and `joint_sign_fit` are whole numbers of rounds, 0 by
+/// default; anything else is an error naming the scene and the key.
 #[test]
 fn joint_sign_rounds_key_is_read_and_checked() {
     let scene = Path::new("scenes/x.toml");
     let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
-    assert_eq!(read("").unwrap().joint_sign_rounds, 0);
-    assert_eq!(
-        read("joint_sign_rounds = 20").unwrap().joint_sign_rounds,
-        20
-    );
-    for bad in [
-        "joint_sign_rounds = -1",
-        "joint_sign_rounds = 1.5",
-        "joint_sign_rounds = \"x\"",
-    ] {
-        let e = read(bad).unwrap_err().to_string();
-        assert!(
-            e.contains("scenes/x.toml") && e.contains("joint_sign_rounds"),
-            "{e}"
-        );
+    let get = |o: &QuinticOptions, key: &str| {
+        if key == "joint_sign_fit" {
+            o.joint_sign_fit
+        } else {
+            o.joint_sign_rounds
+        }
+    };
+    for key in ["joint_sign_rounds", "joint_sign_fit"] {
+        assert_eq!(get(&read("").unwrap(), key), 0);
+        assert_eq!(get(&read(&format!("{key} = 20")).unwrap(), key), 20);
+        for bad in ["-1", "1.5", "\"x\""] {
+            let e = read(&format!("{key} = {bad}")).unwrap_err().to_string();
+            assert!(e.contains("scenes/x.toml") && e.contains(key), "{e}");
+        }
     }
 }
 

@@ -494,7 +494,7 @@ impl UnitRows {
     }
 
     /// Sets `r` to ĉ − Â x and returns max |A x − c| in the rows' own scale.
-    fn residual(&self, x: &[f64], r: &mut [f64]) -> f64 {
+    pub(super) fn residual(&self, x: &[f64], r: &mut [f64]) -> f64 {
         self.residual_to(&self.c, x, r)
     }
 
@@ -667,13 +667,27 @@ pub(super) fn refine_near<F: NormalSolve>(
             best.1 = x;
         }
     }
+    let mut basis = Vec::new();
     if meet && best.0 > tol {
         // The rows still missed are dropped ones, nearly dependent on the kept rows: met by a
         // move in the kept rows' null space ([`meet_dropped`]), with the factor that gave `best`.
         if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
             let mut x = best.1.clone();
-            let got = meet_dropped(unit, f, &mut x, tol, &MEET_OWN_WEIGHTS);
+            let got;
+            (got, basis) = meet_dropped(unit, f, &mut x, tol, &MEET_OWN_WEIGHTS);
             if got < best.0 {
+                best = (got, x, best.2);
+            }
+        }
+    }
+    if let Some(sb) = signs.filter(|sb| sb.fit > 0 && (meet || best.0 <= tol)) {
+        // The sign program inside the group, moving orthogonally to the basis the dropped
+        // rows were met with; a start that met `tol` must still meet it, one that did not may
+        // miss by a little more (as [`sign_rounds`]).
+        if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
+            let bound = if best.0 <= tol { tol } else { 2.0 * best.0 };
+            let mut x = best.1.clone();
+            if let Some(got) = super::signsplit::fit(unit, f, &mut x, &basis, sb, bound) {
                 best = (got, x, best.2);
             }
         }
@@ -691,6 +705,9 @@ pub struct SignBox {
     pub margin: f64,
     /// Most rounds of [`sign_rounds`].
     pub rounds: usize,
+    /// Rounds of the split sign program after the dropped rows are met
+    /// ([`super::signsplit::fit`]; 0 = none).
+    pub fit: usize,
 }
 
 impl SignBox {
@@ -846,14 +863,14 @@ pub(super) const MEET_OWN_WEIGHTS: [f64; 1] = [10.0];
 /// undoing the earlier rounds' or missing the others more.
 /// A few rounds of refinement follow each move (the projections' rounding, amplified by 1/δ);
 /// a round that does not lower the residual is not taken, but its rows stay in Q for the next.
-/// Returns max |A x − c| (x is left at the best round).
+/// Returns max |A x − c| (x is left at the best round) and the basis Q.
 pub(super) fn meet_dropped<F: NormalSolve>(
     unit: &UnitRows,
     f: &F,
     x: &mut Vec<f64>,
     tol: f64,
     own_weights: &[f64],
-) -> f64 {
+) -> (f64, Vec<Vec<f64>>) {
     let arows = &unit.rows;
     let (m, n) = (arows.len(), x.len());
     let mut r = vec![0.0; m];
@@ -1040,7 +1057,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
             (*x, r, res) = (y, ry, got);
         }
     }
-    res
+    (res, q)
 }
 
 /// One candidate move of [`meet_dropped`]: x moved, its residuals and their max, how far it

@@ -195,6 +195,9 @@ pub struct System {
     /// group too large to pin, with its one factor (`QuinticOptions::joint_sign_rounds`, 0 =
     /// off).
     pub joint_sign_rounds: usize,
+    /// Rounds of the split sign program in each group too large to pin, after its dropped
+    /// rows are met (`QuinticOptions::joint_sign_fit`, 0 = off).
+    pub joint_sign_fit: usize,
 }
 
 /// Builds the slots and the C1/C2 equations of every shared face.
@@ -306,6 +309,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         star_tau: 0.0,
         sign_targets: 0.0,
         joint_sign_rounds: 0,
+        joint_sign_fit: 0,
     })
 }
 
@@ -1426,8 +1430,11 @@ impl System {
         if self.sign_targets > 0.0 {
             self.move_targets_into_signs(g);
         }
-        // Groups too large to pin: the signs by alternating projections with their one factor.
-        let signs = (pin && self.joint_sign_rounds > 0 && g.unk.len() > PIN_MAX_UNKNOWNS)
+        // Groups too large to pin: the signs with their one factor (alternating projections, the
+        // split sign program).
+        let signs = (pin
+            && (self.joint_sign_rounds > 0 || self.joint_sign_fit > 0)
+            && g.unk.len() > PIN_MAX_UNKNOWNS)
             .then(|| self.sign_box(g));
         let mut sol =
             solve_rows_signed(&g.rows, g.unk.len(), &g.c, &g.tgt, g.scale, signs.as_ref());
@@ -1471,6 +1478,7 @@ impl System {
             signed,
             margin: per * median,
             rounds: self.joint_sign_rounds,
+            fit: self.joint_sign_fit,
         }
     }
 
