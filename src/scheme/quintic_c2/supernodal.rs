@@ -754,28 +754,13 @@ mod tests {
     #[test]
     fn sign_rounds_reach_the_signs_where_the_rows_allow_them() {
         let (m, n) = (300, 600);
-        let mut s = 5_u64;
-        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
-        let pick = |s: &mut u64, k: usize| ((lcg(s) + 1.0) * 0.5 * k as f64) as usize % k;
-        let mut a = vec![0.0; m * n];
-        for i in 0..m {
-            for _ in 0..8 {
-                let j = pick(&mut s, n);
-                a[i * n + j] = lcg(&mut s);
-            }
-        }
-        // Every third column signed, alternately + and −.
-        let signed: Vec<(usize, f64)> = (0..n)
-            .step_by(3)
-            .map(|j| (j, if j % 2 == 0 { 1.0 } else { -1.0 }))
-            .collect();
-        let mut star: Vec<f64> = (0..n).map(|_| lcg(&mut s)).collect();
-        for &(j, sign) in &signed {
-            star[j] = sign * (1.0 + 0.5 * lcg(&mut s));
-        }
-        let c = times(&a, m, n, &star);
-        let target: Vec<f64> = (0..n).map(|_| 2.0 * lcg(&mut s)).collect();
-        let rows = sparse_rows(&a, m, n);
+        let SignedSystem {
+            a,
+            rows,
+            c,
+            target,
+            signed,
+        } = signed_system(m, n, 5, 3, 0.5);
         let tol = 1e-12;
         let sb = cholesky::SignBox {
             signed,
@@ -800,8 +785,15 @@ mod tests {
         assert!(miss <= 3.0 * tol, "{miss:e}");
     }
 
-    /// Rows, right-hand side, targets and signed columns of a test system.
-    type SignedSystem = (Vec<Row>, Vec<f64>, Vec<f64>, Vec<(usize, f64)>);
+    /// A test system with signed columns: its dense rows (row-major) and sparse rows, its
+    /// right-hand side and targets, and its signed columns with their signs.
+    struct SignedSystem {
+        a: Vec<f64>,
+        rows: Vec<Row>,
+        c: Vec<f64>,
+        target: Vec<f64>,
+        signed: Vec<(usize, f64)>,
+    }
 
     /// A random sparse system (8 entries a row) solved by x* with every `every`-th column
     /// signed (alternately + and −) and x*'s signed weights `lo`..`lo + 1` on their side
@@ -827,7 +819,13 @@ mod tests {
         }
         let c = times(&a, m, n, &star);
         let target: Vec<f64> = (0..n).map(|_| 2.0 * lcg(&mut s)).collect();
-        (sparse_rows(&a, m, n), c, target, signed)
+        SignedSystem {
+            rows: sparse_rows(&a, m, n),
+            a,
+            c,
+            target,
+            signed,
+        }
     }
 
     /// The split sign program (`signsplit::fit`, with the group's one factor) puts every
@@ -840,7 +838,13 @@ mod tests {
     #[test]
     fn the_split_sign_program_leaves_fewer_weights_off_than_alternating_projections() {
         let tol = 1e-12;
-        let (rows, c, target, signed) = signed_system(300, 600, 5, 3, 0.5);
+        let SignedSystem {
+            rows,
+            c,
+            target,
+            signed,
+            ..
+        } = signed_system(300, 600, 5, 3, 0.5);
         let n = 600;
         let sb = |rounds, fit| cholesky::SignBox {
             signed: signed.clone(),
@@ -861,7 +865,13 @@ mod tests {
         // The fit's move is projected onto the rows' null space; what is left is its rounding.
         assert!(fitted.residual <= tol, "{:e}", fitted.residual);
 
-        let (rows, c, target, signed) = signed_system(500, 600, 6, 1, -0.25);
+        let SignedSystem {
+            rows,
+            c,
+            target,
+            signed,
+            ..
+        } = signed_system(500, 600, 6, 1, -0.25);
         let sb = |rounds, fit| cholesky::SignBox {
             signed: signed.clone(),
             margin: 0.1,
