@@ -837,66 +837,39 @@ mod tests {
     /// solve, 100 after alternating projections, 70 after the fit).
     #[test]
     fn the_split_sign_program_leaves_fewer_weights_off_than_alternating_projections() {
-        let tol = 1e-12;
-        let SignedSystem {
-            rows,
-            c,
-            target,
-            signed,
-            ..
-        } = signed_system(300, 600, 5, 3, 0.5);
-        let n = 600;
-        let sb = |rounds, fit| cholesky::SignBox {
-            signed: signed.clone(),
-            margin: 0.1,
-            rounds,
-            fit,
+        let (tol, n) = (1e-12, 600);
+        // Weights off their sign after the plain solve, alternating projections and the fit
+        // (100 rounds each), and the fit's residual.
+        let run = |m, seed, every, lo| {
+            let sys = signed_system(m, n, seed, every, lo);
+            let sb = |rounds, fit| cholesky::SignBox {
+                signed: sys.signed.clone(),
+                margin: 0.1,
+                rounds,
+                fit,
+            };
+            let solve = |b: Option<cholesky::SignBox>| {
+                let (r, c, t) = (&sys.rows, &sys.c, &sys.target);
+                solve_near_signed(r, n, c, t, tol, MAX_VALUES, b.as_ref()).expect("small")
+            };
+            let off = |x: &[f64]| sb(0, 0).off(x, 0.0);
+            let (plain, alt, fit) = (
+                solve(None),
+                solve(Some(sb(100, 0))),
+                solve(Some(sb(0, 100))),
+            );
+            (off(&plain.x), off(&alt.x), off(&fit.x), fit.residual)
         };
-        let plain = solve_near(&rows, n, &c, &target, tol, MAX_VALUES).expect("small");
-        let fitted = solve_near_signed(&rows, n, &c, &target, tol, MAX_VALUES, Some(&sb(0, 300)))
-            .expect("small");
-        let before = sb(0, 0).off(&plain.x, 0.0);
+        let (before, _, after, residual) = run(300, 5, 3, 0.5);
         assert!(before > 20, "the targets leave weights off: {before}");
-        assert_eq!(
-            sb(0, 0).off(&fitted.x, 0.0),
-            0,
-            "{before} off before the fit"
-        );
+        assert_eq!(after, 0, "{before} off before the fit");
         // The fit's move is projected onto the rows' null space; what is left is its rounding.
-        assert!(fitted.residual <= tol, "{:e}", fitted.residual);
+        assert!(residual <= tol, "{residual:e}");
 
-        let SignedSystem {
-            rows,
-            c,
-            target,
-            signed,
-            ..
-        } = signed_system(500, 600, 6, 1, -0.25);
-        let sb = |rounds, fit| cholesky::SignBox {
-            signed: signed.clone(),
-            margin: 0.1,
-            rounds,
-            fit,
-        };
-        let plain = solve_near(&rows, n, &c, &target, tol, MAX_VALUES).expect("small");
-        let solve = |b: cholesky::SignBox| {
-            solve_near_signed(&rows, n, &c, &target, tol, MAX_VALUES, Some(&b)).expect("small")
-        };
-        let (alt, fit) = (solve(sb(100, 0)), solve(sb(0, 100)));
-        let off = |x: &[f64]| sb(0, 0).off(x, 0.0);
-        eprintln!(
-            "off: plain {}, alternating {}, fit {}",
-            off(&plain.x),
-            off(&alt.x),
-            off(&fit.x)
-        );
-        assert!(
-            off(&fit.x) < off(&alt.x),
-            "{} vs {}",
-            off(&fit.x),
-            off(&alt.x)
-        );
-        assert!(fit.residual <= tol, "{:e}", fit.residual);
+        let (plain, alt, fit, residual) = run(500, 6, 1, -0.25);
+        eprintln!("off: plain {plain}, alternating {alt}, fit {fit}");
+        assert!(fit < alt, "{fit} vs {alt}");
+        assert!(residual <= tol, "{residual:e}");
     }
 
     /// A dropped row whose data contradict the kept rows (1e-3 off, at distance 1e-11 from
