@@ -117,7 +117,8 @@ pub struct QuinticOptions {
     /// as `sign_program`) in each group too large to pin, split so that a round is one solve
     /// with the group's factor (ADMM, `signsplit`), after its dropped rows are met and moving
     /// orthogonally to what met them (0 = off, the default). The round with the fewest
-    /// weights off is kept if the rows stay met within 2× the solve's residual.
+    /// weights off is kept if, its dropped rows met again, the rows stay met within 10×
+    /// the solve's residual.
     pub joint_sign_fit: usize,
     /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2, and the
     /// stars one ring in) of the tetrahedra around every boundary face the surface crosses (a

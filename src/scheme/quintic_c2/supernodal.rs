@@ -834,7 +834,7 @@ mod tests {
     /// unknowns, x* with a quarter of its weights off), it leaves fewer weights off than as
     /// many rounds of alternating projections (`sign_rounds`): the sign program's point, the
     /// fewest misses rather than a least-squares compromise (measured: 198 off in the plain
-    /// solve, 100 after alternating projections, 70 after the fit).
+    /// solve, 100 after alternating projections, 80 after the fit).
     #[test]
     fn the_split_sign_program_leaves_fewer_weights_off_than_alternating_projections() {
         let (tol, n) = (1e-12, 600);
