@@ -250,9 +250,27 @@ pub struct SheetStats {
     pub j_multi_lines: usize,
     /// Patches with such a line.
     pub j_multi_patches: usize,
-    /// An example (the line's first root).
+    /// An example (the line's first sample past its first root).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub j_multi_at: Option<Location>,
+    /// Every patch with such a line, in patch order (`apatch check --holes FILE` writes them
+    /// beside the holes). Not in the report's JSON, as [`HoleStats::faces`].
+    #[serde(skip)]
+    pub j_sheets: Vec<JSheet>,
+}
+
+/// One patch whose surface a j-line meets more than once (a j-sheet), for locating them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct JSheet {
+    /// The patch.
+    pub patch: usize,
+    /// The patch's hull role and mesh element, e.g. "face 12".
+    pub element: String,
+    /// Its j-lines that meet F = 0 more than once (a zero face that turns counts as one).
+    pub lines: usize,
+    /// Where: on the first such line, its first sample past the first root (within
+    /// 1/[`CheckOptions::line_samples`] of the line's length), or the zero face's centroid.
+    pub point: [f64; 3],
 }
 
 /// Holes: boundary faces of the hull (faces of one patch only) that the surface crosses
@@ -716,6 +734,50 @@ mod tests {
             ..CheckOptions::default()
         };
         assert!(check(&c, &strict).failures().contains(&"multiple sheets"));
+    }
+
+    #[test]
+    fn j_sheets_are_listed_with_their_first_root() {
+        // Quadratic weights 1 at the apex (vertex 3) and on the base, −2 between: along every
+        // j-line from the apex, φ(t) = (1−t)² − 4t(1−t) + t² = 1 − 6t + 6t², with two roots in
+        // (0, 1), the first at t* = (3 − √3)/6.
+        let twice: Vec<f64> = crate::bb::multi_indices(2)
+            .iter()
+            .map(|l| if l[3] == 1 { -2.0 } else { 1.0 })
+            .collect();
+        // F = λ₃ − ½ (weights: apex 1, base −½, between ¼): one root on every j-line.
+        let once: Vec<f64> = crate::bb::multi_indices(2)
+            .iter()
+            .map(|l| f64::from(l[3]) / 2.0 - 0.5)
+            .collect();
+        let apex_patch = |w: Vec<f64>, shift: f64| {
+            let p = unit_tet_patch(2, w, SheetRule::Any);
+            Patch {
+                jvertex: Some(3),
+                element: 7,
+                tet: p.tet.map(|v| v.map(|x| x + shift)),
+                ..p
+            }
+        };
+        let mut c = PatchComplex::new("test");
+        c.patches.push(apex_patch(once, 0.0));
+        c.patches.push(apex_patch(twice, 5.0));
+        let r = check(&c, &CheckOptions::default());
+        assert_eq!(r.sheets.j_multi_patches, 1, "{r}");
+        assert_eq!(r.sheets.j_sheets.len(), 1, "{r}");
+        let s = &r.sheets.j_sheets[0];
+        assert_eq!((s.patch, s.element.as_str()), (1, "face 7"));
+        // Every line of the second patch crosses twice: half of all lines sampled.
+        assert_eq!(2 * s.lines, r.sheets.j_lines, "{r}");
+        assert_eq!(s.lines, r.sheets.j_multi_lines, "{r}");
+        // The point is the line's first sample past its first root: t in [t*, t* + 1/n) for
+        // the checker's n samples per line, so λ₃ = z − 5 (the patch moved by 5 along every
+        // axis) = 1 − t lies in (1 − t* − 1/n, 1 − t*].
+        let n = CheckOptions::default().line_samples as f64;
+        let t = 1.0 - (s.point[2] - 5.0);
+        let t_star = (3.0 - 3f64.sqrt()) / 6.0;
+        assert!(t >= t_star && t < t_star + 1.0 / n, "{s:?}");
+        assert!(r.failures().contains(&"multiple sheets along j-lines"));
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //!   F = 0 more than once. (Touching roots and pairs of roots between two samples are not seen.)
 
 use super::eval::PatchEval;
-use super::{CheckOptions, Location, SheetStats};
+use super::{CheckOptions, JSheet, Location, SheetStats};
 use crate::bb::rational::segment_poly;
 use crate::bb::{index_of, multi_indices, uni};
 use crate::complex::{Patch, SheetRule};
@@ -54,6 +54,7 @@ fn merge(a: SheetStats, b: SheetStats) -> SheetStats {
         j_multi_lines: a.j_multi_lines + b.j_multi_lines,
         j_multi_patches: a.j_multi_patches + b.j_multi_patches,
         j_multi_at: a.j_multi_at.or(b.j_multi_at),
+        j_sheets: [a.j_sheets, b.j_sheets].concat(),
     }
 }
 
@@ -188,19 +189,17 @@ fn j_lines(e: &PatchEval<'_>, opts: &CheckOptions, n: usize, stats: &mut SheetSt
         return;
     };
     stats.j_patches += 1;
-    let mut multi = false;
+    let before = stats.j_multi_lines;
+    let mut first: Option<[f64; 3]> = None;
     if let Some(j) = e.patch.jvertex.filter(|_| e.patch.rational.is_empty()) {
         let (n, w) = (usize::from(e.patch.degree), &e.patch.weights);
         if zero_face_turns(n, w, usize::from(j)) {
             // Every j-line through the face's points of the wrong sign meets F = 0 twice;
             // counted as one line, placed at the face's centroid.
             stats.j_multi_lines += 1;
-            if stats.j_multi_at.is_none() {
-                let mut c = [1.0 / 3.0; 4];
-                c[usize::from(j)] = 0.0;
-                stats.j_multi_at = Some(Location::new(&[e], point(e, c), None));
-            }
-            multi = true;
+            let mut c = [1.0 / 3.0; 4];
+            c[usize::from(j)] = 0.0;
+            first = Some(point(e, c));
         }
     }
     for a in &from {
@@ -208,14 +207,22 @@ fn j_lines(e: &PatchEval<'_>, opts: &CheckOptions, n: usize, stats: &mut SheetSt
             stats.j_lines += 1;
             if let Some(t) = interior_roots_beyond_one(e, a, b, n) {
                 stats.j_multi_lines += 1;
-                if stats.j_multi_at.is_none() {
-                    stats.j_multi_at = Some(Location::new(&[e], point(e, lerp(a, b, t)), None));
-                }
-                multi = true;
+                first.get_or_insert_with(|| point(e, lerp(a, b, t)));
             }
         }
     }
-    stats.j_multi_patches += usize::from(multi);
+    if let Some(p) = first {
+        stats.j_multi_patches += 1;
+        stats
+            .j_multi_at
+            .get_or_insert_with(|| Location::new(&[e], p, None));
+        stats.j_sheets.push(JSheet {
+            patch: e.id,
+            element: format!("{} {}", e.patch.role.name(), e.patch.element),
+            lines: stats.j_multi_lines - before,
+            point: p,
+        });
+    }
 }
 
 /// Whether F of a polynomial patch (degree `n` ≥ 2, BB `weights`) vanishes on the whole face
@@ -255,8 +262,8 @@ pub(crate) fn zero_face_turns(n: usize, weights: &[f64], j: usize) -> bool {
     crate::check::holes::polynomial_face_crossed(n - 1, &g, j)
 }
 
-/// `Some(first root)` when F on the segment from `a` to `b` has more than one root in (0, 1)
-/// once roots at the ends are divided out: Descartes' rule on the Bernstein coefficients
+/// `Some(t)` (t the first sample past the first root) when F on the segment from `a` to `b`
+/// has more than one root in (0, 1) once roots at the ends are divided out: Descartes' rule on the Bernstein coefficients
 /// decides ≤ 1 root; otherwise the deflated polynomial is sampled at `n` + 1 points.
 fn interior_roots_beyond_one(
     e: &PatchEval<'_>,
@@ -268,7 +275,7 @@ fn interior_roots_beyond_one(
     roots_beyond_one(c, len, n)
 }
 
-/// `Some(first root)` when the univariate Bernstein polynomial `c[..len]` on [0, 1] has more
+/// `Some(t)` (t the first sample past the first root) when the univariate Bernstein polynomial `c[..len]` on [0, 1] has more
 /// than one root in [0, 1] apart from a root at 0 (see [`interior_roots_beyond_one`]); shared
 /// with the quintic scheme's repair, which must judge a patch's j-lines as this check does.
 ///

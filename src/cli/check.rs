@@ -37,7 +37,9 @@ pub struct CheckArgs {
     #[arg(long)]
     pub single_sheet: bool,
     /// Also write every boundary face the surface crosses (the holes: patch, element, corners,
-    /// depth, a point of the minority sign) to this JSON file (format `apatch-holes`).
+    /// depth, a point of the minority sign) and every patch a j-line crosses twice (the
+    /// j-sheets: patch, element, lines, the first root) to this JSON file (format
+    /// `apatch-holes`).
     #[arg(long, value_name = "FILE")]
     pub holes: Option<PathBuf>,
 }
@@ -54,6 +56,8 @@ fn write_holes(path: &Path, input: &Path, report: &check::CheckReport) -> anyhow
         "boundary_faces": report.holes.boundary_faces,
         "crossing": report.holes.crossing,
         "faces": report.holes.faces,
+        "j_sheet_patches": report.sheets.j_multi_patches,
+        "j_sheets": report.sheets.j_sheets,
     });
     apatch::export::write_atomically(path, |out| {
         serde_json::to_writer(&mut *out, &doc).map_err(std::io::Error::other)?;
@@ -407,8 +411,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &args.holes {
         write_holes(path, &args.input, &report)?;
         eprintln!(
-            "apatch: wrote {} crossed boundary faces to {}",
+            "apatch: wrote {} crossed boundary faces and {} j-sheet patches to {}",
             report.holes.faces.len(),
+            report.sheets.j_sheets.len(),
             path.display()
         );
     }

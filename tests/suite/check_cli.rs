@@ -633,6 +633,11 @@ fn holes_file_lists_every_crossed_face() {
     assert_eq!(doc["crossing"].as_u64().unwrap() as usize, count);
     let faces = doc["faces"].as_array().unwrap();
     assert_eq!(faces.len(), count);
+    // The j-sheets beside them: as many as the report counts (none on this cylinder; the
+    // list's content is tested in `check::tests::j_sheets_are_listed_with_their_first_root`).
+    let sheets = report["sheets"]["j_multi_patches"].as_u64().unwrap();
+    assert_eq!(doc["j_sheet_patches"].as_u64(), Some(sheets));
+    assert_eq!(doc["j_sheets"].as_array().unwrap().len() as u64, sheets);
 
     let complex = apatch::complex_io::read_json_file(&patches).unwrap();
     let key = |p: [f64; 3]| p.map(f64::to_bits);
