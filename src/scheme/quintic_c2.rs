@@ -201,6 +201,16 @@ impl QuinticOptions {
                     )
                 })
             };
+            let count = || -> anyhow::Result<usize> {
+                v.as_integer()
+                    .and_then(|i| usize::try_from(i).ok())
+                    .ok_or_else(|| {
+                        anyhow::anyhow!(
+                            "{}: `scheme.{k}` must be a whole number ≥ 0, got {v}",
+                            scene.display()
+                        )
+                    })
+            };
             match k.as_str() {
                 "type" => {}
                 k if crate::hull::inner::InnerOptions::KEYS.contains(&k) => {}
@@ -225,17 +235,7 @@ impl QuinticOptions {
                 "thicken_edges" => o.thicken_edges = flag()?,
                 "balance_edges" => o.balance_edges = flag()?,
                 "sign_program" => o.sign_program = flag()?,
-                "sign_rounds" => {
-                    o.sign_rounds = v
-                        .as_integer()
-                        .and_then(|x| usize::try_from(x).ok())
-                        .ok_or_else(|| {
-                            anyhow::anyhow!(
-                                "{}: `scheme.sign_rounds` must be a whole number ≥ 0, got {v}",
-                                scene.display()
-                            )
-                        })?;
-                }
+                "sign_rounds" => o.sign_rounds = count()?,
                 "zero_groups" => o.zero_groups = flag()?,
                 "tangent_clearance" => {
                     let margin = crate::scheme::cubic_c1::tangent::TANGENT_MARGIN;
@@ -261,28 +261,8 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
-                "joint_sign_rounds" => {
-                    o.joint_sign_rounds = v
-                        .as_integer()
-                        .and_then(|i| usize::try_from(i).ok())
-                        .ok_or_else(|| {
-                            anyhow::anyhow!(
-                                "{}: `scheme.joint_sign_rounds` must be a whole number ≥ 0, got {v}",
-                                scene.display()
-                            )
-                        })?;
-                }
-                "joint_sign_fit" => {
-                    o.joint_sign_fit = v
-                        .as_integer()
-                        .and_then(|i| usize::try_from(i).ok())
-                        .ok_or_else(|| {
-                            anyhow::anyhow!(
-                                "{}: `scheme.joint_sign_fit` must be a whole number ≥ 0, got {v}",
-                                scene.display()
-                            )
-                        })?;
-                }
+                "joint_sign_rounds" => o.joint_sign_rounds = count()?,
+                "joint_sign_fit" => o.joint_sign_fit = count()?,
                 "signs" => o.signs = flag()?,
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));

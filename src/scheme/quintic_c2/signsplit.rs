@@ -66,6 +66,10 @@ pub(super) fn fit<F: NormalSolve>(
     sb: &SignBox,
     bound: f64,
 ) -> Option<f64> {
+    let margin = sb.margin;
+    if sb.fit == 0 || sb.signed.is_empty() || margin.is_nan() || margin <= 0.0 {
+        return None;
+    }
     let n = x.len();
     let m = unit.rows.len();
     let x0 = x.clone();
@@ -74,10 +78,6 @@ pub(super) fn fit<F: NormalSolve>(
     // Weights this small are zero up to the solves' rounding (as `sign_rounds`).
     let tiny = 1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let off_before = sb.off(x, tiny);
-    let margin = sb.margin;
-    if sb.fit == 0 || sb.signed.is_empty() || margin.is_nan() || margin <= 0.0 {
-        return None;
-    }
     let mut sign = vec![0.0; n];
     for &(j, s) in &sb.signed {
         sign[j] = s;
