@@ -18,6 +18,7 @@ pub mod jets;
 pub mod ordering;
 mod pinned;
 pub mod project;
+pub mod resume;
 pub mod signfit;
 pub mod signs;
 mod signsplit;
@@ -415,17 +416,24 @@ pub fn build_prepared(
         signs::HessianFit::default()
     };
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
-    let (mut value, mut stats) = sys.solve(
-        &tets,
-        &jets,
-        nt,
-        &target,
-        options.signs,
-        options.joint_stars,
-        options.relax_stars,
-        options.consistent_stars,
-        options.hessian_signs,
-    )?;
+    let (mut value, mut stats) = match resume::requested() {
+        // Exploration: the solve's result read back from an exported complex.
+        Some(path) => (
+            resume::slot_values(&sys, &tets, &path)?,
+            system::SolveStats::default(),
+        ),
+        None => sys.solve(
+            &tets,
+            &jets,
+            nt,
+            &target,
+            options.signs,
+            options.joint_stars,
+            options.relax_stars,
+            options.consistent_stars,
+            options.hessian_signs,
+        )?,
+    };
     if options.sign_rounds > 0 || options.sign_program {
         stats.sign_projection =
             project::project_signs(&sys, &mut value, options.sign_rounds, options.sign_program);

@@ -44,6 +44,7 @@ mod progress;
 mod quintic_c2;
 mod quintic_holes;
 mod quintic_models;
+mod quintic_resume;
 mod quintic_solve;
 mod rational_meshes;
 mod rational_models;
