@@ -328,9 +328,9 @@ pub fn repair(
             .filter(|&&d| is_open(d, value))
             .filter_map(|&d| neighbourhood(sys, tets, d, &index, reach))
             .collect();
-        crate::progress::report(|| {
+        let pass = || {
             format!(
-                "quintic-c2 hole repair: {} defects open ({} rings{})",
+                "{} defects open ({} rings{})",
                 open.len(),
                 reach.rings,
                 if reach.hessians {
@@ -339,7 +339,9 @@ pub fn repair(
                     ""
                 }
             )
-        });
+        };
+        crate::progress::report(|| format!("quintic-c2 hole repair: {}", pass()));
+        trace(pass);
         let reads: Vec<Vec<u32>> = open.par_iter().map(|l| l.reads(sys)).collect();
         // Waves: in defect order, a defect joins the wave unless it writes what a defect
         // before it (in the wave, or left for a later wave) reads, or reads what one writes.
@@ -914,6 +916,13 @@ fn repair_defect(
         return None;
     }
     x.truncate(unk.len());
+    trace(|| {
+        format!(
+            "{defect:?}: repaired, {} pins{}, residual {grown:.2e}",
+            pins.len(),
+            if soft { " (weighted)" } else { "" }
+        )
+    });
     Some((x, pins.len(), soft))
 }
 
@@ -1060,7 +1069,8 @@ fn dump(
     }
 }
 
-/// Opt-in report of refused repairs on stderr (`APATCH_HOLE_TRACE`; results unaffected).
+/// Opt-in report of each pass and each repair, kept or refused, on stderr (`APATCH_HOLE_TRACE`;
+/// results unaffected).
 fn trace(msg: impl FnOnce() -> String) {
     if std::env::var_os("APATCH_HOLE_TRACE").is_some() {
         eprintln!("quintic-c2 hole repair: {}", msg());
