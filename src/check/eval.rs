@@ -133,6 +133,12 @@ impl<'a> PatchEval<'a> {
         }
     }
 
+    /// The patch's hull role and mesh element, e.g. "face 12", as the reports name it.
+    #[must_use]
+    pub fn element(&self) -> String {
+        format!("{} {}", self.patch.role.name(), self.patch.element)
+    }
+
     /// The largest magnitude among the patch's weights (polynomial and rational): the scale
     /// against which values of F are judged.
     #[must_use]

@@ -81,7 +81,7 @@ pub(super) fn measure(evals: &[PatchEval<'_>], boundary: &[(u32, u8)]) -> HoleSt
                 }
                 s.faces.push(CrossedFace {
                     patch: e.id,
-                    element: format!("{} {}", e.patch.role.name(), e.patch.element),
+                    element: e.element(),
                     corners,
                     depth: v.depth,
                     point: v.point,

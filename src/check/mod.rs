@@ -126,10 +126,7 @@ impl Location {
             patches: patches.iter().map(|e| e.id).collect(),
             point,
             vertex,
-            elements: patches
-                .iter()
-                .map(|e| format!("{} {}", e.patch.role.name(), e.patch.element))
-                .collect(),
+            elements: patches.iter().map(|e| e.element()).collect(),
         }
     }
 }

@@ -38,6 +38,8 @@ fn merge(a: SheetStats, b: SheetStats) -> SheetStats {
     } else {
         (a.min_root_slope, a.min_root_slope_at)
     };
+    let mut j_sheets = a.j_sheets;
+    j_sheets.extend(b.j_sheets);
     SheetStats {
         shooting_patches: a.shooting_patches + b.shooting_patches,
         shooting_lines: a.shooting_lines + b.shooting_lines,
@@ -54,7 +56,7 @@ fn merge(a: SheetStats, b: SheetStats) -> SheetStats {
         j_multi_lines: a.j_multi_lines + b.j_multi_lines,
         j_multi_patches: a.j_multi_patches + b.j_multi_patches,
         j_multi_at: a.j_multi_at.or(b.j_multi_at),
-        j_sheets: [a.j_sheets, b.j_sheets].concat(),
+        j_sheets,
     }
 }
 
@@ -218,7 +220,7 @@ fn j_lines(e: &PatchEval<'_>, opts: &CheckOptions, n: usize, stats: &mut SheetSt
             .get_or_insert_with(|| Location::new(&[e], p, None));
         stats.j_sheets.push(JSheet {
             patch: e.id,
-            element: format!("{} {}", e.patch.role.name(), e.patch.element),
+            element: e.element(),
             lines: stats.j_multi_lines - before,
             point: p,
         });
@@ -263,8 +265,9 @@ pub(crate) fn zero_face_turns(n: usize, weights: &[f64], j: usize) -> bool {
 }
 
 /// `Some(t)` (t the first sample past the first root) when F on the segment from `a` to `b`
-/// has more than one root in (0, 1) once roots at the ends are divided out: Descartes' rule on the Bernstein coefficients
-/// decides ≤ 1 root; otherwise the deflated polynomial is sampled at `n` + 1 points.
+/// has more than one root in (0, 1) once roots at the ends are divided out: Descartes' rule
+/// on the Bernstein coefficients decides ≤ 1 root; otherwise the deflated polynomial is
+/// sampled at `n` + 1 points.
 fn interior_roots_beyond_one(
     e: &PatchEval<'_>,
     a: &[f64; 4],
@@ -275,9 +278,10 @@ fn interior_roots_beyond_one(
     roots_beyond_one(c, len, n)
 }
 
-/// `Some(t)` (t the first sample past the first root) when the univariate Bernstein polynomial `c[..len]` on [0, 1] has more
-/// than one root in [0, 1] apart from a root at 0 (see [`interior_roots_beyond_one`]); shared
-/// with the quintic scheme's repair, which must judge a patch's j-lines as this check does.
+/// `Some(t)` (t the first sample past the first root) when the univariate Bernstein
+/// polynomial `c[..len]` on [0, 1] has more than one root in [0, 1] apart from a root at 0
+/// (see [`interior_roots_beyond_one`]); shared with the quintic scheme's repair, which must
+/// judge a patch's j-lines as this check does.
 ///
 /// A root at 0 (the j-vertex on the surface, a zero-convex j-edge) is shared by every line of
 /// the patch and divided out. A root at 1 is divided out too but still counts: the far end

@@ -39,13 +39,7 @@ pub fn slot_values(sys: &System, tets: &[HullTet], path: &Path) -> Result<Vec<f6
             tets.len()
         )));
     }
-    let slots = sys
-        .slot_of
-        .iter()
-        .flatten()
-        .max()
-        .map_or(0, |&s| s as usize + 1);
-    let mut value = vec![f64::NAN; slots];
+    let mut value = vec![f64::NAN; sys.keys.len()];
     for (t, (p, tet)) in complex.patches.iter().zip(tets).enumerate() {
         let same_tet = p
             .tet
