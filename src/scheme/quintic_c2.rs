@@ -127,11 +127,12 @@ pub struct QuinticOptions {
     /// C1/C2 equations and the defect's weights pinned to Theorem 2.1's signs ([`holes`]): C2
     /// is kept exactly and nothing changes away from the defects. Off by default.
     pub repair_holes: bool,
-    /// With `repair_holes`: two last passes that also free the Hessians of the jets within
-    /// reach ([`holes::Reach::hessians`]) for the defects the other passes leave, such as base
-    /// faces of face tetrahedra, whose weights are all jets and stars. On by default
-    /// (letter_P_poly without `hessian_signs`: 28 → 10 crossed faces; bunny: 6 → 3).
-    pub repair_hessians: bool,
+    /// With `repair_holes`: when the repair also frees the Hessians of the jets within reach
+    /// ([`holes::Reach::hessians`]), for defects whose weights are all jets and stars, such
+    /// as base faces of face tetrahedra. `true` (the default, [`HessianRepair::Last`]): two
+    /// last passes for what the others leave (letter_P_poly without `hessian_signs`: 28 → 10
+    /// crossed faces; bunny: 6 → 3); `"all"`: every pass; `false`: never.
+    pub repair_hessians: HessianRepair,
     /// Move apart the apexes of edge tetrahedra that are slivers (relative volume below
     /// [`slivers::EDGE_MIN_VOLUME`]) before building: their world Hessians carry the weights'
     /// rounding times (L / h)², which no solve can remove ([`slivers`]). On by default; hulls
@@ -173,13 +174,26 @@ impl Default for QuinticOptions {
             tangent_clearance: 0.0,
             zero_groups: false,
             repair_holes: false,
-            repair_hessians: true,
+            repair_hessians: HessianRepair::Last,
             thicken_edges: true,
             balance_edges: false,
             sign_rounds: 0,
             sign_program: false,
         }
     }
+}
+
+/// When the hole repair frees the Hessians of the jets within its reach
+/// ([`QuinticOptions::repair_hessians`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HessianRepair {
+    /// Never: the jets stay as the solve left them.
+    Off,
+    /// In two last passes, for the defects the passes with the Hessians held leave.
+    Last,
+    /// In every pass: on fandisk most defects sit at weights the Hessians set, and a pass
+    /// with them held refuses those for want of anything to pin (docs/quintic.md).
+    All,
 }
 
 /// Default [`QuinticOptions::lift`].
@@ -232,7 +246,17 @@ impl QuinticOptions {
                 "hessian_signs" => o.hessian_signs = flag()?,
                 "contain_tangents" => o.contain_tangents = flag()?,
                 "repair_holes" => o.repair_holes = flag()?,
-                "repair_hessians" => o.repair_hessians = flag()?,
+                "repair_hessians" => {
+                    o.repair_hessians = match (v.as_bool(), v.as_str()) {
+                        (Some(true), _) | (_, Some("last")) => HessianRepair::Last,
+                        (Some(false), _) => HessianRepair::Off,
+                        (_, Some("all")) => HessianRepair::All,
+                        _ => bail!(
+                            "{}: `scheme.repair_hessians` must be true, false, \"last\" or \"all\", got {v}",
+                            scene.display()
+                        ),
+                    }
+                }
                 "thicken_edges" => o.thicken_edges = flag()?,
                 "balance_edges" => o.balance_edges = flag()?,
                 "sign_program" => o.sign_program = flag()?,
@@ -447,9 +471,11 @@ pub fn build_prepared(
             // Exploration overrides (`APATCH_HOLE_RINGS`, `APATCH_HOLE_STARS=0`); the defaults
             // are the measured best on the torus (docs/quintic.md).
             stars: std::env::var("APATCH_HOLE_STARS").map_or(true, |v| v != "0"),
-            hessians: std::env::var("APATCH_HOLE_HESSIANS").is_ok_and(|v| v != "0"),
+            hessians: options.repair_hessians == HessianRepair::All
+                || std::env::var("APATCH_HOLE_HESSIANS").is_ok_and(|v| v != "0"),
         };
-        stats.hole_repair = holes::repair(&sys, &tets, &mut value, reach, options.repair_hessians);
+        let last = options.repair_hessians != HessianRepair::Off;
+        stats.hole_repair = holes::repair(&sys, &tets, &mut value, reach, last);
         if std::env::var_os("APATCH_SIGN_TRACE").is_some() {
             // Opt-in exploration on stderr (results unaffected).
             eprintln!("quintic-c2 hole repair: {:?}", stats.hole_repair);

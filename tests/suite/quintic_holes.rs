@@ -226,4 +226,18 @@ fn repair_hessian_passes_mend_letter_p_base_faces() {
     );
     assert_eq!(after.sheets.j_multi_patches, 0, "{:?}", after.sheets);
     assert_eq!(after.failures(), ["holes"], "{after:?}");
+    // `repair_hessians = "all"`: the Hessians free in every pass, as the environment
+    // override `APATCH_HOLE_HESSIANS=1` asked before the key existed.
+    let all = repaired.replace(
+        "repair_holes = true",
+        "repair_holes = true\nrepair_hessians = \"all\"",
+    );
+    let every = check(&build(&all), &CheckOptions::default());
+    assert!(
+        every.holes.crossing < base.holes.crossing,
+        "{:?} vs {:?}",
+        every.holes,
+        base.holes
+    );
+    assert_eq!(every.sheets.j_multi_patches, 0, "{:?}", every.sheets);
 }

@@ -44,7 +44,11 @@ fn options() -> QuinticOptions {
             .and_then(|x| x.parse().ok())
             .unwrap_or(0.0),
         repair_holes: std::env::var("REPAIR").is_ok_and(|s| s == "1"),
-        repair_hessians: std::env::var("REPAIR_HESSIANS").map_or(true, |s| s != "0"),
+        repair_hessians: match std::env::var("REPAIR_HESSIANS").as_deref() {
+            Ok("0") => apatch::scheme::quintic_c2::HessianRepair::Off,
+            Ok("all") => apatch::scheme::quintic_c2::HessianRepair::All,
+            _ => apatch::scheme::quintic_c2::HessianRepair::Last,
+        },
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
         balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
         joint_sign_rounds: std::env::var("JOINT_SIGN_ROUNDS")

@@ -251,3 +251,31 @@ fn sign_targets_key_is_read_and_checked() {
         );
     }
 }
+
+/// `[scheme] repair_hessians` is true (the two last passes, the default), false, or one of
+/// the names `"last"` and `"all"`; anything else is an error naming the scene and the key.
+#[test]
+fn repair_hessians_key_is_read_and_checked() {
+    use apatch::scheme::quintic_c2::HessianRepair;
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert_eq!(read("").unwrap().repair_hessians, HessianRepair::Last);
+    for (text, want) in [
+        ("true", HessianRepair::Last),
+        ("false", HessianRepair::Off),
+        ("\"last\"", HessianRepair::Last),
+        ("\"all\"", HessianRepair::All),
+    ] {
+        let got = read(&format!("repair_hessians = {text}")).unwrap();
+        assert_eq!(got.repair_hessians, want, "{text}");
+    }
+    for bad in ["\"first\"", "1", "\"All\""] {
+        let e = read(&format!("repair_hessians = {bad}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("repair_hessians"),
+            "{e}"
+        );
+    }
+}

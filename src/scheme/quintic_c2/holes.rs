@@ -52,8 +52,9 @@ pub struct HoleRepair {
     pub widened: usize,
     /// Of the repairs kept, those whose pins were met only as weighted targets ([`SOFT`]).
     pub soft: usize,
-    /// Of the repairs kept, those of the two last passes (`repair_hessians`), with the Hessians of the
-    /// jets free ([`Reach::hessians`]).
+    /// Of the repairs kept, those of the two last passes (`repair_hessians = true`), with the
+    /// Hessians of the jets free ([`Reach::hessians`]); 0 when every pass frees them
+    /// (`repair_hessians = "all"`).
     pub hessian: usize,
     /// Patches crossed twice along a j-line ([`j_sheeted`]) after the solve.
     pub sheets_before: usize,
@@ -296,9 +297,10 @@ pub fn repair(
         }
     }
     let mi = multi_indices(5);
-    // Passes: the asked reach, [`WIDEN`] wider ones, then (the scene's `repair_hessians`, [`hessian_passes`]) the
-    // asked reach and one ring more with the Hessians free for what is left (a base face of a
-    // face tetrahedron holds no late weight: its weights are jets and stars).
+    // Passes: the asked reach, [`WIDEN`] wider ones, then (the scene's `repair_hessians`,
+    // [`hessian_passes`]) the asked reach and one ring more with the Hessians free for what is
+    // left (a base face of a face tetrahedron holds no late weight: its weights are jets and
+    // stars), unless the asked reach frees them already (`repair_hessians = "all"`).
     let asked = reach;
     let passes = (0..=WIDEN)
         .map(|extra| Reach {
