@@ -141,6 +141,13 @@ fn hessian_passes(asked: bool) -> bool {
     asked && std::env::var("APATCH_HOLE_HESSIAN_PASSES").map_or(true, |v| v != "0")
 }
 
+/// Exploration: with `APATCH_HOLE_ONLY=t1,t2,…` only the defects of those tetrahedra are
+/// repaired (to study one refusal in a large model without waiting for the others).
+fn only_tets() -> Option<HashSet<u32>> {
+    let v = std::env::var("APATCH_HOLE_ONLY").ok()?;
+    Some(v.split(',').filter_map(|x| x.trim().parse().ok()).collect())
+}
+
 /// Whether [`SOFT_MAX`] escalation is on (`APATCH_HOLE_SOFT_MAX=0` turns it off, to compare).
 fn soft_escalation() -> bool {
     std::env::var("APATCH_HOLE_SOFT_MAX").map_or(true, |v| v != "0")
@@ -325,8 +332,10 @@ pub fn repair(
             wmax,
         };
         // The defects still open (earlier passes repaired some), with their neighbourhoods.
+        let only = only_tets();
         let open: Vec<Local> = defects
             .par_iter()
+            .filter(|&&d| only.as_ref().is_none_or(|o| o.contains(&d.at().0)))
             .filter(|&&d| is_open(d, value))
             .filter_map(|&d| neighbourhood(sys, tets, d, &index, reach))
             .collect();
@@ -816,8 +825,31 @@ fn repair_defect(
                             )
                         })
                         .collect();
+                    // The face's weights whose sign differs from its largest's: where it
+                    // crosses (exploration detail, with which are re-solved).
+                    let lead = lifted
+                        .iter()
+                        .map(|&s| trial[s as usize])
+                        .fold(0.0_f64, |a, v| if v.abs() > a.abs() { v } else { a });
+                    let against: Vec<String> = lifted
+                        .iter()
+                        .filter(|&&s| trial[s as usize] * lead < 0.0)
+                        .map(|&s| {
+                            format!(
+                                "{:?} req {} {:.2e}{}",
+                                super::system::unkey(sys.keys[s as usize]),
+                                sys.req[s as usize],
+                                trial[s as usize],
+                                if col.contains_key(&s) {
+                                    " solved"
+                                } else {
+                                    " held"
+                                }
+                            )
+                        })
+                        .collect();
                     format!(
-                        "{defect:?}: {} pins; still there ({held_wrong} held weights with the wrong sign; without a sign: {unsigned:?}), side {:?} role {:?}",
+                        "{defect:?}: {} pins; still there ({held_wrong} held weights with the wrong sign; without a sign: {unsigned:?}; against the largest {lead:.2e}: {against:?}), side {:?} role {:?}",
                         pins.len(),
                         tet.side,
                         tet.role
