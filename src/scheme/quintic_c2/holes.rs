@@ -323,6 +323,7 @@ pub fn repair(
                     ..asked
                 }),
         );
+    let only = only_tets();
     for reach in passes {
         let index = Index {
             tets_of: &tets_of,
@@ -332,7 +333,6 @@ pub fn repair(
             wmax,
         };
         // The defects still open (earlier passes repaired some), with their neighbourhoods.
-        let only = only_tets();
         let open: Vec<Local> = defects
             .par_iter()
             .filter(|&&d| only.as_ref().is_none_or(|o| o.contains(&d.at().0)))
@@ -813,17 +813,18 @@ fn repair_defect(
                     let big = lifted
                         .iter()
                         .fold(0.0_f64, |a, &s| a.max(trial[s as usize].abs()));
+                    // A weight as the trace names it: its key and required sign.
+                    let name = |s: u32| {
+                        format!(
+                            "{:?} req {}",
+                            super::system::unkey(sys.keys[s as usize]),
+                            sys.req[s as usize]
+                        )
+                    };
                     let unsigned: Vec<String> = lifted
                         .iter()
                         .filter(|&&s| !has_sign(s))
-                        .map(|&s| {
-                            format!(
-                                "{:?} req {} {:.1e}",
-                                super::system::unkey(sys.keys[s as usize]),
-                                sys.req[s as usize],
-                                trial[s as usize] / big
-                            )
-                        })
+                        .map(|&s| format!("{} {:.1e}", name(s), trial[s as usize] / big))
                         .collect();
                     // The face's weights whose sign differs from its largest's: where it
                     // crosses (exploration detail, with which are re-solved).
@@ -835,17 +836,12 @@ fn repair_defect(
                         .iter()
                         .filter(|&&s| trial[s as usize] * lead < 0.0)
                         .map(|&s| {
-                            format!(
-                                "{:?} req {} {:.2e}{}",
-                                super::system::unkey(sys.keys[s as usize]),
-                                sys.req[s as usize],
-                                trial[s as usize],
-                                if col.contains_key(&s) {
-                                    " solved"
-                                } else {
-                                    " held"
-                                }
-                            )
+                            let how = if col.contains_key(&s) {
+                                "solved"
+                            } else {
+                                "held"
+                            };
+                            format!("{} {:.2e} {how}", name(s), trial[s as usize])
                         })
                         .collect();
                     format!(
