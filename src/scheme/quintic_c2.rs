@@ -8,6 +8,7 @@
 //! single-sheeted (see [`QuinticOptions`]). The result is C2 across every shared face
 //! and interpolates T's points with ∇F ∥ their normals.
 
+pub mod checkpoint;
 pub mod cholesky;
 mod dd;
 pub mod dense;
@@ -475,7 +476,14 @@ pub fn build_prepared(
                 || std::env::var("APATCH_HOLE_HESSIANS").is_ok_and(|v| v != "0"),
         };
         let last = options.repair_hessians != HessianRepair::Off;
-        stats.hole_repair = holes::repair(&sys, &tets, &mut value, reach, last);
+        stats.hole_repair = holes::repair(
+            &sys,
+            &tets,
+            &mut value,
+            reach,
+            last,
+            checkpoint::requested().as_deref(),
+        )?;
         if std::env::var_os("APATCH_SIGN_TRACE").is_some() {
             // Opt-in exploration on stderr (results unaffected).
             eprintln!("quintic-c2 hole repair: {:?}", stats.hole_repair);

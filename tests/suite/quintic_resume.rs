@@ -11,12 +11,24 @@ fn tmp(name: &str) -> PathBuf {
 
 /// `apatch export patches scene -o out`, resumed from `resume` when given.
 fn export(scene: &Path, out: &Path, resume: Option<&Path>) -> Output {
+    export_with(scene, out, resume, &[])
+}
+
+/// [`export`] with more environment variables.
+fn export_with(scene: &Path, out: &Path, resume: Option<&Path>, env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_apatch"));
     c.args(["export", "patches"]).arg(scene).arg("-o").arg(out);
-    c.env_remove("APATCH_QUINTIC_RESUME");
+    for v in [
+        "APATCH_QUINTIC_RESUME",
+        "APATCH_HOLE_CHECKPOINT",
+        "APATCH_HOLE_STOP_AFTER",
+    ] {
+        c.env_remove(v);
+    }
     if let Some(r) = resume {
         c.env("APATCH_QUINTIC_RESUME", r);
     }
+    c.envs(env.iter().copied());
     c.output().expect("run apatch")
 }
 
@@ -66,6 +78,70 @@ fn resumed_repair_equals_the_whole_build() {
         std::fs::read(&resumed).unwrap() == std::fs::read(&direct).unwrap(),
         "the resumed repair differs from the whole build's"
     );
+}
+
+/// `APATCH_HOLE_CHECKPOINT`: a repair stopped after its first wave (`APATCH_HOLE_STOP_AFTER`,
+/// as if its process had ended) and taken up again from its checkpoint gives the whole
+/// build's complex, bit for bit.
+#[test]
+fn a_repair_taken_up_from_its_checkpoint_equals_the_whole_build() {
+    let repairing = scene("torus_quad_quintic", true);
+    let direct = tmp("ckpt_direct.json");
+    let o = export(&repairing, &direct, None);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ckpt = tmp("torus.ckpt");
+    let _ = std::fs::remove_file(&ckpt);
+    let ckpt_s = ckpt.to_str().unwrap();
+    let stopped = tmp("ckpt_stopped.json");
+    let o = export_with(
+        &repairing,
+        &stopped,
+        None,
+        &[
+            ("APATCH_HOLE_CHECKPOINT", ckpt_s),
+            ("APATCH_HOLE_STOP_AFTER", "1"),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(ckpt.exists(), "the stopped repair saved its checkpoint");
+    // Stopped part way: the whole repair mends more than its first wave.
+    assert!(holes(&stopped) > holes(&direct));
+    let taken_up = tmp("ckpt_taken_up.json");
+    let o = export_with(
+        &repairing,
+        &taken_up,
+        None,
+        &[
+            ("APATCH_HOLE_CHECKPOINT", ckpt_s),
+            ("APATCH_HOLE_TRACE", "1"),
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    // It did start from the checkpoint (a fresh repair would give the same complex too).
+    assert!(err.contains("taken up from"), "{err}");
+    assert!(
+        std::fs::read(&taken_up).unwrap() == std::fs::read(&direct).unwrap(),
+        "the repair taken up from its checkpoint differs from the whole build's"
+    );
+    // A file that is not a checkpoint is refused, naming it (a checkpoint of another repair
+    // is refused the same way: `quintic_c2::checkpoint`'s unit test).
+    std::fs::write(&ckpt, b"not a checkpoint").unwrap();
+    let other = tmp("ckpt_other.json");
+    let _ = std::fs::remove_file(&other);
+    let o = export_with(
+        &repairing,
+        &other,
+        None,
+        &[("APATCH_HOLE_CHECKPOINT", ckpt_s)],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(ckpt_s) && err.contains("APATCH_HOLE_CHECKPOINT"),
+        "{err}"
+    );
+    assert!(!other.exists(), "no output on bad input");
 }
 
 #[test]

@@ -27,14 +27,17 @@
 //! turns defective joins the defect (its weights are lifted too, and the group solved again)
 //! instead of refusing the repair at once.
 
+use super::checkpoint;
 use super::pinned::PinnedSolves;
 use super::system::{HullTet, System};
 use super::{cholesky, dense};
 use crate::bb::{multi_indices, poly};
 use crate::check::sheets::{roots_beyond_one, simplex_lattice, zero_face_turns};
 use crate::complex::Role;
+use crate::error::Result;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
+use std::path::Path;
 use std::sync::OnceLock;
 
 /// What [`repair`] did.
@@ -152,6 +155,9 @@ fn only_tets() -> Option<HashSet<u32>> {
 fn soft_escalation() -> bool {
     std::env::var("APATCH_HOLE_SOFT_MAX").map_or(true, |v| v != "0")
 }
+/// The least time between two checkpoints within a pass ([`checkpoint`]): writing fandisk's
+/// 40 MB of values takes under a second, a wave of its repairs minutes.
+const CHECKPOINT_EVERY: std::time::Duration = std::time::Duration::from_secs(120);
 /// Lattice steps per edge at which [`j_sheeted`] draws j-lines: twice the checker's 5
 /// (`CheckOptions::sheet_resolution`), so its lines are among them.
 const SHEET_RES: usize = 10;
@@ -243,15 +249,19 @@ pub fn j_sheeted(weights: &[f64], role: Role) -> bool {
 }
 
 /// Repairs the crossed boundary faces of the solved `value` (slots of `sys`) in place, one at
-/// a time in tetrahedron order (see the module documentation).
-#[must_use]
+/// a time in tetrahedron order (see the module documentation). With `checkpoint`, the
+/// progress is saved there as it goes and taken up again from there ([`checkpoint`]).
+///
+/// # Errors
+/// The checkpoint's: it cannot be read or written, or it is another repair's.
 pub fn repair(
     sys: &System,
     tets: &[HullTet],
     value: &mut [f64],
     reach: Reach,
     hessian_passes_asked: bool,
-) -> HoleRepair {
+    checkpoint: Option<&Path>,
+) -> Result<HoleRepair> {
     let np = sys.np;
     let boundary = boundary_faces(tets);
     let weights = |t: u32, value: &[f64]| -> Vec<f64> { sys.weights(t as usize, value) };
@@ -271,7 +281,7 @@ pub fn repair(
         ..HoleRepair::default()
     };
     if holes.is_empty() && sheets.is_empty() {
-        return out;
+        return Ok(out);
     }
     let is_open = |d: Defect, value: &[f64]| {
         let t = d.at().0;
@@ -285,6 +295,31 @@ pub fn repair(
     // Equations are judged relative to the size of F, as the checker does: the largest weight
     // of the solve (the repairs are small against it).
     let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
+    // Taken up again from a checkpoint: its values, its pass and the defects it decided.
+    let fingerprint = checkpoint::fingerprint(defects.iter().map(|d| d.at()));
+    let mut start_pass = 0;
+    let mut decided: Vec<u32> = Vec::new();
+    if let Some(path) = checkpoint {
+        if let Some(p) = checkpoint::load(path, value.len(), fingerprint)? {
+            value.copy_from_slice(&p.value);
+            start_pass = p.pass;
+            decided = p.decided;
+            out = HoleRepair {
+                crossed_before: out.crossed_before,
+                sheets_before: out.sheets_before,
+                ..p.counts
+            };
+            trace(|| {
+                format!(
+                    "taken up from {} at pass {} ({} defects decided)",
+                    path.display(),
+                    start_pass + 1,
+                    decided.len()
+                )
+            });
+        }
+    }
+    let mut saved_at = std::time::Instant::now();
     // Indexes: tetrahedra of each point of T, boundary faces of each tetrahedron, equations
     // of each slot.
     let mut tets_of: HashMap<u32, Vec<u32>> = HashMap::new();
@@ -324,7 +359,16 @@ pub fn repair(
                 }),
         );
     let only = only_tets();
-    for reach in passes {
+    let stop_after = checkpoint::stop_after();
+    let mut waves_run = 0usize;
+    'passes: for (pass_no, reach) in passes.enumerate() {
+        if pass_no < start_pass {
+            continue;
+        }
+        if pass_no > start_pass {
+            decided.clear();
+        }
+        let skip: HashSet<u32> = decided.iter().copied().collect();
         let index = Index {
             tets_of: &tets_of,
             faces_of: &faces_of,
@@ -333,12 +377,14 @@ pub fn repair(
             wmax,
         };
         // The defects still open (earlier passes repaired some), with their neighbourhoods.
-        let open: Vec<Local> = defects
+        let (ids, open): (Vec<u32>, Vec<Local>) = defects
             .par_iter()
-            .filter(|&&d| only.as_ref().is_none_or(|o| o.contains(&d.at().0)))
-            .filter(|&&d| is_open(d, value))
-            .filter_map(|&d| neighbourhood(sys, tets, d, &index, reach))
-            .collect();
+            .enumerate()
+            .filter(|&(k, _)| !skip.contains(&(k as u32)))
+            .filter(|&(_, &d)| only.as_ref().is_none_or(|o| o.contains(&d.at().0)))
+            .filter(|&(_, &d)| is_open(d, value))
+            .filter_map(|(k, &d)| Some((k as u32, neighbourhood(sys, tets, d, &index, reach)?)))
+            .unzip();
         let pass = || {
             format!(
                 "{} defects open ({} rings{})",
@@ -414,14 +460,42 @@ pub fn repair(
                 out.hessian += usize::from(reach.hessians && !asked.hessians);
                 out.soft += usize::from(soft);
             }
+            decided.extend(wave.iter().map(|&i| ids[i]));
             left = later;
+            waves_run += 1;
+            let stop = stop_after.is_some_and(|n| waves_run >= n);
+            if let Some(path) = checkpoint {
+                // Every few minutes, and at a pass's end (then as the next pass, none decided).
+                let pass_done = left.is_empty();
+                if pass_done || stop || saved_at.elapsed() >= CHECKPOINT_EVERY {
+                    checkpoint::save(
+                        path,
+                        &checkpoint::Progress {
+                            defects: fingerprint,
+                            pass: pass_no + usize::from(pass_done),
+                            decided: if pass_done {
+                                Vec::new()
+                            } else {
+                                decided.clone()
+                            },
+                            counts: out.clone(),
+                            value: value.to_vec(),
+                        },
+                    )?;
+                    saved_at = std::time::Instant::now();
+                }
+            }
+            if stop {
+                trace(|| format!("stopped after {waves_run} waves"));
+                break 'passes;
+            }
         }
     }
     out.crossed_after = boundary.iter().filter(|f| is_crossed(f, value)).count();
     out.sheets_after = (0..tets.len() as u32)
         .filter(|&t| is_sheet(t, value))
         .count();
-    out
+    Ok(out)
 }
 
 /// The lookups [`repair_defect`] shares across defects.
