@@ -1126,6 +1126,28 @@ impl EitherFactor {
         }
     }
 
+    /// [`EitherFactor::solve`] of each of `rs`, [`BATCH`] of them per pass over the factor
+    /// (each with the arithmetic it gets alone).
+    fn solve_many(&self, rs: &mut [Vec<f64>]) {
+        for chunk in rs.chunks_mut(BATCH) {
+            let views: Vec<&[f64]> = chunk.iter().map(Vec::as_slice).collect();
+            match self {
+                EitherFactor::Double(f) => {
+                    let ys = f.solve_wide_many(&views);
+                    for (r, y) in chunk.iter_mut().zip(ys) {
+                        *r = y;
+                    }
+                }
+                EitherFactor::Precise(f) => {
+                    let ys = f.solve_wide_many(&views);
+                    for (r, y) in chunk.iter_mut().zip(ys) {
+                        r.iter_mut().zip(y).for_each(|(ri, yi)| *ri = yi.f64());
+                    }
+                }
+            }
+        }
+    }
+
     /// x += Âᵀ (Â Âᵀ)⁻¹ r (r is overwritten): the least-norm correction towards the rows.
     /// In double-double the sum Âᵀ y is formed in double-double too: y is large along nearly
     /// dependent rows (pivots down to [`PRECISE_PIVOT`]) whose terms nearly cancel in Âᵀ y, and
@@ -1258,12 +1280,24 @@ impl Projector {
                 for (((&k, mut x), mut r), old) in active.iter().zip(ax).zip(ar).zip(before) {
                     let now = self.unit.residual_to(&zero, &x, &mut r);
                     res[k] = if now.partial_cmp(&res[k]) == Some(std::cmp::Ordering::Less) {
-                        self.refine_from(&mut x, &zero, tol, &mut r, now, 1)
+                        self.refine_steps(&mut x, &zero, tol, &mut r, now, 1)
                     } else {
                         x = old;
-                        self.finish(&mut x, &zero, tol, res[k])
+                        res[k]
                     };
                     xs[k] = x;
+                }
+                // The refinement's end, conjugate gradients, in lock step for those short
+                // of `tol` (most of the repair's time went to their preconditioner solves).
+                let short: Vec<usize> = (0..chunk.len()).filter(|&k| res[k] > tol).collect();
+                let mut sx: Vec<Vec<f64>> =
+                    short.iter().map(|&k| std::mem::take(&mut xs[k])).collect();
+                let solve = |zs: &mut [Vec<f64>]| self.factor.solve_many(zs);
+                let got =
+                    conjugate_gradients_many(&self.unit, &zero, &solve, &mut sx, tol, CG_STALL);
+                for ((&k, x), (g, _)) in short.iter().zip(sx).zip(got) {
+                    xs[k] = x;
+                    res[k] = g.min(res[k]);
                 }
                 xs.into_iter().zip(res).collect::<Vec<_>>()
             })
@@ -1286,6 +1320,20 @@ impl Projector {
         c: &[f64],
         tol: f64,
         r: &mut [f64],
+        res: f64,
+        from: usize,
+    ) -> f64 {
+        let res = self.refine_steps(x, c, tol, r, res, from);
+        self.finish(x, c, tol, res)
+    }
+
+    /// The refinement steps of [`Projector::refine_from`], without its end ([`Projector::finish`]).
+    fn refine_steps(
+        &self,
+        x: &mut Vec<f64>,
+        c: &[f64],
+        tol: f64,
+        r: &mut [f64],
         mut res: f64,
         from: usize,
     ) -> f64 {
@@ -1299,10 +1347,10 @@ impl Projector {
             if res.partial_cmp(&before.0) != Some(std::cmp::Ordering::Less) {
                 // Refinement stopped helping (NaN-safe): keep the better point.
                 (res, *x) = before;
-                return self.finish(x, c, tol, res);
+                return res;
             }
         }
-        self.finish(x, c, tol, res)
+        res
     }
 
     /// The end of [`Projector::refine`]: conjugate gradients where refinement left `x` (its
@@ -1427,71 +1475,153 @@ fn conjugate_gradients(
     tol: f64,
     stall: usize,
 ) -> (f64, usize) {
+    let each = |zs: &mut [Vec<f64>]| zs.iter_mut().for_each(|z| f(z));
+    let mut xs = [std::mem::take(x)];
+    let got = conjugate_gradients_many(unit, c, &each, &mut xs, tol, stall);
+    *x = std::mem::take(&mut xs[0]);
+    got[0]
+}
+
+/// One right-hand side's state in [`conjugate_gradients_many`].
+struct Cg {
+    /// The recurrence's residual ĉ − Â x.
+    r: Vec<f64>,
+    /// The least true residual met, and its iterate.
+    best: f64,
+    best_x: Vec<f64>,
+    /// The preconditioned residual, the search direction and r·z.
+    z: Vec<f64>,
+    p: Vec<f64>,
+    rz: f64,
+    /// Âᵀ p, Â Âᵀ p and the true residual (buffers).
+    dx: Vec<f64>,
+    q: Vec<f64>,
+    true_r: Vec<f64>,
+    stalled: usize,
+    iterations: usize,
+    done: bool,
+}
+
+/// [`conjugate_gradients`] for several starting points `xs` at once, in lock step: each
+/// iteration's preconditioner solves of the iterations still going are one call of `f` (the
+/// factor then reads L once for up to [`BATCH`] of them, [`EitherFactor::solve_many`]). Each x
+/// gets the arithmetic it gets alone; returns each one's least residual and iterations.
+fn conjugate_gradients_many(
+    unit: &UnitRows,
+    c: &[f64],
+    f: &dyn Fn(&mut [Vec<f64>]),
+    xs: &mut [Vec<f64>],
+    tol: f64,
+    stall: usize,
+) -> Vec<(f64, usize)> {
     let arows = &unit.rows;
-    let residual_of = |x: &[f64], r: &mut [f64]| unit.residual_to(c, x, r);
     let m = arows.len();
-    let mut r = vec![0.0; m];
-    let mut best = residual_of(x, &mut r);
-    let mut best_x = x.clone();
+    let mut st: Vec<Cg> = xs
+        .iter()
+        .map(|x| {
+            let mut r = vec![0.0; m];
+            let best = unit.residual_to(c, x, &mut r);
+            Cg {
+                r,
+                best,
+                best_x: x.clone(),
+                z: Vec::new(),
+                p: Vec::new(),
+                rz: 0.0,
+                dx: vec![0.0; x.len()],
+                q: vec![0.0; m],
+                true_r: vec![0.0; m],
+                stalled: 0,
+                iterations: 0,
+                done: false,
+            }
+        })
+        .collect();
     // The factor as preconditioner, on the rows it keeps (identity on the rows it dropped
-    // was tried: on the bunny it left two j-sheets that this repairs).
-    let precondition = |r: &[f64], z: &mut Vec<f64>| {
-        z.clear();
-        z.extend_from_slice(r);
-        f(z);
+    // was tried: on the bunny it left two j-sheets that this repairs): z = f(r) for the
+    // states `ks`, in one call.
+    let precondition = |st: &mut [Cg], ks: &[usize]| {
+        let mut zs: Vec<Vec<f64>> = ks
+            .iter()
+            .map(|&k| {
+                let mut z = std::mem::take(&mut st[k].z);
+                z.clear();
+                z.extend_from_slice(&st[k].r);
+                z
+            })
+            .collect();
+        f(&mut zs);
+        for (&k, z) in ks.iter().zip(zs) {
+            st[k].z = z;
+        }
     };
-    let mut z = Vec::new();
-    precondition(&r, &mut z);
-    let mut p = z.clone();
-    let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
-    let mut dx = vec![0.0; x.len()];
-    let mut q = vec![0.0; m];
-    let mut true_r = vec![0.0; m];
-    let mut stalled = 0;
-    let mut iterations = 0;
+    let all: Vec<usize> = (0..st.len()).collect();
+    precondition(&mut st, &all);
+    for s in &mut st {
+        s.p.clone_from(&s.z);
+        s.rz = s.r.iter().zip(&s.z).map(|(a, b)| a * b).sum();
+    }
     for _ in 0..CG_ITERATIONS {
-        // A non-positive (or NaN) curvature ends the iteration.
-        if best <= tol
-            || stalled == stall
-            || rz.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
-        {
+        let mut going = Vec::new();
+        for (k, (s, x)) in st.iter_mut().zip(xs.iter_mut()).enumerate() {
+            // A non-positive (or NaN) curvature ends the iteration.
+            if s.done
+                || s.best <= tol
+                || s.stalled == stall
+                || s.rz.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+            {
+                s.done = true;
+                continue;
+            }
+            // dx = Âᵀ p, q = Â dx.
+            s.dx.iter_mut().for_each(|v| *v = 0.0);
+            add_transposed(arows, &s.p, &mut s.dx);
+            for (qi, row) in s.q.iter_mut().zip(arows) {
+                *qi = row.iter().map(|&(j, a)| a * s.dx[j as usize]).sum();
+            }
+            let pq: f64 = s.p.iter().zip(&s.q).map(|(a, b)| a * b).sum();
+            if pq.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                s.done = true;
+                continue;
+            }
+            let alpha = s.rz / pq;
+            s.iterations += 1;
+            for (xi, d) in x.iter_mut().zip(&s.dx) {
+                *xi += alpha * d;
+            }
+            for (ri, qi) in s.r.iter_mut().zip(&s.q) {
+                *ri -= alpha * qi;
+            }
+            // The recurrence's residual drifts from the true one: judge by the true one.
+            let res = unit.residual_to(c, x, &mut s.true_r);
+            s.stalled = if res < 0.5 * s.best { 0 } else { s.stalled + 1 };
+            if res < s.best {
+                s.best = res;
+                s.best_x.clone_from(x);
+            }
+            going.push(k);
+        }
+        if going.is_empty() {
             break;
         }
-        // dx = Âᵀ p, q = Â dx.
-        dx.iter_mut().for_each(|v| *v = 0.0);
-        add_transposed(arows, &p, &mut dx);
-        for (qi, row) in q.iter_mut().zip(arows) {
-            *qi = row.iter().map(|&(j, a)| a * dx[j as usize]).sum();
-        }
-        let pq: f64 = p.iter().zip(&q).map(|(a, b)| a * b).sum();
-        if pq.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            break;
-        }
-        let alpha = rz / pq;
-        iterations += 1;
-        for (xi, d) in x.iter_mut().zip(&dx) {
-            *xi += alpha * d;
-        }
-        for (ri, qi) in r.iter_mut().zip(&q) {
-            *ri -= alpha * qi;
-        }
-        // The recurrence's residual drifts from the true one: judge by the true one.
-        let res = residual_of(x, &mut true_r);
-        stalled = if res < 0.5 * best { 0 } else { stalled + 1 };
-        if res < best {
-            best = res;
-            best_x.clone_from(x);
-        }
-        precondition(&r, &mut z);
-        let rz_new: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
-        let beta = rz_new / rz;
-        rz = rz_new;
-        for (pi, zi) in p.iter_mut().zip(&z) {
-            *pi = zi + beta * *pi;
+        precondition(&mut st, &going);
+        for &k in &going {
+            let s = &mut st[k];
+            let rz_new: f64 = s.r.iter().zip(&s.z).map(|(a, b)| a * b).sum();
+            let beta = rz_new / s.rz;
+            s.rz = rz_new;
+            for (pi, zi) in s.p.iter_mut().zip(&s.z) {
+                *pi = zi + beta * *pi;
+            }
         }
     }
-    *x = best_x;
-    (best, iterations)
+    st.into_iter()
+        .zip(xs.iter_mut())
+        .map(|(s, x)| {
+            *x = s.best_x;
+            (s.best, s.iterations)
+        })
+        .collect()
 }
 
 #[cfg(test)]
