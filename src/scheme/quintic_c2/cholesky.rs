@@ -1736,6 +1736,67 @@ pub(super) mod tests {
         }
     }
 
+    /// [`conjugate_gradients_many`] gives each starting point what [`conjugate_gradients`]
+    /// gives it alone, bit for bit (same iterate, residual and iterations), with the
+    /// iterations ending at different steps: 11 starts (two batches of the factor's solves),
+    /// on a consistent system with the identity as preconditioner (many iterations) and on an
+    /// inconsistent one with the exact factor (stalls).
+    #[test]
+    fn conjugate_gradients_in_lock_step_are_the_single_ones() {
+        let (m, n) = (40, 60);
+        // Iterations per (case, start): they must differ somewhere (the consistent case: starts
+        // at different distances; the inconsistent one stalls at the same step everywhere).
+        let mut counts = std::collections::HashSet::new();
+        for (inconsistent, seed) in [(false, 5), (true, 3)] {
+            let (_, rows, mut c, target) = system(m, n, seed);
+            if inconsistent {
+                c[39] += 0.5;
+            }
+            let unit = UnitRows::new(&rows, &c);
+            let ordering = Ordering::of(&rows, n);
+            let (f, _) = if inconsistent {
+                let (d, off) = normal_matrix::<f64>(&unit.rows, n);
+                factor(&d, &off, DEPENDENT_PIVOT, &ordering)
+            } else {
+                factor(&vec![1.0; m], &[], DEPENDENT_PIVOT, &ordering)
+            };
+            let f = EitherFactor::Double(f);
+            // Without the factor the largest residual need not halve for many steps in a row
+            // (as in `conjugate_gradients_reach_the_closest_solution`): no stall stop there.
+            let stall = if inconsistent {
+                CG_STALL
+            } else {
+                CG_ITERATIONS
+            };
+            let mut seed = 99u64;
+            let starts: Vec<Vec<f64>> = (0..11)
+                .map(|k| {
+                    // Starts at different distances: their iterations end at different steps.
+                    let scale = 10f64.powi(k % 4 - 2);
+                    target.iter().map(|t| t + scale * lcg(&mut seed)).collect()
+                })
+                .collect();
+            let mut many = starts.clone();
+            let got = conjugate_gradients_many(
+                &unit,
+                &unit.c,
+                &|zs: &mut [Vec<f64>]| f.solve_many(zs),
+                &mut many,
+                1e-12,
+                stall,
+            );
+            for ((start, x), (res, it)) in starts.iter().zip(&many).zip(&got) {
+                let mut one = start.clone();
+                let (r1, i1) =
+                    conjugate_gradients(&unit, &unit.c, &|z| f.solve(z), &mut one, 1e-12, stall);
+                assert_eq!((res.to_bits(), *it), (r1.to_bits(), i1));
+                assert!(x.iter().zip(&one).all(|(a, b)| a.to_bits() == b.to_bits()));
+                counts.insert(*it);
+            }
+        }
+        assert!(counts.len() > 2 && !counts.contains(&0), "{counts:?}");
+    }
+
     /// On an inconsistent system (one dependent row contradicted by 0.5) no iterate meets the
     /// rows: with the exact factor as preconditioner CG stops after [`CG_STALL`] iterations
     /// without a halving instead of running all [`CG_ITERATIONS`], and keeps its best iterate.
