@@ -1268,24 +1268,33 @@ impl Projector {
                     .zip(&mut rs)
                     .map(|(x, r)| self.unit.residual_to(&zero, x, r))
                     .collect();
-                // Step 0 of the refinement, batched for those above `tol`.
-                let active: Vec<usize> = (0..chunk.len()).filter(|&k| res[k] > tol).collect();
-                let before: Vec<Vec<f64>> = active.iter().map(|&k| xs[k].clone()).collect();
-                let mut ax: Vec<Vec<f64>> =
-                    active.iter().map(|&k| std::mem::take(&mut xs[k])).collect();
-                let ar: Vec<Vec<f64>> =
-                    active.iter().map(|&k| std::mem::take(&mut rs[k])).collect();
-                let views: Vec<&[f64]> = ar.iter().map(Vec::as_slice).collect();
-                self.factor.correct_many(&self.unit.rows, &views, &mut ax);
-                for (((&k, mut x), mut r), old) in active.iter().zip(ax).zip(ar).zip(before) {
-                    let now = self.unit.residual_to(&zero, &x, &mut r);
-                    res[k] = if now.partial_cmp(&res[k]) == Some(std::cmp::Ordering::Less) {
-                        self.refine_steps(&mut x, &zero, tol, &mut r, now, 1)
-                    } else {
-                        x = old;
-                        res[k]
-                    };
-                    xs[k] = x;
+                // The refinement's steps in lock step: each step's corrections of those above
+                // `tol` and still improving share one pass over the factor; a correction that
+                // does not lower the residual is undone and ends that one's refinement.
+                let mut improving = vec![true; chunk.len()];
+                for _ in 0..=REFINE {
+                    let active: Vec<usize> = (0..chunk.len())
+                        .filter(|&k| improving[k] && res[k] > tol)
+                        .collect();
+                    if active.is_empty() {
+                        break;
+                    }
+                    let before: Vec<Vec<f64>> = active.iter().map(|&k| xs[k].clone()).collect();
+                    let mut ax: Vec<Vec<f64>> =
+                        active.iter().map(|&k| std::mem::take(&mut xs[k])).collect();
+                    let views: Vec<&[f64]> = active.iter().map(|&k| rs[k].as_slice()).collect();
+                    self.factor.correct_many(&self.unit.rows, &views, &mut ax);
+                    for ((&k, mut x), old) in active.iter().zip(ax).zip(before) {
+                        let now = self.unit.residual_to(&zero, &x, &mut rs[k]);
+                        if now.partial_cmp(&res[k]) == Some(std::cmp::Ordering::Less) {
+                            res[k] = now;
+                        } else {
+                            // Refinement stopped helping (NaN-safe): keep the better point.
+                            x = old;
+                            improving[k] = false;
+                        }
+                        xs[k] = x;
+                    }
                 }
                 // The refinement's end, conjugate gradients, in lock step for those short
                 // of `tol` (most of the repair's time went to their preconditioner solves).
