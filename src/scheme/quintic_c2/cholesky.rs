@@ -55,8 +55,13 @@ pub const MAX_FACTOR_ROWS: usize = 1_000_000;
 struct Factor<T: Real = f64> {
     /// Elimination position → node.
     order: Vec<u32>,
-    /// Node → columns of L below the diagonal: (row node, value), in elimination order.
-    cols: Vec<Vec<(u32, T)>>,
+    /// L's columns below the diagonal in elimination order, packed: column p's entries are
+    /// `start[p]..start[p + 1]` of `rows` (elimination positions, ascending) and `vals`. One
+    /// array read front to back (or back to front) by a solve: the repair's time is mostly
+    /// these solves, and a vector per column scattered them over the heap.
+    start: Vec<usize>,
+    rows: Vec<u32>,
+    vals: Vec<T>,
     /// Node → diagonal of L (0 for a dropped, dependent node).
     diag: Vec<T>,
 }
@@ -77,8 +82,10 @@ impl<T: Real> Factor<T> {
     }
 }
 
-/// Right-hand sides of [`Factor::solve_wide_many`]'s one pass over L.
-const BATCH: usize = 8;
+/// Right-hand sides of [`Factor::solve_wide_many`]'s one pass over L. On three of fandisk's
+/// repairs (user time, the setup included): 8 → 16 took 143 s to 118 s, with the same
+/// output; 32 gained nothing over 16 (8: 163 s, 16: 139 s, 32: 139 s before L was packed).
+const BATCH: usize = 16;
 
 impl<T: Real> Factor<T> {
     /// [`Factor::solve_wide`] for up to [`BATCH`] right-hand sides in one pass over L (the
@@ -110,49 +117,58 @@ impl<T: Real> Factor<T> {
         let b = rs.len();
         assert!(b <= B, "{b} right-hand sides, at most {B}");
         let m = self.diag.len();
+        // By elimination position.
         let mut w = vec![[T::default(); B]; m];
         for (k, r) in rs.iter().enumerate() {
-            for (wi, &ri) in w.iter_mut().zip(r.iter()) {
-                wi[k] = T::of(ri);
+            for (wi, &v) in w.iter_mut().zip(&self.order) {
+                wi[k] = T::of(r[v as usize]);
             }
         }
-        for &v in &self.order {
-            let v = v as usize;
-            if self.diag[v].f64() == 0.0 {
-                w[v] = [T::default(); B];
+        for (p, &v) in self.order.iter().enumerate() {
+            let d = self.diag[v as usize];
+            if d.f64() == 0.0 {
+                w[p] = [T::default(); B];
                 continue;
             }
-            let d = self.diag[v];
-            let mut z = w[v];
+            let mut z = w[p];
             for zk in &mut z[..b] {
                 *zk = *zk / d;
             }
-            w[v] = z;
-            for &(u, l) in &self.cols[v] {
+            w[p] = z;
+            let (lo, hi) = (self.start[p], self.start[p + 1]);
+            for (&u, &l) in self.rows[lo..hi].iter().zip(&self.vals[lo..hi]) {
                 let wu = &mut w[u as usize];
                 for k in 0..b {
                     wu[k] -= l * z[k];
                 }
             }
         }
-        for &v in self.order.iter().rev() {
-            let v = v as usize;
-            if self.diag[v].f64() == 0.0 {
+        for (p, &v) in self.order.iter().enumerate().rev() {
+            let d = self.diag[v as usize];
+            if d.f64() == 0.0 {
                 continue;
             }
-            let mut s = w[v];
-            for &(u, l) in &self.cols[v] {
+            let mut s = w[p];
+            let (lo, hi) = (self.start[p], self.start[p + 1]);
+            for (&u, &l) in self.rows[lo..hi].iter().zip(&self.vals[lo..hi]) {
                 let wu = &w[u as usize];
                 for k in 0..b {
                     s[k] -= l * wu[k];
                 }
             }
-            let d = self.diag[v];
             for k in 0..b {
-                w[v][k] = s[k] / d;
+                w[p][k] = s[k] / d;
             }
         }
-        (0..b).map(|k| w.iter().map(|wi| wi[k]).collect()).collect()
+        (0..b)
+            .map(|k| {
+                let mut y = vec![T::default(); m];
+                for (wi, &v) in w.iter().zip(&self.order) {
+                    y[v as usize] = wi[k];
+                }
+                y
+            })
+            .collect()
     }
 }
 
@@ -390,12 +406,25 @@ fn factor_in<T: Real>(
             links[first as usize].push((v, 0));
         }
     }
-    let cols = pattern
-        .iter()
-        .zip(vals)
-        .map(|(p, v)| p.iter().copied().zip(v).collect())
-        .collect();
-    (Factor { order, cols, diag }, dropped)
+    let mut start = Vec::with_capacity(m + 1);
+    start.push(0);
+    let mut rows = Vec::with_capacity(ppos.iter().map(Vec::len).sum());
+    let mut packed = Vec::with_capacity(rows.capacity());
+    for &v in &order {
+        rows.extend_from_slice(&ppos[v as usize]);
+        packed.extend_from_slice(&vals[v as usize]);
+        start.push(rows.len());
+    }
+    (
+        Factor {
+            order,
+            start,
+            rows,
+            vals: packed,
+            diag,
+        },
+        dropped,
+    )
 }
 
 /// Multiply-adds of one column's updates from which [`factor`] splits them over two threads
@@ -1245,9 +1274,11 @@ impl Projector {
 
     /// The projections Π e_j of the unit vectors of unknowns `js` (of `n`), as
     /// [`Projector::project`] makes them one by one (the same values), with their residuals:
-    /// the first solve of each [`BATCH`] of them shares one pass over the factor, and the
-    /// batches run in parallel. The repair's pinned solves spent most of their time in these
-    /// projections (a profile of the nut's repair: 66% in the factor's solves).
+    /// each [`BATCH`] of them is refined and then iterated by conjugate gradients in lock step,
+    /// every step's solves sharing one pass over the factor, and the batches run in parallel.
+    /// The repair's pinned solves spend most of their time in these projections (profiles of
+    /// the nut's repair: 66% in the factor's solves; of fandisk's, 70%, most of it in the
+    /// conjugate gradients, which solved one vector at a time before session 51).
     #[must_use]
     pub fn project_units(&self, js: &[usize], n: usize, tol: f64) -> Vec<(Vec<f64>, f64)> {
         let m = self.unit.rows.len();
@@ -1747,9 +1778,9 @@ pub(super) mod tests {
 
     /// [`conjugate_gradients_many`] gives each starting point what [`conjugate_gradients`]
     /// gives it alone, bit for bit (same iterate, residual and iterations), with the
-    /// iterations ending at different steps: 11 starts (two batches of the factor's solves),
-    /// on a consistent system with the identity as preconditioner (many iterations) and on an
-    /// inconsistent one with the exact factor (stalls).
+    /// iterations ending at different steps: [`BATCH`] + 3 starts (two batches of the factor's
+    /// solves), on a consistent system with the identity as preconditioner (many iterations)
+    /// and on an inconsistent one with the exact factor (stalls).
     #[test]
     fn conjugate_gradients_in_lock_step_are_the_single_ones() {
         let (m, n) = (40, 60);
@@ -1778,7 +1809,7 @@ pub(super) mod tests {
                 CG_ITERATIONS
             };
             let mut seed = 99u64;
-            let starts: Vec<Vec<f64>> = (0..11)
+            let starts: Vec<Vec<f64>> = (0..BATCH as i32 + 3)
                 .map(|k| {
                     // Starts at different distances: their iterations end at different steps.
                     let scale = 10f64.powi(k % 4 - 2);
@@ -1907,7 +1938,7 @@ pub(super) mod tests {
         assert_eq!(dropped, dropped_fused);
         assert!(dropped >= 2, "the two dependent rows, {dropped}");
         assert_eq!(plain.diag, fused.diag);
-        assert_eq!(plain.cols, fused.cols);
+        assert_eq!((&plain.rows, &plain.vals), (&fused.rows, &fused.vals));
         let r: &[f64] = &unit.c;
         let y = plain.solve_batch_in::<1>(&[r]);
         // SAFETY: FMA checked above.
@@ -1929,12 +1960,12 @@ pub(super) mod tests {
         let (split, dropped_split) = factor_in(&d, &off, PRECISE_PIVOT, &ordering, 0);
         assert_eq!(dropped, dropped_split);
         assert_eq!(serial.diag, split.diag);
-        assert_eq!(serial.cols, split.cols);
+        assert_eq!((&serial.rows, &serial.vals), (&split.rows, &split.vals));
         let (d, off) = normal_matrix::<f64>(&unit.rows, 260);
         let (serial, _) = factor_in(&d, &off, DEPENDENT_PIVOT, &ordering, usize::MAX);
         let (split, _) = factor_in(&d, &off, DEPENDENT_PIVOT, &ordering, 0);
         assert_eq!(serial.diag, split.diag);
-        assert_eq!(serial.cols, split.cols);
+        assert_eq!((&serial.rows, &serial.vals), (&split.rows, &split.vals));
         // Fill: some columns have updates to split.
         assert!(ordering.entries() > 260, "{}", ordering.entries());
     }
