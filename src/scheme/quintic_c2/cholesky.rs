@@ -66,7 +66,7 @@ struct Factor<T: Real = f64> {
     diag: Vec<T>,
 }
 
-impl<T: Real> Factor<T> {
+impl<T: PackedSolve> Factor<T> {
     /// Solves L Lᵀ y = r in place (dependent nodes get y = 0), in the factor's precision.
     fn solve(&self, r: &mut [f64]) {
         let w = self.solve_wide(r);
@@ -87,7 +87,7 @@ impl<T: Real> Factor<T> {
 /// output; 32 gained nothing over 16 (8: 163 s, 16: 139 s, 32: 139 s before L was packed).
 const BATCH: usize = 16;
 
-impl<T: Real> Factor<T> {
+impl<T: PackedSolve> Factor<T> {
     /// [`Factor::solve_wide`] for up to [`BATCH`] right-hand sides in one pass over L (the
     /// solve reads L once from memory for all of them); each gets the same arithmetic, in the
     /// same order, as alone.
@@ -102,16 +102,157 @@ impl<T: Real> Factor<T> {
             // SAFETY: the processor has FMA, checked just above.
             return unsafe { self.solve_batch_fma::<B>(rs) };
         }
-        self.solve_batch_in::<B>(rs)
+        T::solve_packed::<B>(self, rs)
     }
 
     /// [`Factor::solve_batch`] compiled with FMA (see [`factor_fma`]).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "fma")]
     unsafe fn solve_batch_fma<const B: usize>(&self, rs: &[&[f64]]) -> Vec<Vec<T>> {
-        self.solve_batch_in::<B>(rs)
+        T::solve_packed::<B>(self, rs)
+    }
+}
+
+/// How a factor in a scalar type runs its batched solves ([`Factor::solve_batch`]).
+trait PackedSolve: Real {
+    /// L Lᵀ y = r for up to `B` right-hand sides `rs`; each gets the arithmetic it gets alone.
+    fn solve_packed<const B: usize>(f: &Factor<Self>, rs: &[&[f64]]) -> Vec<Vec<Self>>;
+}
+
+impl PackedSolve for f64 {
+    #[inline(always)]
+    fn solve_packed<const B: usize>(f: &Factor<f64>, rs: &[&[f64]]) -> Vec<Vec<f64>> {
+        f.solve_batch_in::<B>(rs)
+    }
+}
+
+impl PackedSolve for Dd {
+    /// In lanes of hi and lo parts ([`Lanes`]), as few as the right-hand sides need: the
+    /// double-double products then run side by side in vector registers. Each lane's
+    /// operations are [`Dd`]'s, in its order, so the results are its to the bit.
+    #[inline(always)]
+    fn solve_packed<const B: usize>(f: &Factor<Dd>, rs: &[&[f64]]) -> Vec<Vec<Dd>> {
+        assert!(rs.len() <= B, "{} right-hand sides, at most {B}", rs.len());
+        match rs.len() {
+            0..=1 => f.solve_batch_in::<1>(rs),
+            2..=4 => solve_lanes::<4>(f, rs),
+            5..=8 => solve_lanes::<8>(f, rs),
+            9..=16 => solve_lanes::<16>(f, rs),
+            _ => f.solve_batch_in::<B>(rs),
+        }
+    }
+}
+
+/// Up to `L` double-double values, their hi parts side by side and their lo parts side by
+/// side (the layout a vector unit adds and multiplies in).
+#[derive(Clone, Copy)]
+struct Lanes<const L: usize> {
+    hi: [f64; L],
+    lo: [f64; L],
+}
+
+impl<const L: usize> Lanes<L> {
+    const ZERO: Lanes<L> = Lanes {
+        hi: [0.0; L],
+        lo: [0.0; L],
+    };
+
+    fn get(&self, k: usize) -> Dd {
+        Dd {
+            hi: self.hi[k],
+            lo: self.lo[k],
+        }
     }
 
+    fn set(&mut self, k: usize, x: Dd) {
+        self.hi[k] = x.hi;
+        self.lo[k] = x.lo;
+    }
+
+    /// self[k] −= l · z[k] for every lane: [`Dd`]'s product and difference, step by step.
+    #[inline(always)]
+    fn sub_product(&mut self, l: Dd, z: &Lanes<L>) {
+        for k in 0..L {
+            // l · z[k]
+            let p = l.hi * z.hi[k];
+            let e = l.hi.mul_add(z.hi[k], -p);
+            let e = e + (l.hi * z.lo[k] + l.lo * z.hi[k]);
+            let ph = p + e;
+            let pl = e - (ph - p);
+            // self[k] + (−(l · z[k]))
+            let (a, b) = (self.hi[k], -ph);
+            let s = a + b;
+            let bb = s - a;
+            let e = (a - (s - bb)) + (b - bb);
+            let (c, d) = (self.lo[k], -pl);
+            let t = c + d;
+            let dd = t - c;
+            let f = (c - (t - dd)) + (d - dd);
+            let e = e + t;
+            let s2 = s + e;
+            let e = e - (s2 - s);
+            let e = e + f;
+            let hi = s2 + e;
+            self.lo[k] = e - (hi - s2);
+            self.hi[k] = hi;
+        }
+    }
+}
+
+/// [`Factor::solve_batch_in`] for a double-double factor in [`Lanes`] of `L`.
+#[inline(always)]
+fn solve_lanes<const L: usize>(f: &Factor<Dd>, rs: &[&[f64]]) -> Vec<Vec<Dd>> {
+    let b = rs.len();
+    assert!(b <= L, "{b} right-hand sides, at most {L}");
+    let m = f.diag.len();
+    let mut w = vec![Lanes::<L>::ZERO; m];
+    for (k, r) in rs.iter().enumerate() {
+        for (wi, &v) in w.iter_mut().zip(&f.order) {
+            wi.hi[k] = r[v as usize];
+        }
+    }
+    for (p, &v) in f.order.iter().enumerate() {
+        let d = f.diag[v as usize];
+        if d.f64() == 0.0 {
+            w[p] = Lanes::ZERO;
+            continue;
+        }
+        let mut z = w[p];
+        for k in 0..b {
+            z.set(k, z.get(k) / d);
+        }
+        w[p] = z;
+        let (lo, hi) = (f.start[p], f.start[p + 1]);
+        for (&u, &l) in f.rows[lo..hi].iter().zip(&f.vals[lo..hi]) {
+            w[u as usize].sub_product(l, &z);
+        }
+    }
+    for (p, &v) in f.order.iter().enumerate().rev() {
+        let d = f.diag[v as usize];
+        if d.f64() == 0.0 {
+            continue;
+        }
+        let mut s = w[p];
+        let (lo, hi) = (f.start[p], f.start[p + 1]);
+        for (&u, &l) in f.rows[lo..hi].iter().zip(&f.vals[lo..hi]) {
+            s.sub_product(l, &w[u as usize]);
+        }
+        for k in 0..b {
+            w[p].set(k, s.get(k) / d);
+        }
+    }
+    (0..b)
+        .map(|k| {
+            let mut y = vec![Dd::default(); m];
+            for (wi, &v) in w.iter().zip(&f.order) {
+                y[v as usize] = wi.get(k);
+            }
+            y
+        })
+        .collect()
+}
+
+impl<T: Real> Factor<T> {
     #[inline(always)]
     fn solve_batch_in<const B: usize>(&self, rs: &[&[f64]]) -> Vec<Vec<T>> {
         let b = rs.len();
@@ -1968,6 +2109,38 @@ pub(super) mod tests {
         assert_eq!((&serial.rows, &serial.vals), (&split.rows, &split.vals));
         // Fill: some columns have updates to split.
         assert!(ordering.entries() > 260, "{}", ordering.entries());
+    }
+
+    /// The double-double solve in [`Lanes`] gives what the solve side by side per node gives,
+    /// bit for bit, for every number of right-hand sides up to [`BATCH`] (each lane count
+    /// 1, 4, 8, 16 and its partly filled cases), on a rank-deficient system (dropped nodes).
+    #[test]
+    fn double_double_lanes_are_the_plain_solve() {
+        let (m, n) = (60, 90);
+        let (_, rows, c, _) = system(m, n, 4242);
+        let ordering = Ordering::of(&rows, n);
+        let unit = UnitRows::new(&rows, &c);
+        let (d, off) = normal_matrix::<Dd>(&unit.rows, n);
+        let (f, dropped) = factor(&d, &off, PRECISE_PIVOT, &ordering);
+        assert!(dropped > 0, "the system should be rank deficient");
+        let mut seed = 7u64;
+        let rs: Vec<Vec<f64>> = (0..BATCH)
+            .map(|_| (0..m).map(|_| lcg(&mut seed)).collect())
+            .collect();
+        for b in 1..=BATCH {
+            let views: Vec<&[f64]> = rs[..b].iter().map(Vec::as_slice).collect();
+            let lanes = f.solve_wide_many(&views);
+            let plain = f.solve_batch_in::<BATCH>(&views);
+            let bits = |v: &[Vec<Dd>]| {
+                v.iter()
+                    .flatten()
+                    .map(|x| (x.hi.to_bits(), x.lo.to_bits()))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&lanes), bits(&plain), "{b} right-hand sides");
+            // Not all zero: the solve did something.
+            assert!(lanes.iter().flatten().any(|x| x.lo != 0.0));
+        }
     }
 
     /// [`Projector::project_units`] (batched, parallel) gives the projections
