@@ -22,6 +22,8 @@ fn export_with(scene: &Path, out: &Path, resume: Option<&Path>, env: &[(&str, &s
         "APATCH_QUINTIC_RESUME",
         "APATCH_HOLE_CHECKPOINT",
         "APATCH_HOLE_STOP_AFTER",
+        "APATCH_HOLE_CHECKPOINT_EVERY",
+        "APATCH_HOLE_EXIT_AFTER",
     ] {
         c.env_remove(v);
     }
@@ -142,6 +144,57 @@ fn a_repair_taken_up_from_its_checkpoint_equals_the_whole_build() {
         "{err}"
     );
     assert!(!other.exists(), "no output on bad input");
+}
+
+/// A repair whose process ends midway through a wave (`APATCH_HOLE_EXIT_AFTER`, with a
+/// checkpoint after every finished repair) is taken up from the repairs of that wave saved so
+/// far and gives the whole build's complex, bit for bit.
+#[test]
+fn a_repair_killed_midway_through_a_wave_is_taken_up_from_its_checkpoint() {
+    let repairing = scene("torus_quad_quintic", true);
+    let direct = tmp("mid_direct.json");
+    let o = export(&repairing, &direct, None);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ckpt = tmp("torus_mid.ckpt");
+    let _ = std::fs::remove_file(&ckpt);
+    let ckpt_s = ckpt.to_str().unwrap();
+    let killed = tmp("mid_killed.json");
+    let _ = std::fs::remove_file(&killed);
+    let o = export_with(
+        &repairing,
+        &killed,
+        None,
+        &[
+            ("APATCH_HOLE_CHECKPOINT", ckpt_s),
+            ("APATCH_HOLE_CHECKPOINT_EVERY", "0"),
+            ("APATCH_HOLE_EXIT_AFTER", "1"),
+        ],
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(ckpt.exists() && !killed.exists());
+    let taken_up = tmp("mid_taken_up.json");
+    let o = export_with(
+        &repairing,
+        &taken_up,
+        None,
+        &[
+            ("APATCH_HOLE_CHECKPOINT", ckpt_s),
+            ("APATCH_HOLE_TRACE", "1"),
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    // Taken up at the first pass with the first repair of its first wave decided.
+    assert!(err.contains("at pass 1 (1 defects decided)"), "{err}");
+    assert!(
+        std::fs::read(&taken_up).unwrap() == std::fs::read(&direct).unwrap(),
+        "the repair taken up midway through a wave differs from the whole build's"
+    );
 }
 
 #[test]

@@ -35,6 +35,22 @@ pub fn stop_after() -> Option<usize> {
     std::env::var("APATCH_HOLE_STOP_AFTER").ok()?.parse().ok()
 }
 
+/// Test hooks for checkpoints within a wave of repairs: `APATCH_HOLE_CHECKPOINT_EVERY=s` saves
+/// at most every `s` seconds instead of `default`'s, and `APATCH_HOLE_EXIT_AFTER=n` ends the
+/// process (exit status 3, nothing written but the checkpoint) once `n` repairs of a wave are
+/// saved, as a process killed midway would.
+#[must_use]
+pub fn midway_hooks(default: std::time::Duration) -> (std::time::Duration, Option<usize>) {
+    let every = std::env::var("APATCH_HOLE_CHECKPOINT_EVERY")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(default, std::time::Duration::from_secs);
+    let exit_after = std::env::var("APATCH_HOLE_EXIT_AFTER")
+        .ok()
+        .and_then(|v| v.parse().ok());
+    (every, exit_after)
+}
+
 /// A repair's progress.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Progress {

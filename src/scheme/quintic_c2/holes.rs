@@ -360,6 +360,7 @@ pub fn repair(
         );
     let only = only_tets();
     let stop_after = checkpoint::stop_after();
+    let (every, exit_after) = checkpoint::midway_hooks(CHECKPOINT_EVERY);
     let mut waves_run = 0usize;
     'passes: for (pass_no, reach) in passes.enumerate() {
         if pass_no < start_pass {
@@ -435,30 +436,73 @@ pub fn repair(
                     .for_each(|&s| write_mark[s as usize] = false);
             }
             let snapshot: &[f64] = value;
+            // A wave can take an hour on fandisk: its finished repairs are saved as they come
+            // (they touch nothing of each other's, so any of them applied to the snapshot is
+            // what the wave's end gives for them).
+            let midway = std::sync::Mutex::new(Midway {
+                done: Vec::new(),
+                saved_at,
+                error: None,
+            });
             let kept: Vec<Option<(Vec<f64>, usize, bool)>> = wave
                 .par_iter()
                 .map(|&i| {
                     // Repaired with an earlier defect.
-                    is_open(open[i].defect, snapshot)
+                    let k = is_open(open[i].defect, snapshot)
                         .then(|| repair_defect(sys, tets, snapshot, &open[i], &index, reach))
-                        .flatten()
+                        .flatten();
+                    if let Some(path) = checkpoint {
+                        let mut m = midway
+                            .lock()
+                            .unwrap_or_else(std::sync::PoisonError::into_inner);
+                        m.done.push((i, k.clone()));
+                        if m.error.is_none() && m.saved_at.elapsed() >= every {
+                            let mut v = snapshot.to_vec();
+                            let mut counts = out.clone();
+                            for (j, k) in &m.done {
+                                let kept = Kept {
+                                    local: &open[*j],
+                                    reach,
+                                    asked,
+                                };
+                                kept.apply(k.as_ref(), &mut v, &mut counts);
+                            }
+                            let mut d = decided.clone();
+                            d.extend(m.done.iter().map(|(j, _)| ids[*j]));
+                            let p = checkpoint::Progress {
+                                defects: fingerprint,
+                                pass: pass_no,
+                                decided: d,
+                                counts,
+                                value: v,
+                            };
+                            match checkpoint::save(path, &p) {
+                                Ok(()) => m.saved_at = std::time::Instant::now(),
+                                Err(e) => m.error = Some(e),
+                            }
+                            if exit_after.is_some_and(|n| m.done.len() >= n) {
+                                // Test hook: the process killed midway through a wave.
+                                std::process::exit(3);
+                            }
+                        }
+                    }
+                    k
                 })
                 .collect();
+            let midway = midway
+                .into_inner()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            if let Some(e) = midway.error {
+                return Err(e);
+            }
+            saved_at = midway.saved_at;
             for (&i, k) in wave.iter().zip(kept) {
-                let Some((x, pinned, soft)) = k else {
-                    continue;
+                let kept = Kept {
+                    local: &open[i],
+                    reach,
+                    asked,
                 };
-                for (&s, v) in open[i].unk.iter().zip(x) {
-                    value[s as usize] = v;
-                }
-                match open[i].defect {
-                    Defect::Face(..) => out.repaired += 1,
-                    Defect::Sheet(_) => out.sheets_repaired += 1,
-                }
-                out.pinned += pinned;
-                out.widened += usize::from(reach.rings > asked.rings);
-                out.hessian += usize::from(reach.hessians && !asked.hessians);
-                out.soft += usize::from(soft);
+                kept.apply(k.as_ref(), value, &mut out);
             }
             decided.extend(wave.iter().map(|&i| ids[i]));
             left = later;
@@ -467,7 +511,7 @@ pub fn repair(
             if let Some(path) = checkpoint {
                 // Every few minutes, and at a pass's end (then as the next pass, none decided).
                 let pass_done = left.is_empty();
-                if pass_done || stop || saved_at.elapsed() >= CHECKPOINT_EVERY {
+                if pass_done || stop || saved_at.elapsed() >= every {
                     checkpoint::save(
                         path,
                         &checkpoint::Progress {
@@ -496,6 +540,42 @@ pub fn repair(
         .filter(|&t| is_sheet(t, value))
         .count();
     Ok(out)
+}
+
+/// What a wave's repairs finished so far, for a checkpoint midway.
+struct Midway {
+    /// (index into the pass's open defects, what its repair gave).
+    done: Vec<(usize, Option<(Vec<f64>, usize, bool)>)>,
+    saved_at: std::time::Instant,
+    error: Option<crate::error::Error>,
+}
+
+/// A decided repair, to apply to the values and the counts.
+struct Kept<'a> {
+    local: &'a Local,
+    reach: Reach,
+    asked: Reach,
+}
+
+impl Kept<'_> {
+    /// Writes the repair's values (if it was kept: `k`, with its pins and whether they were
+    /// weighted) into `value` and counts it in `out`.
+    fn apply(&self, k: Option<&(Vec<f64>, usize, bool)>, value: &mut [f64], out: &mut HoleRepair) {
+        let Some((x, pinned, soft)) = k else {
+            return;
+        };
+        for (&s, &v) in self.local.unk.iter().zip(x) {
+            value[s as usize] = v;
+        }
+        match self.local.defect {
+            Defect::Face(..) => out.repaired += 1,
+            Defect::Sheet(_) => out.sheets_repaired += 1,
+        }
+        out.pinned += pinned;
+        out.widened += usize::from(self.reach.rings > self.asked.rings);
+        out.hessian += usize::from(self.reach.hessians && !self.asked.hessians);
+        out.soft += usize::from(*soft);
+    }
 }
 
 /// The lookups [`repair_defect`] shares across defects.
