@@ -444,7 +444,7 @@ pub fn repair(
                 saved_at,
                 error: None,
             });
-            let kept: Vec<Option<(Vec<f64>, usize, bool)>> = wave
+            let kept: Vec<Option<Repaired>> = wave
                 .par_iter()
                 .map(|&i| {
                     // Repaired with an earlier defect.
@@ -542,10 +542,13 @@ pub fn repair(
     Ok(out)
 }
 
+/// A kept repair: the re-solved values, the pins it took and whether they were weighted.
+type Repaired = (Vec<f64>, usize, bool);
+
 /// What a wave's repairs finished so far, for a checkpoint midway.
 struct Midway {
     /// (index into the pass's open defects, what its repair gave).
-    done: Vec<(usize, Option<(Vec<f64>, usize, bool)>)>,
+    done: Vec<(usize, Option<Repaired>)>,
     saved_at: std::time::Instant,
     error: Option<crate::error::Error>,
 }
@@ -560,7 +563,7 @@ struct Kept<'a> {
 impl Kept<'_> {
     /// Writes the repair's values (if it was kept: `k`, with its pins and whether they were
     /// weighted) into `value` and counts it in `out`.
-    fn apply(&self, k: Option<&(Vec<f64>, usize, bool)>, value: &mut [f64], out: &mut HoleRepair) {
+    fn apply(&self, k: Option<&Repaired>, value: &mut [f64], out: &mut HoleRepair) {
         let Some((x, pinned, soft)) = k else {
             return;
         };
@@ -720,7 +723,7 @@ fn repair_defect(
     local: &Local,
     index: &Index<'_>,
     reach: Reach,
-) -> Option<(Vec<f64>, usize, bool)> {
+) -> Option<Repaired> {
     let Index {
         faces_of, mi, wmax, ..
     } = *index;
