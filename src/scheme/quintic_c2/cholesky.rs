@@ -1490,48 +1490,21 @@ impl Projector {
     /// (as [`solve_near_ordered`] does). Leaves `x` at the best point met.
     fn refine(&self, x: &mut Vec<f64>, c: &[f64], tol: f64) -> f64 {
         let mut r = vec![0.0; self.unit.rows.len()];
-        let res = self.unit.residual_to(c, x, &mut r);
-        self.refine_from(x, c, tol, &mut r, res, 0)
-    }
-
-    /// [`Projector::refine`] from refinement step `from` on, `r` and `res` the residual at `x`.
-    fn refine_from(
-        &self,
-        x: &mut Vec<f64>,
-        c: &[f64],
-        tol: f64,
-        r: &mut [f64],
-        res: f64,
-        from: usize,
-    ) -> f64 {
-        let res = self.refine_steps(x, c, tol, r, res, from);
-        self.finish(x, c, tol, res)
-    }
-
-    /// The refinement steps of [`Projector::refine_from`], without its end ([`Projector::finish`]).
-    fn refine_steps(
-        &self,
-        x: &mut Vec<f64>,
-        c: &[f64],
-        tol: f64,
-        r: &mut [f64],
-        mut res: f64,
-        from: usize,
-    ) -> f64 {
-        for _ in from..=REFINE {
+        let mut res = self.unit.residual_to(c, x, &mut r);
+        for _ in 0..=REFINE {
             if res <= tol {
                 return res;
             }
             let before = (res, x.clone());
-            self.factor.correct(&self.unit.rows, r, x);
-            res = self.unit.residual_to(c, x, r);
+            self.factor.correct(&self.unit.rows, &mut r, x);
+            res = self.unit.residual_to(c, x, &mut r);
             if res.partial_cmp(&before.0) != Some(std::cmp::Ordering::Less) {
                 // Refinement stopped helping (NaN-safe): keep the better point.
                 (res, *x) = before;
-                return res;
+                break;
             }
         }
-        res
+        self.finish(x, c, tol, res)
     }
 
     /// The end of [`Projector::refine`]: conjugate gradients where refinement left `x` (its

@@ -370,6 +370,30 @@ pub fn repair(
             decided.clear();
         }
         let skip: HashSet<u32> = decided.iter().copied().collect();
+        // A decided repair into the values and the counts (nothing if it was refused).
+        let apply = |l: &Local, k: Option<&Repaired>, value: &mut [f64], out: &mut HoleRepair| {
+            let Some((x, pinned, soft)) = k else {
+                return;
+            };
+            for (&s, &v) in l.unk.iter().zip(x) {
+                value[s as usize] = v;
+            }
+            match l.defect {
+                Defect::Face(..) => out.repaired += 1,
+                Defect::Sheet(_) => out.sheets_repaired += 1,
+            }
+            out.pinned += pinned;
+            out.widened += usize::from(reach.rings > asked.rings);
+            out.hessian += usize::from(reach.hessians && !asked.hessians);
+            out.soft += usize::from(*soft);
+        };
+        let progress = |pass, decided, counts, value| checkpoint::Progress {
+            defects: fingerprint,
+            pass,
+            decided,
+            counts,
+            value,
+        };
         let index = Index {
             tets_of: &tets_of,
             faces_of: &faces_of,
@@ -460,23 +484,11 @@ pub fn repair(
                             let mut v = snapshot.to_vec();
                             let mut counts = out.clone();
                             for (j, k) in &m.done {
-                                let kept = Kept {
-                                    local: &open[*j],
-                                    reach,
-                                    asked,
-                                };
-                                kept.apply(k.as_ref(), &mut v, &mut counts);
+                                apply(&open[*j], k.as_ref(), &mut v, &mut counts);
                             }
                             let mut d = decided.clone();
                             d.extend(m.done.iter().map(|(j, _)| ids[*j]));
-                            let p = checkpoint::Progress {
-                                defects: fingerprint,
-                                pass: pass_no,
-                                decided: d,
-                                counts,
-                                value: v,
-                            };
-                            match checkpoint::save(path, &p) {
+                            match checkpoint::save(path, &progress(pass_no, d, counts, v)) {
                                 Ok(()) => m.saved_at = std::time::Instant::now(),
                                 Err(e) => m.error = Some(e),
                             }
@@ -497,12 +509,7 @@ pub fn repair(
             }
             saved_at = midway.saved_at;
             for (&i, k) in wave.iter().zip(kept) {
-                let kept = Kept {
-                    local: &open[i],
-                    reach,
-                    asked,
-                };
-                kept.apply(k.as_ref(), value, &mut out);
+                apply(&open[i], k.as_ref(), value, &mut out);
             }
             decided.extend(wave.iter().map(|&i| ids[i]));
             left = later;
@@ -512,20 +519,13 @@ pub fn repair(
                 // Every few minutes, and at a pass's end (then as the next pass, none decided).
                 let pass_done = left.is_empty();
                 if pass_done || stop || saved_at.elapsed() >= every {
-                    checkpoint::save(
-                        path,
-                        &checkpoint::Progress {
-                            defects: fingerprint,
-                            pass: pass_no + usize::from(pass_done),
-                            decided: if pass_done {
-                                Vec::new()
-                            } else {
-                                decided.clone()
-                            },
-                            counts: out.clone(),
-                            value: value.to_vec(),
-                        },
-                    )?;
+                    let d = if pass_done {
+                        Vec::new()
+                    } else {
+                        decided.clone()
+                    };
+                    let next = pass_no + usize::from(pass_done);
+                    checkpoint::save(path, &progress(next, d, out.clone(), value.to_vec()))?;
                     saved_at = std::time::Instant::now();
                 }
             }
@@ -551,34 +551,6 @@ struct Midway {
     done: Vec<(usize, Option<Repaired>)>,
     saved_at: std::time::Instant,
     error: Option<crate::error::Error>,
-}
-
-/// A decided repair, to apply to the values and the counts.
-struct Kept<'a> {
-    local: &'a Local,
-    reach: Reach,
-    asked: Reach,
-}
-
-impl Kept<'_> {
-    /// Writes the repair's values (if it was kept: `k`, with its pins and whether they were
-    /// weighted) into `value` and counts it in `out`.
-    fn apply(&self, k: Option<&Repaired>, value: &mut [f64], out: &mut HoleRepair) {
-        let Some((x, pinned, soft)) = k else {
-            return;
-        };
-        for (&s, &v) in self.local.unk.iter().zip(x) {
-            value[s as usize] = v;
-        }
-        match self.local.defect {
-            Defect::Face(..) => out.repaired += 1,
-            Defect::Sheet(_) => out.sheets_repaired += 1,
-        }
-        out.pinned += pinned;
-        out.widened += usize::from(self.reach.rings > self.asked.rings);
-        out.hessian += usize::from(self.reach.hessians && !self.asked.hessians);
-        out.soft += usize::from(*soft);
-    }
 }
 
 /// The lookups [`repair_defect`] shares across defects.
