@@ -134,6 +134,12 @@ pub struct QuinticOptions {
     /// last passes for what the others leave (letter_P_poly without `hessian_signs`: 28 → 10
     /// crossed faces; bunny: 6 → 3); `"all"`: every pass; `false`: never.
     pub repair_hessians: HessianRepair,
+    /// With `repair_holes`: how many passes with one more ring each follow the first (2 rings)
+    /// for the defects left open ([`holes::WIDEN`] = 2 by default, so 2, 3 and 4 rings; at
+    /// most [`MAX_REPAIR_WIDEN`]). The defects a pass refuses because their pins could be met
+    /// only as weighted targets are held back by weights beyond its reach; a wider pass frees
+    /// them (fandisk, docs/quintic.md). A repair taken up from its checkpoint may ask for more.
+    pub repair_widen: usize,
     /// Move apart the apexes of edge tetrahedra that are slivers (relative volume below
     /// [`slivers::EDGE_MIN_VOLUME`]) before building: their world Hessians carry the weights'
     /// rounding times (L / h)², which no solve can remove ([`slivers`]). On by default; hulls
@@ -176,6 +182,7 @@ impl Default for QuinticOptions {
             zero_groups: false,
             repair_holes: false,
             repair_hessians: HessianRepair::Last,
+            repair_widen: holes::WIDEN,
             thicken_edges: true,
             balance_edges: false,
             sign_rounds: 0,
@@ -196,6 +203,10 @@ pub enum HessianRepair {
     /// with them held refuses those for want of anything to pin (docs/quintic.md).
     All,
 }
+
+/// The largest [`QuinticOptions::repair_widen`]: 2 + 8 = 10 rings of points round a defect
+/// already reach across most of a model's features, and every ring grows the local group.
+pub const MAX_REPAIR_WIDEN: usize = 8;
 
 /// Default [`QuinticOptions::lift`].
 pub const LIFT: f64 = 3.0;
@@ -258,6 +269,15 @@ impl QuinticOptions {
                         ),
                     }
                 }
+                "repair_widen" => {
+                    o.repair_widen = match v.as_integer() {
+                        Some(n) if (0..=MAX_REPAIR_WIDEN as i64).contains(&n) => n as usize,
+                        _ => bail!(
+                            "{}: `scheme.repair_widen` must be an integer in [0, {MAX_REPAIR_WIDEN}], got {v}",
+                            scene.display()
+                        ),
+                    }
+                }
                 "thicken_edges" => o.thicken_edges = flag()?,
                 "balance_edges" => o.balance_edges = flag()?,
                 "sign_program" => o.sign_program = flag()?,
@@ -301,7 +321,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `repair_holes`, `repair_hessians`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -481,6 +501,7 @@ pub fn build_prepared(
             &tets,
             &mut value,
             reach,
+            options.repair_widen,
             last,
             checkpoint::requested().as_deref(),
         )?;

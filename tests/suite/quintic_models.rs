@@ -16,7 +16,7 @@ use std::path::Path;
 /// rounds, `SIGN_PROGRAM=1` its linear program (HiGHS with the feature `highs`, else the
 /// interior point method), `TANGENT_CLEARANCE` the quintic's `tangent_clearance`,
 /// `SIGN_TARGETS` its `sign_targets`, `JOINT_SIGN_ROUNDS` its `joint_sign_rounds`,
-/// `JOINT_SIGN_FIT` its `joint_sign_fit` (to explore).
+/// `JOINT_SIGN_FIT` its `joint_sign_fit`, `REPAIR_WIDEN` its `repair_widen` (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -49,6 +49,10 @@ fn options() -> QuinticOptions {
             Ok("all") => apatch::scheme::quintic_c2::HessianRepair::All,
             _ => apatch::scheme::quintic_c2::HessianRepair::Last,
         },
+        repair_widen: std::env::var("REPAIR_WIDEN")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(apatch::scheme::quintic_c2::holes::WIDEN),
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
         balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
         joint_sign_rounds: std::env::var("JOINT_SIGN_ROUNDS")

@@ -37,6 +37,11 @@ fn export_with(scene: &Path, out: &Path, resume: Option<&Path>, env: &[(&str, &s
 /// The shipped scene `name` (paper1994) copied with an absolute model path, `repair_holes`
 /// set as asked and Theorem 2.1's pins off (so the torus has holes to repair).
 fn scene(name: &str, repair: bool) -> PathBuf {
+    scene_with(name, &format!("repair_holes = {repair}"), &repair.to_string())
+}
+
+/// [`scene`] with the scheme keys `keys` instead, saved under a name ending in `tag`.
+fn scene_with(name: &str, keys: &str, tag: &str) -> PathBuf {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(root.join(format!("scenes/paper1994/{name}.toml")))
         .unwrap()
@@ -47,9 +52,9 @@ fn scene(name: &str, repair: bool) -> PathBuf {
         .replace("\nsigns = true", "\n")
         .replace(
             "type = \"quintic-c2\"",
-            &format!("type = \"quintic-c2\"\nrepair_holes = {repair}"),
+            &format!("type = \"quintic-c2\"\n{keys}"),
         );
-    let path = tmp(&format!("{name}_{repair}.toml"));
+    let path = tmp(&format!("{name}_{tag}.toml"));
     std::fs::write(&path, text).unwrap();
     path
 }
@@ -195,6 +200,55 @@ fn a_repair_killed_midway_through_a_wave_is_taken_up_from_its_checkpoint() {
         std::fs::read(&taken_up).unwrap() == std::fs::read(&direct).unwrap(),
         "the repair taken up midway through a wave differs from the whole build's"
     );
+}
+
+/// `repair_widen`: a repair finished with fewer passes is taken up from its checkpoint by one
+/// that asks for more, and gives the whole wider build's complex, bit for bit; one whose passes
+/// differ from the checkpoint's is refused, naming the file. The torus without its pins,
+/// started at 1 ring (`APATCH_HOLE_RINGS`, so that the second pass has something to do): one
+/// pass leaves 20 of its 40 crossed faces, a second at 2 rings closes them.
+#[test]
+fn a_finished_repair_is_taken_up_with_more_passes() {
+    let keys = |widen: usize, hessians: &str| {
+        format!("repair_holes = true\nrepair_hessians = {hessians}\nrepair_widen = {widen}")
+    };
+    let narrow = scene_with("torus_quad_quintic", &keys(0, "\"all\""), "widen0");
+    let wide = scene_with("torus_quad_quintic", &keys(1, "\"all\""), "widen1");
+    let ckpt = tmp("torus_widen.ckpt");
+    let _ = std::fs::remove_file(&ckpt);
+    let ckpt_s = ckpt.to_str().unwrap();
+    let run = |scene: &Path, out: &str, ckpt: bool| {
+        let out = tmp(out);
+        let _ = std::fs::remove_file(&out);
+        let mut env = vec![("APATCH_HOLE_RINGS", "1"), ("APATCH_HOLE_TRACE", "1")];
+        if ckpt {
+            env.push(("APATCH_HOLE_CHECKPOINT", ckpt_s));
+        }
+        let o = export_with(scene, &out, None, &env);
+        (out, o)
+    };
+    let ok = |o: &Output| assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (direct, o) = run(&wide, "widen_direct.json", false);
+    ok(&o);
+    let (first, o) = run(&narrow, "widen_first.json", true);
+    ok(&o);
+    // The one pass leaves holes the wider pass closes.
+    assert!(holes(&first) > holes(&direct), "{} {}", holes(&first), holes(&direct));
+    let (taken_up, o) = run(&wide, "widen_taken_up.json", true);
+    ok(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("at pass 2 (0 defects decided)"), "{err}");
+    assert!(
+        std::fs::read(&taken_up).unwrap() == std::fs::read(&direct).unwrap(),
+        "the repair taken up with more passes differs from the whole wider build's"
+    );
+    // Other passes than the checkpoint's (its first one with the Hessians held): refused.
+    let other = scene_with("torus_quad_quintic", &keys(1, "true"), "widen1_last");
+    let (out, o) = run(&other, "widen_other.json", true);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains(ckpt_s) && err.contains("pass 1"), "{err}");
+    assert!(!out.exists(), "no output on bad input");
 }
 
 #[test]

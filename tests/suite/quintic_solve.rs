@@ -279,3 +279,26 @@ fn repair_hessians_key_is_read_and_checked() {
         );
     }
 }
+
+#[test]
+fn repair_widen_key_is_read_and_checked() {
+    use apatch::scheme::quintic_c2::MAX_REPAIR_WIDEN;
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    // The default is the two wider passes the repair always made (2, 3 and 4 rings).
+    assert_eq!(read("").unwrap().repair_widen, 2);
+    for n in [0, 1, 5, MAX_REPAIR_WIDEN] {
+        let got = read(&format!("repair_widen = {n}")).unwrap();
+        assert_eq!(got.repair_widen, n);
+    }
+    let too_many = (MAX_REPAIR_WIDEN + 1).to_string();
+    for bad in ["-1", too_many.as_str(), "2.0", "\"2\"", "true"] {
+        let e = read(&format!("repair_widen = {bad}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("repair_widen"),
+            "{e}"
+        );
+    }
+}

@@ -10,6 +10,11 @@
 //! uninterrupted run's result, bit for bit. The file must come from the same scene and solve:
 //! the slot count and the defect list found at the start are checked.
 //!
+//! The file also holds the repair's plan, the reach of each of its passes (format 2), so that a
+//! repair can be taken up with more passes than it was started with (`repair_widen` raised):
+//! the passes done and the one under way must be the same, else the file is refused. A file of
+//! format 1 (no plan) is taken up by its pass number alone.
+//!
 //! The file is written beside its name and renamed over it, so a process stopped while
 //! writing leaves the previous checkpoint whole.
 
@@ -19,8 +24,10 @@ use std::path::{Path, PathBuf};
 
 /// The environment variable naming the checkpoint file.
 pub const CHECKPOINT_VAR: &str = "APATCH_HOLE_CHECKPOINT";
-/// First bytes of a checkpoint (format version 1).
-const MAGIC: &[u8; 8] = b"APHCKPT1";
+/// First bytes of a checkpoint: format version 2, with the plan.
+const MAGIC: &[u8; 8] = b"APHCKPT2";
+/// First bytes of a checkpoint of format version 1 (no plan), still read.
+const MAGIC_1: &[u8; 8] = b"APHCKPT1";
 
 /// The checkpoint named by [`CHECKPOINT_VAR`], if set.
 #[must_use]
@@ -56,8 +63,11 @@ pub fn midway_hooks(default: std::time::Duration) -> (std::time::Duration, Optio
 pub struct Progress {
     /// A fingerprint of the defects found at the start ([`fingerprint`]).
     pub defects: u64,
-    /// The pass under way (0 = the first).
+    /// The pass under way (0 = the first; the plan's length when every pass is done).
     pub pass: usize,
+    /// The reach of every pass of the repair's plan, as (rings, Hessians free); empty when
+    /// read from a file of format 1, which did not keep it.
+    pub plan: Vec<(usize, bool)>,
     /// Defects (indices into the start's list) that pass has decided.
     pub decided: Vec<u32>,
     /// The counts of the repairs kept so far.
@@ -103,6 +113,11 @@ pub fn save(path: &Path, p: &Progress) -> Result<()> {
     b.extend_from_slice(MAGIC);
     b.extend_from_slice(&p.defects.to_le_bytes());
     b.extend_from_slice(&(p.pass as u64).to_le_bytes());
+    b.extend_from_slice(&(p.plan.len() as u64).to_le_bytes());
+    for &(rings, hessians) in &p.plan {
+        b.extend_from_slice(&(rings as u64).to_le_bytes());
+        b.extend_from_slice(&u64::from(hessians).to_le_bytes());
+    }
     for c in counts_of(&p.counts) {
         b.extend_from_slice(&(c as u64).to_le_bytes());
     }
@@ -144,13 +159,31 @@ pub fn load(path: &Path, slots: usize, defects: u64) -> Result<Option<Progress>>
     };
     let mut r = Reader { b: &b, at: 0 };
     let short = || bad("the checkpoint ends early".into());
-    if r.bytes(8).ok_or_else(short)? != MAGIC {
-        return Err(bad("not a hole repair checkpoint".into()));
-    }
+    let version = match r.bytes(8).ok_or_else(short)? {
+        m if m == MAGIC => 2,
+        m if m == MAGIC_1 => 1,
+        _ => return Err(bad("not a hole repair checkpoint".into())),
+    };
     if r.u64().ok_or_else(short)? != defects {
         return Err(bad("its defects are not the ones this solve leaves".into()));
     }
     let pass = r.u64().ok_or_else(short)? as usize;
+    let mut plan = Vec::new();
+    if version == 2 {
+        let n = r.u64().ok_or_else(short)? as usize;
+        for _ in 0..n {
+            let rings = r.u64().ok_or_else(short)? as usize;
+            let hessians = match r.u64().ok_or_else(short)? {
+                0 => false,
+                1 => true,
+                h => return Err(bad(format!("a pass's Hessian flag is {h}, not 0 or 1"))),
+            };
+            plan.push((rings, hessians));
+        }
+        if pass > plan.len() {
+            return Err(bad(format!("pass {pass} of a plan of {}", plan.len())));
+        }
+    }
     let mut c = [0usize; 6];
     for x in &mut c {
         *x = r.u64().ok_or_else(short)? as usize;
@@ -186,10 +219,41 @@ pub fn load(path: &Path, slots: usize, defects: u64) -> Result<Option<Progress>>
     Ok(Some(Progress {
         defects,
         pass,
+        plan,
         decided,
         counts,
         value,
     }))
+}
+
+/// Whether the progress `p` read from `path` can be taken up by a repair whose passes are
+/// `plan`: the passes it finished and the one under way must be the same (more passes after
+/// them are fine). A file without a plan (format 1) is taken up by its pass number alone.
+///
+/// # Errors
+/// An input error naming `path` and the first pass that differs.
+pub fn check_plan(path: &Path, p: &Progress, plan: &[(usize, bool)]) -> Result<()> {
+    if p.plan.is_empty() {
+        return Ok(());
+    }
+    let upto = (p.pass + 1).min(p.plan.len());
+    let show = |r: Option<&(usize, bool)>| match r {
+        Some(&(rings, true)) => format!("{rings} rings, Hessians free"),
+        Some(&(rings, false)) => format!("{rings} rings"),
+        None => "none".to_string(),
+    };
+    match (0..upto).find(|&k| plan.get(k) != p.plan.get(k)) {
+        None => Ok(()),
+        Some(k) => Err(Error::Input {
+            path: path.to_path_buf(),
+            message: format!(
+                "the checkpoint's pass {} ({}) is not this scene's ({}): a repair can be taken up only with the same passes, more after them (`{CHECKPOINT_VAR}`)",
+                k + 1,
+                show(p.plan.get(k)),
+                show(plan.get(k))
+            ),
+        }),
+    }
 }
 
 /// Little-endian fields read in turn from a checkpoint's bytes.
@@ -228,6 +292,7 @@ mod tests {
         let p = Progress {
             defects: fp,
             pass: 2,
+            plan: vec![(2, false), (3, false), (4, true)],
             decided: vec![0, 5, 3],
             counts: HoleRepair {
                 repaired: 11,
@@ -244,6 +309,7 @@ mod tests {
         save(&path, &p).unwrap();
         let q = load(&path, 3, fp).unwrap().unwrap();
         assert_eq!(q.pass, p.pass);
+        assert_eq!(q.plan, p.plan);
         assert_eq!(q.decided, p.decided);
         assert_eq!(q.counts, p.counts);
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -256,7 +322,25 @@ mod tests {
         ] {
             assert!(e.to_string().contains("r.ckpt"), "{e}");
         }
+        // The plan: the passes done and the one under way must match; more after them may
+        // follow, and a file of format 1 (the same without its plan) is taken as it is.
+        let longer = [(2, false), (3, false), (4, true), (5, true)];
+        check_plan(&path, &q, &longer).unwrap();
+        for other in [&longer[..2], &[(2, false), (3, true), (4, true)][..]] {
+            let e = check_plan(&path, &q, other).unwrap_err().to_string();
+            assert!(e.contains("r.ckpt") && e.contains("pass"), "{e}");
+        }
         let b = std::fs::read(&path).unwrap();
+        let mut v1 = b"APHCKPT1".to_vec();
+        v1.extend_from_slice(&b[8..24]);
+        v1.extend_from_slice(&b[24 + 8 + 16 * p.plan.len()..]);
+        let old = dir.join("v1.ckpt");
+        std::fs::write(&old, &v1).unwrap();
+        let q1 = load(&old, 3, fp).unwrap().unwrap();
+        assert_eq!((q1.pass, q1.plan.len()), (2, 0));
+        assert_eq!((q1.decided, q1.counts), (p.decided.clone(), p.counts.clone()));
+        assert_eq!(bits(&q1.value), bits(&p.value));
+        check_plan(&old, &q1, &longer[..1]).unwrap();
         std::fs::write(&path, &b[..b.len() - 1]).unwrap();
         assert!(load(&path, 3, fp)
             .unwrap_err()

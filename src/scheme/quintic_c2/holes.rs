@@ -259,6 +259,7 @@ pub fn repair(
     tets: &[HullTet],
     value: &mut [f64],
     reach: Reach,
+    widen: usize,
     hessian_passes_asked: bool,
     checkpoint: Option<&Path>,
 ) -> Result<HoleRepair> {
@@ -296,11 +297,34 @@ pub fn repair(
     // of the solve (the repairs are small against it).
     let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
     // Taken up again from a checkpoint: its values, its pass and the defects it decided.
+    // Passes: the asked reach, `widen` wider ones ([`WIDEN`] by default), then (the scene's
+    // `repair_hessians`, [`hessian_passes`]) the asked reach and one ring more with the
+    // Hessians free for what is left (a base face of a face tetrahedron holds no late weight:
+    // its weights are jets and stars), unless the asked reach frees them already
+    // (`repair_hessians = "all"`).
+    let asked = reach;
+    let passes: Vec<Reach> = (0..=widen)
+        .map(|extra| Reach {
+            rings: asked.rings + extra,
+            ..asked
+        })
+        .chain(
+            (0..2)
+                .filter(|_| hessian_passes(hessian_passes_asked) && !asked.hessians)
+                .map(|extra| Reach {
+                    rings: asked.rings + extra,
+                    hessians: true,
+                    ..asked
+                }),
+        )
+        .collect();
+    let plan: Vec<(usize, bool)> = passes.iter().map(|r| (r.rings, r.hessians)).collect();
     let fingerprint = checkpoint::fingerprint(defects.iter().map(|d| d.at()));
     let mut start_pass = 0;
     let mut decided: Vec<u32> = Vec::new();
     if let Some(path) = checkpoint {
         if let Some(p) = checkpoint::load(path, value.len(), fingerprint)? {
+            checkpoint::check_plan(path, &p, &plan)?;
             value.copy_from_slice(&p.value);
             start_pass = p.pass;
             decided = p.decided;
@@ -339,30 +363,11 @@ pub fn repair(
         }
     }
     let mi = multi_indices(5);
-    // Passes: the asked reach, [`WIDEN`] wider ones, then (the scene's `repair_hessians`,
-    // [`hessian_passes`]) the asked reach and one ring more with the Hessians free for what is
-    // left (a base face of a face tetrahedron holds no late weight: its weights are jets and
-    // stars), unless the asked reach frees them already (`repair_hessians = "all"`).
-    let asked = reach;
-    let passes = (0..=WIDEN)
-        .map(|extra| Reach {
-            rings: asked.rings + extra,
-            ..asked
-        })
-        .chain(
-            (0..2)
-                .filter(|_| hessian_passes(hessian_passes_asked) && !asked.hessians)
-                .map(|extra| Reach {
-                    rings: asked.rings + extra,
-                    hessians: true,
-                    ..asked
-                }),
-        );
     let only = only_tets();
     let stop_after = checkpoint::stop_after();
     let (every, exit_after) = checkpoint::midway_hooks(CHECKPOINT_EVERY);
     let mut waves_run = 0usize;
-    'passes: for (pass_no, reach) in passes.enumerate() {
+    'passes: for (pass_no, &reach) in passes.iter().enumerate() {
         if pass_no < start_pass {
             continue;
         }
@@ -390,6 +395,7 @@ pub fn repair(
         let progress = |pass, decided, counts, value| checkpoint::Progress {
             defects: fingerprint,
             pass,
+            plan: plan.clone(),
             decided,
             counts,
             value,
