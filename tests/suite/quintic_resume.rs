@@ -37,7 +37,11 @@ fn export_with(scene: &Path, out: &Path, resume: Option<&Path>, env: &[(&str, &s
 /// The shipped scene `name` (paper1994) copied with an absolute model path, `repair_holes`
 /// set as asked and Theorem 2.1's pins off (so the torus has holes to repair).
 fn scene(name: &str, repair: bool) -> PathBuf {
-    scene_with(name, &format!("repair_holes = {repair}"), &repair.to_string())
+    scene_with(
+        name,
+        &format!("repair_holes = {repair}"),
+        &repair.to_string(),
+    )
 }
 
 /// [`scene`] with the scheme keys `keys` instead, saved under a name ending in `tag`.
@@ -233,7 +237,12 @@ fn a_finished_repair_is_taken_up_with_more_passes() {
     let (first, o) = run(&narrow, "widen_first.json", true);
     ok(&o);
     // The one pass leaves holes the wider pass closes.
-    assert!(holes(&first) > holes(&direct), "{} {}", holes(&first), holes(&direct));
+    assert!(
+        holes(&first) > holes(&direct),
+        "{} {}",
+        holes(&first),
+        holes(&direct)
+    );
     let (taken_up, o) = run(&wide, "widen_taken_up.json", true);
     ok(&o);
     let err = String::from_utf8_lossy(&o.stderr);

@@ -338,7 +338,7 @@ mod tests {
         std::fs::write(&old, &v1).unwrap();
         let q1 = load(&old, 3, fp).unwrap().unwrap();
         assert_eq!((q1.pass, q1.plan.len()), (2, 0));
-        assert_eq!((q1.decided, q1.counts), (p.decided.clone(), p.counts.clone()));
+        assert_eq!((&q1.decided, &q1.counts), (&p.decided, &p.counts));
         assert_eq!(bits(&q1.value), bits(&p.value));
         check_plan(&old, &q1, &longer[..1]).unwrap();
         std::fs::write(&path, &b[..b.len() - 1]).unwrap();
