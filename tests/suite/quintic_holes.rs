@@ -238,3 +238,65 @@ fn repair_hessian_passes_mend_letter_p_base_faces() {
         "repair_holes = true\nrepair_hessians = \"all\"",
     ));
 }
+
+/// Exploration `APATCH_HOLE_ELEVATE`: letter_P_poly without `hessian_signs`, repaired with the
+/// Hessians free in every pass, keeps crossed base faces whose pins are Theorem 2.1's signs on
+/// the weights (at its crease points the sides ask opposite signs of the curvature along one
+/// line: no margin is feasible); with the signs asked of the faces' coefficients elevated by
+/// 2 degrees instead, those faces are mended and C1/C2 stay within `check`'s bounds.
+#[test]
+fn elevated_face_pins_mend_what_weight_pins_cannot() {
+    use std::process::Command;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("scenes/paper1994/letter_P_poly_quintic.toml"))
+        .unwrap()
+        .replace(
+            "\"../models/",
+            &format!("\"{}/", root.join("scenes/models").display()),
+        )
+        .replace(
+            "hessian_signs = true",
+            "hessian_signs = false\nrepair_holes = true\nrepair_hessians = \"all\"",
+        );
+    assert!(text.contains("repair_holes = true"), "the scene changed");
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let scene = dir.join("letter_p_elevate.toml");
+    std::fs::write(&scene, text).unwrap();
+    let run = |out: &str, elevate: Option<&str>| {
+        let out = dir.join(out);
+        let mut c = Command::new(env!("CARGO_BIN_EXE_apatch"));
+        c.args(["export", "patches"])
+            .arg(&scene)
+            .arg("-o")
+            .arg(&out);
+        for v in [
+            "APATCH_HOLE_ELEVATE",
+            "APATCH_HOLE_ELEVATE_MARGIN",
+            "APATCH_HOLE_RINGS",
+        ] {
+            c.env_remove(v);
+        }
+        if let Some(r) = elevate {
+            c.env("APATCH_HOLE_ELEVATE", r);
+        }
+        let o = c.output().expect("run apatch");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let complex = apatch::complex_io::read_json_file(&out).unwrap();
+        apatch::check::check(&complex, &apatch::check::CheckOptions::default())
+    };
+    let plain = run("letter_p_plain.json", None);
+    let elevated = run("letter_p_elevated.json", Some("2"));
+    assert!(plain.holes.crossing > 0, "{:?}", plain.holes);
+    assert_eq!(elevated.holes.crossing, 0, "{:?}", elevated.holes);
+    // The scheme's C1 and C2 bounds as `check` applies them (1e-9 and 1e-7).
+    assert!(
+        elevated.gradient_jump.worst <= 1e-9,
+        "{}",
+        elevated.gradient_jump.worst
+    );
+    assert!(
+        elevated.hessian_jump.worst <= 1e-7,
+        "{}",
+        elevated.hessian_jump.worst
+    );
+}

@@ -151,6 +151,47 @@ fn only_tets() -> Option<HashSet<u32>> {
     Some(v.split(',').filter_map(|x| x.trim().parse().ok()).collect())
 }
 
+/// Exploration (`APATCH_HOLE_ELEVATE=r`): a crossed face's sign conditions on the coefficients
+/// of its polynomial elevated by `r` degrees instead of on its weights ([`elevation`]).
+fn elevate_by() -> Option<usize> {
+    std::env::var("APATCH_HOLE_ELEVATE")
+        .ok()?
+        .parse()
+        .ok()
+        .filter(|&r| r > 0)
+}
+
+/// The degree elevation by `r` of a quintic on a triangle: for each coefficient of degree
+/// 5 + r (indices `b`), its terms over the quintic's coefficients `face` (positions in `face`,
+/// factor): c_b = Σ_a C(5; a) C(r; b − a) / C(5 + r; b) w_a, a convex combination. Elevated
+/// coefficients converge to the polynomial's values, so their signs are a weaker sufficient
+/// condition for one sign on the face than the weights' own.
+fn elevation(face: &[[u8; 3]], r: usize) -> Vec<Vec<(usize, f64)>> {
+    let fact = |k: usize| (1..=k).map(|i| i as f64).product::<f64>();
+    let multi = |n: usize, a: [usize; 3]| fact(n) / (fact(a[0]) * fact(a[1]) * fact(a[2]));
+    let d = 5 + r;
+    let mut out = Vec::new();
+    for b0 in 0..=d {
+        for b1 in 0..=d - b0 {
+            let b = [b0, b1, d - b0 - b1];
+            let total = multi(d, b);
+            let row: Vec<(usize, f64)> = face
+                .iter()
+                .enumerate()
+                .filter_map(|(i, a)| {
+                    let a = a.map(usize::from);
+                    (0..3).all(|k| a[k] <= b[k]).then(|| {
+                        let rest = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                        (i, multi(5, a) * multi(r, rest) / total)
+                    })
+                })
+                .collect();
+            out.push(row);
+        }
+    }
+    out
+}
+
 /// Whether [`SOFT_MAX`] escalation is on (`APATCH_HOLE_SOFT_MAX=0` turns it off, to compare).
 fn soft_escalation() -> bool {
     std::env::var("APATCH_HOLE_SOFT_MAX").map_or(true, |v| v != "0")
@@ -715,7 +756,7 @@ fn repair_defect(
     } = *local;
     let t = defect.at().0;
     let tet = &tets[t as usize];
-    let col: HashMap<u32, usize> = unk.iter().enumerate().map(|(i, &s)| (s, i)).collect();
+    let mut col: HashMap<u32, usize> = unk.iter().enumerate().map(|(i, &s)| (s, i)).collect();
     // With `hessians`, the number 2 weights of each inner point p move together as its jet's
     // Hessian does: one more unknown per entry of the change δH (target 0), and for each
     // such weight b at p, a, b' the equation b − (a − p)ᵀ δH (b' − p)/20 = its value now.
@@ -799,6 +840,80 @@ fn repair_defect(
     }
     let mut x0: Vec<f64> = unk.iter().map(|&s| value[s as usize]).collect();
     x0.resize(n, 0.0);
+    // Exploration (`APATCH_HOLE_ELEVATE`): every boundary face of the re-solved tetrahedra gets
+    // one more unknown per elevated coefficient that a re-solved weight enters, tied to the
+    // weights by a row; those carry the faces' sign conditions instead of the weights (ids
+    // past the slots: `nslots + k`).
+    let nslots = sys.keys.len() as u32;
+    let mut aux_sign: Vec<f64> = Vec::new();
+    let mut aux_of: HashMap<(u32, usize), Vec<u32>> = HashMap::new();
+    let elevate = elevate_by().filter(|_| matches!(defect, Defect::Face(..)));
+    if let Some(r) = elevate {
+        let face_list: Vec<(u32, usize)> = near
+            .iter()
+            .flat_map(|&k| faces_of.get(&k).into_iter().flatten().map(move |&o| (k, o)))
+            .collect();
+        for (k, o) in face_list {
+            let (slots, idx): (Vec<u32>, Vec<[u8; 3]>) = mi
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| l[o] == 0)
+                .map(|(i, l)| {
+                    let mut a = [0u8; 3];
+                    for (c, v) in (0..4).filter(|&v| v != o).enumerate() {
+                        a[c] = l[v];
+                    }
+                    (sys.slot_of[k as usize][i], a)
+                })
+                .unzip();
+            // The face's sign: Theorem 2.1's for its signed weights (their majority), else its
+            // largest weight's.
+            let votes: i32 = slots
+                .iter()
+                .map(|&q| i32::from(sys.req[q as usize]))
+                .filter(|v| v.abs() == 1)
+                .sum();
+            let big = slots
+                .iter()
+                .map(|&q| value[q as usize])
+                .fold(0.0_f64, |a, v| if v.abs() > a.abs() { v } else { a });
+            let sigma = if votes != 0 {
+                f64::from(votes.signum())
+            } else {
+                big.signum()
+            };
+            if sigma == 0.0 {
+                continue;
+            }
+            let mut ids = Vec::new();
+            for erow in elevation(&idx, r) {
+                if !erow.iter().any(|&(i, _)| col.contains_key(&slots[i])) {
+                    continue;
+                }
+                let j = x0.len();
+                let id = nslots + aux_sign.len() as u32;
+                let mut row = vec![(j, 1.0)];
+                let mut rhs = 0.0;
+                let mut now = 0.0;
+                for &(i, f) in &erow {
+                    let q = slots[i];
+                    now += f * value[q as usize];
+                    match col.get(&q) {
+                        Some(&jj) => row.push((jj, -f)),
+                        None => rhs += f * value[q as usize],
+                    }
+                }
+                rows.push(row);
+                c.push(rhs);
+                x0.push(now);
+                col.insert(id, j);
+                aux_sign.push(sigma);
+                ids.push(id);
+            }
+            aux_of.insert((k, o), ids);
+        }
+    }
+    let n = x0.len();
     let scale = c.iter().chain(&x0).fold(1e-300_f64, |a, x| a.max(x.abs()));
     let bound = GROWTH * scale;
     // The boundary faces of the re-solved tetrahedra and whether each is crossed now.
@@ -825,8 +940,39 @@ fn repair_defect(
     // Sign conditions: every late slot on a boundary face of the re-solved tetrahedra with a
     // sign from Theorem 2.1 (its face's weights), the crossed face's misses pinned first, then
     // whatever a solution newly misses among the ones met before.
-    let sign = |s: u32| f64::from(sys.req[s as usize]);
-    let has_sign = |s: u32| matches!(sys.req[s as usize], 1 | -1);
+    let sign = |s: u32| match s.checked_sub(nslots) {
+        Some(a) => aux_sign[a as usize],
+        None => f64::from(sys.req[s as usize]),
+    };
+    let has_sign = |s: u32| s >= nslots || matches!(sys.req[s as usize], 1 | -1);
+    // A weight's value before the repair, or an elevated coefficient's.
+    let cur = |s: u32| {
+        if s >= nslots {
+            x0[col[&s]]
+        } else {
+            value[s as usize]
+        }
+    };
+    // What carries a face's sign conditions: its weights, or its elevated coefficients.
+    let face_cond = |k: u32, o: usize| -> Vec<u32> {
+        if elevate.is_some() {
+            aux_of.get(&(k, o)).cloned().unwrap_or_default()
+        } else {
+            mi.iter()
+                .enumerate()
+                .filter(|(_, l)| l[o] == 0)
+                .map(|(i, _)| sys.slot_of[k as usize][i])
+                .collect()
+        }
+    };
+    // The elevated coefficients' margin as a share of the weights' (exploration,
+    // `APATCH_HOLE_ELEVATE_MARGIN`; 0 by default): at a crease point of letter_P the sides ask
+    // opposite signs of the curvature along one line, so its number 2 weights there must be
+    // zero and any margin is infeasible (`scripts/hole_feasibility.py`); the face test decides.
+    let aux_margin: f64 = std::env::var("APATCH_HOLE_ELEVATE_MARGIN")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0.0);
     let face_slots = |k: u32, o: usize| -> Vec<u32> {
         mi.iter()
             .enumerate()
@@ -836,29 +982,29 @@ fn repair_defect(
     };
     // The largest weight among `slots` (before the repair), and: watch the signed re-solved
     // ones of `slots` with margin `m`, returning those.
-    let largest = |slots: &[u32]| {
-        slots
-            .iter()
-            .fold(0.0_f64, |a, &s| a.max(value[s as usize].abs()))
-    };
+    let largest = |slots: &[u32]| slots.iter().fold(0.0_f64, |a, &s| a.max(cur(s).abs()));
     let watch = |watched: &mut Vec<(u32, f64)>, slots: &[u32], m: f64| -> Vec<u32> {
         let signed: Vec<u32> = slots
             .iter()
             .copied()
             .filter(|s| col.contains_key(s) && has_sign(*s))
             .collect();
-        watched.extend(signed.iter().map(|&s| (s, m)));
+        watched.extend(
+            signed
+                .iter()
+                .map(|&s| (s, if s >= nslots { m * aux_margin } else { m })),
+        );
         signed
     };
     let mut watched: Vec<(u32, f64)> = Vec::new();
     for &(k, o) in &faces {
         let slots = face_slots(k, o);
-        watch(&mut watched, &slots, MARGIN * largest(&slots));
+        watch(&mut watched, &face_cond(k, o), MARGIN * largest(&slots));
     }
     // The defect's own weights: a crossed face's, or every signed weight of a patch crossed
     // twice along a j-line (Theorem 2.1's signs make every j-line cross once).
     let hole_slots: HashSet<u32> = match defect {
-        Defect::Face(_, opp) => face_slots(t, opp).into_iter().collect(),
+        Defect::Face(_, opp) => face_cond(t, opp).into_iter().collect(),
         Defect::Sheet(_) => {
             let own = &sys.slot_of[t as usize];
             watch(&mut watched, own, MARGIN * largest(own));
@@ -870,7 +1016,7 @@ fn repair_defect(
     let tiny = ZERO * scale;
     let met_before: HashSet<u32> = watched
         .iter()
-        .filter(|&&(s, _)| sign(s) * value[s as usize] >= -tiny)
+        .filter(|&&(s, _)| sign(s) * cur(s) >= -tiny)
         .map(|w| w.0)
         .collect();
     let mut pins: Vec<(usize, f64)> = Vec::new();
@@ -908,6 +1054,18 @@ fn repair_defect(
     let mut lifted = hole_slots;
     let mut trial = value.to_vec();
     let mut solves = 0;
+    // Exploration, with `APATCH_HOLE_ELEVATE`: moves at the solves' rounding are dropped, so
+    // that weights exactly zero (flat regions) stay so and their equations stay exact.
+    let snap = |mut y: Vec<f64>| {
+        if elevate.is_some() {
+            for (v, v0) in y.iter_mut().zip(&x0) {
+                if (*v - v0).abs() <= tiny {
+                    *v = *v0;
+                }
+            }
+        }
+        y
+    };
     loop {
         let miss: Vec<(u32, f64)> = watched
             .iter()
@@ -933,7 +1091,7 @@ fn repair_defect(
             if still {
                 if soft {
                     if let Some(y) = heavier(&mut weight, &mut solves, &pins) {
-                        x = y;
+                        x = snap(y);
                         continue;
                     }
                 }
@@ -942,11 +1100,13 @@ fn repair_defect(
                     // beyond the reach) with the wrong sign, and those without a sign.
                     let held_wrong = lifted
                         .iter()
+                        .filter(|&&s| s < nslots)
                         .filter(|s| !col.contains_key(s))
                         .filter(|&&s| has_sign(s) && sign(s) * trial[s as usize] < -tiny)
                         .count();
                     let big = lifted
                         .iter()
+                        .filter(|&&s| s < nslots)
                         .fold(0.0_f64, |a, &s| a.max(trial[s as usize].abs()));
                     // A weight as the trace names it: its key and required sign.
                     let name = |s: u32| {
@@ -958,6 +1118,7 @@ fn repair_defect(
                     };
                     let unsigned: Vec<String> = lifted
                         .iter()
+                        .filter(|&&s| s < nslots)
                         .filter(|&&s| !has_sign(s))
                         .map(|&s| format!("{} {:.1e}", name(s), trial[s as usize] / big))
                         .collect();
@@ -965,10 +1126,12 @@ fn repair_defect(
                     // crosses (exploration detail, with which are re-solved).
                     let lead = lifted
                         .iter()
+                        .filter(|&&s| s < nslots)
                         .map(|&s| trial[s as usize])
                         .fold(0.0_f64, |a, v| if v.abs() > a.abs() { v } else { a });
                     let against: Vec<String> = lifted
                         .iter()
+                        .filter(|&&s| s < nslots)
                         .filter(|&&s| trial[s as usize] * lead < 0.0)
                         .map(|&s| {
                             let how = if col.contains_key(&s) {
@@ -1002,7 +1165,7 @@ fn repair_defect(
             let mut grew = false;
             let turned = new_faces
                 .iter()
-                .map(|&(k, o)| face_slots(k, o))
+                .map(|&(k, o)| face_cond(k, o))
                 .chain(new_sheets.iter().map(|&k| sys.slot_of[k as usize].to_vec()));
             for slots in turned {
                 for s in watch(&mut watched, &slots, MARGIN * largest(&slots)) {
@@ -1013,7 +1176,7 @@ fn repair_defect(
             watched.dedup_by_key(|w| w.0);
             if !grew && soft {
                 if let Some(y) = heavier(&mut weight, &mut solves, &pins) {
-                    x = y;
+                    x = snap(y);
                     continue;
                 }
             }
@@ -1039,7 +1202,17 @@ fn repair_defect(
             pinned.insert(s);
             pins.push((col[&s], sign(s) * m));
         }
-        dump(defect, n, &rows, &c, &x0, &pins);
+        dump(defect, n, &rows, &c, &x0, &pins, || {
+            unk.iter()
+                .map(|&s| {
+                    format!(
+                        "{:?} req {}",
+                        super::system::unkey(sys.keys[s as usize]),
+                        sys.req[s as usize]
+                    )
+                })
+                .collect()
+        });
         let mut sol = solve(&rows, &c, &pins, n, &x0, &sparse);
         if !ok(&sol) {
             let (hard, hard_rank) = (sol.residual, sol.rank);
@@ -1063,7 +1236,7 @@ fn repair_defect(
             }
             soft = true;
         }
-        x = sol.x;
+        x = snap(sol.x);
     }
     // The checker measures jumps relative to the local size of F: each re-solved equation's
     // residual relative to its own terms may not grow past what it was and the staged solve's
@@ -1075,9 +1248,57 @@ fn repair_defect(
             .fold(0.0, f64::max)
     };
     let limit = worst(value).max(super::system::NEAR_NULL_RESIDUAL);
-    let grown = worst(&trial);
+    let mut grown = worst(&trial);
+    if elevate.is_some() && grown > limit {
+        // Exploration: judged against the terms' sizes before or after the move, whichever is
+        // larger. The elevated pins can take a point's number 2 weights from 4e-2 to zero (a
+        // flat direction at letter_P's creases, where sides ask opposite signs): their
+        // equations are then met to the rounding of the move (1e-16) but fail a bound
+        // relative to the new terms alone, which the checker (jumps relative to the face's
+        // gradient) does not see.
+        grown = eqs
+            .iter()
+            .map(|&e| {
+                let (r, size) = sys.equations[e as usize].terms.iter().fold(
+                    (0.0, 0.0),
+                    |(r, size), &(q, k)| {
+                        let (a, b) = (trial[q as usize], value[q as usize]);
+                        (
+                            r + k * a,
+                            size + k.abs() * a.abs().max(b.abs()).max(1e-12 * wmax),
+                        )
+                    },
+                );
+                f64::abs(r) / size
+            })
+            .fold(0.0, f64::max);
+    }
     if grown.is_nan() || grown > limit {
-        trace(|| format!("{defect:?}: relative residual {grown:.2e} > {limit:.2e}"));
+        trace(|| {
+            // The worst equation: its terms before and after (exploration detail).
+            let e = eqs
+                .iter()
+                .copied()
+                .max_by(|&a, &b| {
+                    sys.relative_residual(a as usize, &trial, wmax)
+                        .total_cmp(&sys.relative_residual(b as usize, &trial, wmax))
+                })
+                .unwrap_or(0);
+            let terms: Vec<String> = sys.equations[e as usize]
+                .terms
+                .iter()
+                .map(|&(q, k)| {
+                    format!(
+                        "{k:.3e}×{:?} {:.3e}→{:.3e}{}",
+                        super::system::unkey(sys.keys[q as usize]),
+                        value[q as usize],
+                        trial[q as usize],
+                        if col.contains_key(&q) { "" } else { " held" }
+                    )
+                })
+                .collect();
+            format!("{defect:?}: relative residual {grown:.2e} > {limit:.2e}: {terms:?}")
+        });
         return None;
     }
     x.truncate(unk.len());
@@ -1215,7 +1436,8 @@ fn solve_soft(
 /// Opt-in dump of a defect's group before each of its solves (`APATCH_HOLE_DUMP` = the
 /// defect as the trace prints it, e.g. `Face(4274, 3)`; results unaffected): its unknowns,
 /// rows, right-hand sides, values and pins as JSON in `/tmp/dump_<defect>_<n>.json`, for
-/// `pinned`'s ignored `explore_dump` test.
+/// `pinned`'s ignored `explore_dump` test and `scripts/hole_feasibility.py`; `names` gives the
+/// re-solved slots' keys and required signs (the Hessian unknowns after them are unnamed).
 fn dump(
     defect: Defect,
     n: usize,
@@ -1223,11 +1445,12 @@ fn dump(
     c: &[f64],
     x0: &[f64],
     pins: &[(usize, f64)],
+    names: impl FnOnce() -> Vec<String>,
 ) {
     if std::env::var("APATCH_HOLE_DUMP").is_ok_and(|want| want == format!("{defect:?}")) {
         let name = format!("{defect:?}").replace([' ', '(', ')', ','], "_");
         let path = std::env::temp_dir().join(format!("dump_{name}_{n}.json"));
-        let j = serde_json::json!({"n": n, "rows": rows, "c": c, "x0": x0, "pins": pins});
+        let j = serde_json::json!({"n": n, "rows": rows, "c": c, "x0": x0, "pins": pins, "names": names()});
         if let Err(e) = std::fs::write(&path, j.to_string()) {
             eprintln!("quintic-c2 hole repair: dump {}: {e}", path.display());
         }
@@ -1352,5 +1575,70 @@ mod tests {
         assert!(s.residual < 1e-9, "{}", s.residual);
         let left = dense::Solution::unsolved(&x0);
         assert!(left.residual.is_infinite() && left.x == x0);
+    }
+
+    /// The elevated net of a quintic on a triangle is the same polynomial: evaluated at
+    /// interior and edge points its Bernstein sum equals the quintic's, each elevated
+    /// coefficient is a convex combination of the weights, and the corners are the corner
+    /// weights themselves.
+    #[test]
+    fn elevated_coefficients_are_the_same_polynomial() {
+        let face: Vec<[u8; 3]> = (0..=5u8)
+            .flat_map(|a| (0..=5 - a).map(move |b| [a, b, 5 - a - b]))
+            .collect();
+        // Weights without structure (a fixed pseudo-random sequence).
+        let w: Vec<f64> = (0..face.len())
+            .map(|i| ((i * 7919 % 23) as f64 - 11.0) / 7.0)
+            .collect();
+        let fact = |k: usize| (1..=k).map(|i| i as f64).product::<f64>();
+        let bern = |idx: [usize; 3], l: [f64; 3]| {
+            let d = idx.iter().sum::<usize>();
+            fact(d) / (fact(idx[0]) * fact(idx[1]) * fact(idx[2]))
+                * l[0].powi(idx[0] as i32)
+                * l[1].powi(idx[1] as i32)
+                * l[2].powi(idx[2] as i32)
+        };
+        for r in [1, 2, 5] {
+            let rows = elevation(&face, r);
+            let d = 5 + r;
+            assert_eq!(rows.len(), (d + 1) * (d + 2) / 2);
+            let mut k = 0;
+            for b0 in 0..=d {
+                for b1 in 0..=d - b0 {
+                    let row = &rows[k];
+                    k += 1;
+                    let sum: f64 = row.iter().map(|t| t.1).sum();
+                    // Rational factors summing to one: a few roundings of numbers near 1.
+                    assert!((sum - 1.0).abs() < 1e-14, "r {r}: row sums to {sum}");
+                    assert!(row.iter().all(|t| t.1 > 0.0));
+                    if [b0, b1, d - b0 - b1].contains(&d) {
+                        assert_eq!(row.len(), 1, "a corner is its own weight");
+                    }
+                }
+            }
+            for l in [
+                [0.2, 0.3, 0.5],
+                [0.6, 0.4, 0.0],
+                [1.0 / 3.0; 3],
+                [0.05, 0.9, 0.05],
+            ] {
+                let f5: f64 = face
+                    .iter()
+                    .zip(&w)
+                    .map(|(a, wi)| wi * bern(a.map(usize::from), l))
+                    .sum();
+                let mut fe = 0.0;
+                let mut k = 0;
+                for b0 in 0..=d {
+                    for b1 in 0..=d - b0 {
+                        let c: f64 = rows[k].iter().map(|&(i, f)| f * w[i]).sum();
+                        fe += c * bern([b0, b1, d - b0 - b1], l);
+                        k += 1;
+                    }
+                }
+                // Sums of ~60 terms of size ≤ 1.6: rounding well below 1e-12.
+                assert!((f5 - fe).abs() < 1e-12, "r {r} at {l:?}: {f5} vs {fe}");
+            }
+        }
     }
 }
