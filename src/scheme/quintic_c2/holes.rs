@@ -152,13 +152,32 @@ fn only_tets() -> Option<HashSet<u32>> {
 }
 
 /// Exploration (`APATCH_HOLE_ELEVATE=r`): a crossed face's sign conditions on the coefficients
-/// of its polynomial elevated by `r` degrees instead of on its weights ([`elevation`]).
-fn elevate_by() -> Option<usize> {
-    std::env::var("APATCH_HOLE_ELEVATE")
-        .ok()?
-        .parse()
+/// of its polynomial elevated by `r` degrees instead of on its weights ([`elevation`]), with
+/// the margins `APATCH_HOLE_ELEVATE_MARGIN` (a share of the weights' [`MARGIN`]; 0 by
+/// default) tried in turn until one repairs the defect, `w` in that list standing for the
+/// weights' own pins: `w,1,1e-2,0` tries the weight pins first, then the elevated ones with
+/// decreasing margins. Without the variable, the weights' pins alone (`None`).
+fn elevated_modes() -> Vec<Option<(usize, f64)>> {
+    let Some(r) = std::env::var("APATCH_HOLE_ELEVATE")
         .ok()
+        .and_then(|v| v.parse::<usize>().ok())
         .filter(|&r| r > 0)
+    else {
+        return vec![None];
+    };
+    let list = std::env::var("APATCH_HOLE_ELEVATE_MARGIN").unwrap_or_else(|_| "0".into());
+    let modes: Vec<Option<(usize, f64)>> = list
+        .split(',')
+        .filter_map(|m| match m.trim() {
+            "w" => Some(None),
+            m => m.parse::<f64>().ok().map(|m| Some((r, m))),
+        })
+        .collect();
+    if modes.is_empty() {
+        vec![Some((r, 0.0))]
+    } else {
+        modes
+    }
 }
 
 /// The degree elevation by `r` of a quintic on a triangle: for each coefficient of degree
@@ -405,6 +424,7 @@ pub fn repair(
     }
     let mi = multi_indices(5);
     let only = only_tets();
+    let modes = elevated_modes();
     let stop_after = checkpoint::stop_after();
     let (every, exit_after) = checkpoint::midway_hooks(CHECKPOINT_EVERY);
     let mut waves_run = 0usize;
@@ -520,7 +540,16 @@ pub fn repair(
                 .map(|&i| {
                     // Repaired with an earlier defect.
                     let k = is_open(open[i].defect, snapshot)
-                        .then(|| repair_defect(sys, tets, snapshot, &open[i], &index, reach))
+                        .then(|| {
+                            // A j-sheet's pins are the weights' in every mode: one try.
+                            let tries = match open[i].defect {
+                                Defect::Face(..) => modes.len(),
+                                Defect::Sheet(_) => 1,
+                            };
+                            modes[..tries].iter().find_map(|&mode| {
+                                repair_defect(sys, tets, snapshot, &open[i], &index, reach, mode)
+                            })
+                        })
                         .flatten();
                     if let Some(path) = checkpoint {
                         let mut m = midway
@@ -742,6 +771,7 @@ fn repair_defect(
     local: &Local,
     index: &Index<'_>,
     reach: Reach,
+    mode: Option<(usize, f64)>,
 ) -> Option<Repaired> {
     let Index {
         faces_of, mi, wmax, ..
@@ -847,7 +877,9 @@ fn repair_defect(
     let nslots = sys.keys.len() as u32;
     let mut aux_sign: Vec<f64> = Vec::new();
     let mut aux_of: HashMap<(u32, usize), Vec<u32>> = HashMap::new();
-    let elevate = elevate_by().filter(|_| matches!(defect, Defect::Face(..)));
+    let elevate = mode
+        .map(|m| m.0)
+        .filter(|_| matches!(defect, Defect::Face(..)));
     if let Some(r) = elevate {
         let face_list: Vec<(u32, usize)> = near
             .iter()
@@ -965,14 +997,12 @@ fn repair_defect(
                 .collect()
         }
     };
-    // The elevated coefficients' margin as a share of the weights' (exploration,
-    // `APATCH_HOLE_ELEVATE_MARGIN`; 0 by default): at a crease point of letter_P the sides ask
-    // opposite signs of the curvature along one line, so its number 2 weights there must be
-    // zero and any margin is infeasible (`scripts/hole_feasibility.py`); the face test decides.
-    let aux_margin: f64 = std::env::var("APATCH_HOLE_ELEVATE_MARGIN")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(0.0);
+    // The elevated coefficients' margin as a share of the weights' ([`elevated_modes`]): at a
+    // crease point of letter_P the sides ask opposite signs of the curvature along one line,
+    // so its number 2 weights there must be zero and any margin is infeasible
+    // (`scripts/hole_feasibility.py`); on fandisk's Face(22450, 3) 1e-2 mends what 0 and 1
+    // do not.
+    let aux_margin = mode.map_or(0.0, |m| m.1);
     let face_slots = |k: u32, o: usize| -> Vec<u32> {
         mi.iter()
             .enumerate()
