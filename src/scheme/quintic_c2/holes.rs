@@ -985,16 +985,19 @@ fn repair_defect(
             value[s as usize]
         }
     };
+    let face_slots = |k: u32, o: usize| -> Vec<u32> {
+        mi.iter()
+            .enumerate()
+            .filter(|(_, l)| l[o] == 0)
+            .map(|(i, _)| sys.slot_of[k as usize][i])
+            .collect()
+    };
     // What carries a face's sign conditions: its weights, or its elevated coefficients.
     let face_cond = |k: u32, o: usize| -> Vec<u32> {
         if elevate.is_some() {
             aux_of.get(&(k, o)).cloned().unwrap_or_default()
         } else {
-            mi.iter()
-                .enumerate()
-                .filter(|(_, l)| l[o] == 0)
-                .map(|(i, _)| sys.slot_of[k as usize][i])
-                .collect()
+            face_slots(k, o)
         }
     };
     // The elevated coefficients' margin as a share of the weights' ([`elevated_modes`]): at a
@@ -1003,13 +1006,6 @@ fn repair_defect(
     // (`scripts/hole_feasibility.py`); on fandisk's Face(22450, 3) 1e-2 mends what 0 and 1
     // do not.
     let aux_margin = mode.map_or(0.0, |m| m.1);
-    let face_slots = |k: u32, o: usize| -> Vec<u32> {
-        mi.iter()
-            .enumerate()
-            .filter(|(_, l)| l[o] == 0)
-            .map(|(i, _)| sys.slot_of[k as usize][i])
-            .collect()
-    };
     // The largest weight among `slots` (before the repair), and: watch the signed re-solved
     // ones of `slots` with margin `m`, returning those.
     let largest = |slots: &[u32]| slots.iter().fold(0.0_f64, |a, &s| a.max(cur(s).abs()));
@@ -1127,16 +1123,16 @@ fn repair_defect(
                 }
                 trace(|| {
                     // What the re-solve cannot reach: the defect's weights held (data, or
-                    // beyond the reach) with the wrong sign, and those without a sign.
-                    let held_wrong = lifted
+                    // beyond the reach) with the wrong sign, and those without a sign (its
+                    // elevated coefficients left out).
+                    let real: Vec<u32> = lifted.iter().copied().filter(|&s| s < nslots).collect();
+                    let held_wrong = real
                         .iter()
-                        .filter(|&&s| s < nslots)
                         .filter(|s| !col.contains_key(s))
                         .filter(|&&s| has_sign(s) && sign(s) * trial[s as usize] < -tiny)
                         .count();
-                    let big = lifted
+                    let big = real
                         .iter()
-                        .filter(|&&s| s < nslots)
                         .fold(0.0_f64, |a, &s| a.max(trial[s as usize].abs()));
                     // A weight as the trace names it: its key and required sign.
                     let name = |s: u32| {
@@ -1146,22 +1142,19 @@ fn repair_defect(
                             sys.req[s as usize]
                         )
                     };
-                    let unsigned: Vec<String> = lifted
+                    let unsigned: Vec<String> = real
                         .iter()
-                        .filter(|&&s| s < nslots)
                         .filter(|&&s| !has_sign(s))
                         .map(|&s| format!("{} {:.1e}", name(s), trial[s as usize] / big))
                         .collect();
                     // The face's weights whose sign differs from its largest's: where it
                     // crosses (exploration detail, with which are re-solved).
-                    let lead = lifted
+                    let lead = real
                         .iter()
-                        .filter(|&&s| s < nslots)
                         .map(|&s| trial[s as usize])
                         .fold(0.0_f64, |a, v| if v.abs() > a.abs() { v } else { a });
-                    let against: Vec<String> = lifted
+                    let against: Vec<String> = real
                         .iter()
-                        .filter(|&&s| s < nslots)
                         .filter(|&&s| trial[s as usize] * lead < 0.0)
                         .map(|&s| {
                             let how = if col.contains_key(&s) {
@@ -1272,47 +1265,27 @@ fn repair_defect(
     // residual relative to its own terms may not grow past what it was and the staged solve's
     // standard (on the nut, residuals small against the group's largest datum still gave
     // Hessian jumps of 6.5e-7 where F is small).
-    let worst = |value: &[f64]| {
-        eqs.iter()
-            .map(|&e| sys.relative_residual(e as usize, value, wmax))
-            .fold(0.0, f64::max)
-    };
-    let limit = worst(value).max(super::system::NEAR_NULL_RESIDUAL);
-    let mut grown = worst(&trial);
-    if elevate.is_some() && grown > limit {
-        // Exploration: judged against the terms' sizes before or after the move, whichever is
-        // larger. The elevated pins can take a point's number 2 weights from 4e-2 to zero (a
-        // flat direction at letter_P's creases, where sides ask opposite signs): their
-        // equations are then met to the rounding of the move (1e-16) but fail a bound
-        // relative to the new terms alone, which the checker (jumps relative to the face's
-        // gradient) does not see.
-        grown = eqs
-            .iter()
-            .map(|&e| {
-                let (r, size) = sys.equations[e as usize].terms.iter().fold(
-                    (0.0, 0.0),
-                    |(r, size), &(q, k)| {
-                        let (a, b) = (trial[q as usize], value[q as usize]);
-                        (
-                            r + k * a,
-                            size + k.abs() * a.abs().max(b.abs()).max(1e-12 * wmax),
-                        )
-                    },
-                );
-                f64::abs(r) / size
-            })
-            .fold(0.0, f64::max);
-    }
+    // In the elevated mode each term is sized by the larger of its values before and after
+    // the move ([`System::relative_residual_moved`]): the elevated pins can take a point's
+    // number 2 weights from 4e-2 to zero (a flat direction at letter_P's creases, where the
+    // sides ask opposite signs), and their equations are then met to the rounding of the
+    // move (1e-16), which a bound relative to the new terms alone refuses while the checker
+    // (jumps relative to the face's gradient) does not see it.
+    let sized_by: &[f64] = if elevate.is_some() { value } else { &trial };
+    let measure = |e: u32| sys.relative_residual_moved(e as usize, &trial, sized_by, wmax);
+    let limit = eqs
+        .iter()
+        .map(|&e| sys.relative_residual(e as usize, value, wmax))
+        .fold(0.0, f64::max)
+        .max(super::system::NEAR_NULL_RESIDUAL);
+    let grown = eqs.iter().map(|&e| measure(e)).fold(0.0, f64::max);
     if grown.is_nan() || grown > limit {
         trace(|| {
             // The worst equation: its terms before and after (exploration detail).
             let e = eqs
                 .iter()
                 .copied()
-                .max_by(|&a, &b| {
-                    sys.relative_residual(a as usize, &trial, wmax)
-                        .total_cmp(&sys.relative_residual(b as usize, &trial, wmax))
-                })
+                .max_by(|&a, &b| measure(a).total_cmp(&measure(b)))
                 .unwrap_or(0);
             let terms: Vec<String> = sys.equations[e as usize]
                 .terms

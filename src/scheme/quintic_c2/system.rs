@@ -747,12 +747,29 @@ impl System {
     /// Equation `e`'s residual in `value` relative to the size of its terms, as
     /// [`Self::scheme_residual`] measures it (`wmax`: the largest |weight|).
     pub(super) fn relative_residual(&self, e: usize, value: &[f64], wmax: f64) -> f64 {
+        self.relative_residual_moved(e, value, value, wmax)
+    }
+
+    /// [`Self::relative_residual`] in `value` with each term's size the larger of its sizes in
+    /// `value` and in `before`: for a move that takes terms to (near) zero, whose equation is
+    /// then met to the rounding of the move rather than of the new, tiny terms (the hole
+    /// repair's elevated pins). With `before` = `value` it is `relative_residual`, bit for bit.
+    pub(super) fn relative_residual_moved(
+        &self,
+        e: usize,
+        value: &[f64],
+        before: &[f64],
+        wmax: f64,
+    ) -> f64 {
         let (r, size) = self.equations[e]
             .terms
             .iter()
             .fold((0.0, 0.0), |(r, size), (s, c)| {
-                let x = value[*s as usize];
-                (r + c * x, size + c.abs() * x.abs().max(1e-12 * wmax))
+                let (x, x0) = (value[*s as usize], before[*s as usize]);
+                (
+                    r + c * x,
+                    size + c.abs() * x.abs().max(x0.abs()).max(1e-12 * wmax),
+                )
             });
         r.abs() / size
     }
