@@ -546,8 +546,24 @@ pub fn repair(
                                 Defect::Face(..) => modes.len(),
                                 Defect::Sheet(_) => 1,
                             };
+                            // Modes of one elevation build the same group (only their
+                            // margins differ), so they share its factor: fandisk's take 70 s in
+                            // double-double.
+                            let mut factors: Vec<(Option<usize>, Factor)> = Vec::new();
                             modes[..tries].iter().find_map(|&mode| {
-                                repair_defect(sys, tets, snapshot, &open[i], &index, reach, mode)
+                                let r = mode.map(|m| m.0);
+                                let at = match factors.iter().position(|f| f.0 == r) {
+                                    Some(at) => at,
+                                    None => {
+                                        factors.push((r, Factor::new()));
+                                        factors.len() - 1
+                                    }
+                                };
+                                let attempt = Attempt {
+                                    mode,
+                                    sparse: &factors[at].1,
+                                };
+                                repair_defect(sys, tets, snapshot, &open[i], &index, reach, attempt)
                             })
                         })
                         .flatten();
@@ -762,6 +778,14 @@ fn neighbourhood(
     })
 }
 
+/// One try at a defect: its pins' mode ([`elevated_modes`]) and its group's factor, shared by
+/// the tries whose groups are the same.
+#[derive(Clone, Copy)]
+struct Attempt<'a> {
+    mode: Option<(usize, f64)>,
+    sparse: &'a Factor,
+}
+
 /// One defect's repair on `value` within `local`: the re-solved values of `local.unk`, the
 /// pins and whether they were weighted, when kept.
 fn repair_defect(
@@ -771,8 +795,9 @@ fn repair_defect(
     local: &Local,
     index: &Index<'_>,
     reach: Reach,
-    mode: Option<(usize, f64)>,
+    attempt: Attempt<'_>,
 ) -> Option<Repaired> {
+    let Attempt { mode, sparse } = attempt;
     let Index {
         faces_of, mi, wmax, ..
     } = *index;
@@ -1052,8 +1077,6 @@ fn repair_defect(
     // The weight of pins met only as targets, raised ([`SOFT_MAX`]) while the targets as
     // weighted leave the defect or a turned neighbour.
     let mut weight = SOFT;
-    // The group's factored equations, made at its first sparse solve and kept for the rest.
-    let sparse = OnceLock::new();
     let ok = |sol: &dense::Solution| {
         // NaN-safe: a NaN residual or weight refuses the repair too.
         sol.residual <= CONSISTENT * scale && sol.x.iter().all(|v| v.abs() <= bound)
@@ -1072,7 +1095,7 @@ fn repair_defect(
         }
         *weight *= 10.0;
         *solves += 1;
-        let sol = solve_soft(&rows, &c, pins, n, &x0, *weight, &sparse);
+        let sol = solve_soft(&rows, &c, pins, n, &x0, *weight, sparse);
         ok_soft(&sol).then_some(sol.x)
     };
     // The weights lifted to the margin: the defect's, then those of any boundary face or
@@ -1236,10 +1259,10 @@ fn repair_defect(
                 })
                 .collect()
         });
-        let mut sol = solve(&rows, &c, &pins, n, &x0, &sparse);
+        let mut sol = solve(&rows, &c, &pins, n, &x0, sparse);
         if !ok(&sol) {
             let (hard, hard_rank) = (sol.residual, sol.rank);
-            sol = solve_soft(&rows, &c, &pins, n, &x0, weight, &sparse);
+            sol = solve_soft(&rows, &c, &pins, n, &x0, weight, sparse);
             if !ok_soft(&sol) {
                 trace(|| {
                     format!(
