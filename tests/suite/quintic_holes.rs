@@ -287,8 +287,8 @@ fn elevated_face_pins_mend_what_weight_pins_cannot() {
         apatch::check::check(&complex, &apatch::check::CheckOptions::default())
     };
     let plain = run("letter_p_plain.json", None);
-    // The margins in turn, as on fandisk: 7 of the 12 repairs refuse margin 1 and take a smaller one,
-    // each later try on the first's factor (they share its group).
+    // The margins in turn, as on fandisk: 7 of the 12 repairs refuse margin 1 and take a
+    // smaller one, each later try on the first's factor (they share its group).
     let elevated = run("letter_p_elevated.json", Some(("2", "1,1e-2,0")));
     assert!(plain.holes.crossing > 0, "{:?}", plain.holes);
     assert_eq!(elevated.holes.crossing, 0, "{:?}", elevated.holes);
