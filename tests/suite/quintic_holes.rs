@@ -244,7 +244,7 @@ fn repair_hessian_passes_mend_letter_p_base_faces() {
 /// the weights (at its crease points the sides ask opposite signs of the curvature along one
 /// line: no margin is feasible); with the signs asked of the faces' coefficients elevated by
 /// 2 degrees instead, those faces are mended and C1/C2 stay within `check`'s bounds, with the
-/// margins tried in turn.
+/// margins tried in turn: the whole `check` passes.
 #[test]
 fn elevated_face_pins_mend_what_weight_pins_cannot() {
     use std::process::Command;
@@ -273,6 +273,7 @@ fn elevated_face_pins_mend_what_weight_pins_cannot() {
         for v in [
             "APATCH_HOLE_ELEVATE",
             "APATCH_HOLE_ELEVATE_MARGIN",
+            "APATCH_HOLE_ELEVATE_SCOPE",
             "APATCH_HOLE_RINGS",
         ] {
             c.env_remove(v);
@@ -291,7 +292,10 @@ fn elevated_face_pins_mend_what_weight_pins_cannot() {
     // smaller one, each later try on the first's factor (they share its group).
     let elevated = run("letter_p_elevated.json", Some(("2", "1,1e-2,0")));
     assert!(plain.holes.crossing > 0, "{:?}", plain.holes);
+    // Only the crossed face is elevated (the default scope), its neighbours watched by whether
+    // they turn: every defect is mended, j-sheets too, and `check` passes.
     assert_eq!(elevated.holes.crossing, 0, "{:?}", elevated.holes);
+    assert!(elevated.failures().is_empty(), "{elevated}");
     // The scheme's C1 and C2 bounds as `check` applies them (1e-9 and 1e-7).
     assert!(
         elevated.gradient_jump.worst <= 1e-9,

@@ -211,6 +211,15 @@ fn elevation(face: &[[u8; 3]], r: usize) -> Vec<Vec<(usize, f64)>> {
     out
 }
 
+/// Whether the elevated mode elevates the crossed face only, the other faces in reach watched
+/// only by whether they turn (the default), or every boundary face in reach with its signs
+/// watched (`APATCH_HOLE_ELEVATE_SCOPE=all`, session 52's first form): on letter_P_poly
+/// without `hessian_signs` the first passes `check` in 3.5 user s, the second leaves 2
+/// j-sheets in 51 s.
+fn defect_scope() -> bool {
+    std::env::var("APATCH_HOLE_ELEVATE_SCOPE").map_or(true, |v| v != "all")
+}
+
 /// Whether [`SOFT_MAX`] escalation is on (`APATCH_HOLE_SOFT_MAX=0` turns it off, to compare).
 fn soft_escalation() -> bool {
     std::env::var("APATCH_HOLE_SOFT_MAX").map_or(true, |v| v != "0")
@@ -895,20 +904,27 @@ fn repair_defect(
     }
     let mut x0: Vec<f64> = unk.iter().map(|&s| value[s as usize]).collect();
     x0.resize(n, 0.0);
-    // Exploration (`APATCH_HOLE_ELEVATE`): every boundary face of the re-solved tetrahedra gets
-    // one more unknown per elevated coefficient that a re-solved weight enters, tied to the
-    // weights by a row; those carry the faces' sign conditions instead of the weights (ids
-    // past the slots: `nslots + k`).
+    // Exploration (`APATCH_HOLE_ELEVATE`): the crossed face (or every boundary face of the
+    // re-solved tetrahedra) gets one more unknown per elevated coefficient that a re-solved
+    // weight enters, tied to the weights by a row; those carry the face's sign conditions
+    // instead of its weights (ids past the slots: `nslots + k`).
     let nslots = sys.keys.len() as u32;
     let mut aux_sign: Vec<f64> = Vec::new();
     let mut aux_of: HashMap<(u32, usize), Vec<u32>> = HashMap::new();
     let elevate = mode
         .map(|m| m.0)
         .filter(|_| matches!(defect, Defect::Face(..)));
+    // Only the crossed face itself is elevated unless `APATCH_HOLE_ELEVATE_SCOPE=all`
+    // ([`defect_scope`]).
+    let one_face = defect_scope();
+    let elevated_face = |k: u32, o: usize| {
+        elevate.is_some() && (!one_face || matches!(defect, Defect::Face(f, p) if (f, p) == (k, o)))
+    };
     if let Some(r) = elevate {
         let face_list: Vec<(u32, usize)> = near
             .iter()
             .flat_map(|&k| faces_of.get(&k).into_iter().flatten().map(move |&o| (k, o)))
+            .filter(|&(k, o)| elevated_face(k, o))
             .collect();
         for (k, o) in face_list {
             let (slots, idx): (Vec<u32>, Vec<[u8; 3]>) = mi
@@ -1019,7 +1035,7 @@ fn repair_defect(
     };
     // What carries a face's sign conditions: its weights, or its elevated coefficients.
     let face_cond = |k: u32, o: usize| -> Vec<u32> {
-        if elevate.is_some() {
+        if elevated_face(k, o) {
             aux_of.get(&(k, o)).cloned().unwrap_or_default()
         } else {
             face_slots(k, o)
@@ -1048,7 +1064,13 @@ fn repair_defect(
         signed
     };
     let mut watched: Vec<(u32, f64)> = Vec::new();
-    for &(k, o) in &faces {
+    // (With the crossed face alone elevated, the other faces are watched only by whether they
+    // turn: their weights' signs are what a crease cannot meet.)
+    let watch_weights = elevate.is_none() || !one_face;
+    for &(k, o) in faces
+        .iter()
+        .filter(|&&f| watch_weights || elevated_face(f.0, f.1))
+    {
         let slots = face_slots(k, o);
         watch(&mut watched, &face_cond(k, o), MARGIN * largest(&slots));
     }
