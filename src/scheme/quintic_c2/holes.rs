@@ -555,22 +555,18 @@ pub fn repair(
                                 Defect::Face(..) => modes.len(),
                                 Defect::Sheet(_) => 1,
                             };
-                            // Modes of one elevation build the same group (only their
-                            // margins differ), so they share its factor: fandisk's take 70 s in
-                            // double-double.
-                            let mut factors: Vec<(Option<usize>, Factor)> = Vec::new();
+                            // The elevated modes (one elevation, only their margins differ)
+                            // build the same group, so they share its factor: fandisk's take
+                            // 70 s in double-double. The weights' pins have their own group.
+                            let (weights_factor, elevated_factor) = (Factor::new(), Factor::new());
                             modes[..tries].iter().find_map(|&mode| {
-                                let r = mode.map(|m| m.0);
-                                let at = match factors.iter().position(|f| f.0 == r) {
-                                    Some(at) => at,
-                                    None => {
-                                        factors.push((r, Factor::new()));
-                                        factors.len() - 1
-                                    }
-                                };
                                 let attempt = Attempt {
                                     mode,
-                                    sparse: &factors[at].1,
+                                    sparse: if mode.is_some() {
+                                        &elevated_factor
+                                    } else {
+                                        &weights_factor
+                                    },
                                 };
                                 repair_defect(sys, tets, snapshot, &open[i], &index, reach, attempt)
                             })
@@ -1064,12 +1060,11 @@ fn repair_defect(
         signed
     };
     let mut watched: Vec<(u32, f64)> = Vec::new();
-    // (With the crossed face alone elevated, the other faces are watched only by whether they
-    // turn: their weights' signs are what a crease cannot meet.)
-    let watch_weights = elevate.is_none() || !one_face;
+    // (In the elevated mode only the elevated faces are watched by their signs, the others
+    // only by whether they turn: their weights' signs are what a crease cannot meet.)
     for &(k, o) in faces
         .iter()
-        .filter(|&&f| watch_weights || elevated_face(f.0, f.1))
+        .filter(|&&(k, o)| elevate.is_none() || elevated_face(k, o))
     {
         let slots = face_slots(k, o);
         watch(&mut watched, &face_cond(k, o), MARGIN * largest(&slots));
