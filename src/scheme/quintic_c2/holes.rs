@@ -135,7 +135,7 @@ pub const WIDEN: usize = 2;
 /// residual (2.6e-9 of the data) missed the 1e-9 consistency standard.
 const SOFT: f64 = 1e2;
 /// The heaviest weight of pins met only as targets: where the weighted solve leaves the
-/// defect, the weight grows tenfold up to this (exploration, `APATCH_HOLE_SOFT_MAX=0` off).
+/// defect, the weight grows tenfold up to this ([`soft_max`]).
 const SOFT_MAX: f64 = 1e4;
 
 /// Whether the last two passes free the Hessians: `asked` (the scene's
@@ -220,9 +220,13 @@ fn defect_scope() -> bool {
     std::env::var("APATCH_HOLE_ELEVATE_SCOPE").map_or(true, |v| v != "all")
 }
 
-/// Whether [`SOFT_MAX`] escalation is on (`APATCH_HOLE_SOFT_MAX=0` turns it off, to compare).
-fn soft_escalation() -> bool {
-    std::env::var("APATCH_HOLE_SOFT_MAX").map_or(true, |v| v != "0")
+/// The heaviest weight the escalation reaches: [`SOFT_MAX`], or `APATCH_HOLE_SOFT_MAX`
+/// (exploration; 0 turns the escalation off, to compare).
+fn soft_max() -> f64 {
+    std::env::var("APATCH_HOLE_SOFT_MAX")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .unwrap_or(SOFT_MAX)
 }
 /// The least time between two checkpoints within a pass ([`checkpoint`]): writing fandisk's
 /// 40 MB of values takes under a second, a wave of its repairs minutes.
@@ -1107,7 +1111,7 @@ fn repair_defect(
     // One more solve with the pins weighted ten times more, when they are targets and the
     // solves and the weight allow: the new values if that solve meets the equations.
     let heavier = |weight: &mut f64, solves: &mut usize, pins: &[(usize, f64)]| {
-        if !soft_escalation() || *weight >= SOFT_MAX || *solves >= ROUNDS {
+        if *weight >= soft_max() || *solves >= ROUNDS {
             return None;
         }
         *weight *= 10.0;
@@ -1205,8 +1209,62 @@ fn repair_defect(
                             format!("{} {:.2e} {how}", name(s), trial[s as usize])
                         })
                         .collect();
+                    // In the elevated mode: the crossed face's elevated coefficients at the
+                    // trial that are negative (against its sign), in the group (a re-solved
+                    // weight enters them) and held, each group's least as a share of the
+                    // face's largest weight, and where the negative ones are (degree 5 + r
+                    // indices over the face's corners).
+                    let elevated = match (elevate, defect) {
+                        (Some(r), Defect::Face(_, opp)) => {
+                            let w = sys.weights(t as usize, &trial);
+                            let (fw, idx): (Vec<(u32, f64)>, Vec<[u8; 3]>) = mi
+                                .iter()
+                                .enumerate()
+                                .filter(|(_, l)| l[opp] == 0)
+                                .map(|(i, l)| {
+                                    let mut a = [0u8; 3];
+                                    for (c, v) in (0..4).filter(|&v| v != opp).enumerate() {
+                                        a[c] = l[v];
+                                    }
+                                    ((sys.slot_of[t as usize][i], w[i]), a)
+                                })
+                                .unzip();
+                            let big = fw.iter().fold(1e-300_f64, |a, p| a.max(p.1.abs()));
+                            let sigma = aux_of
+                                .get(&(t, opp))
+                                .and_then(|ids| ids.first())
+                                .map_or(0.0, |&id| aux_sign[(id - nslots) as usize]);
+                            let d = 5 + r;
+                            let at: Vec<[usize; 3]> = (0..=d)
+                                .flat_map(|b0| (0..=d - b0).map(move |b1| [b0, b1, d - b0 - b1]))
+                                .collect();
+                            let (mut held, mut solved) = ((0, 0.0_f64), (0, 0.0_f64));
+                            let mut negative = Vec::new();
+                            for (erow, b) in elevation(&idx, r).into_iter().zip(at) {
+                                let v: f64 = erow.iter().map(|&(i, f)| f * fw[i].1).sum();
+                                let share = sigma * v / big;
+                                if share < 0.0 {
+                                    let in_group =
+                                        erow.iter().any(|&(i, _)| col.contains_key(&fw[i].0));
+                                    let tally = if in_group { &mut solved } else { &mut held };
+                                    tally.0 += 1;
+                                    tally.1 = tally.1.min(share);
+                                    negative.push(format!("{b:?} {share:.2e}"));
+                                }
+                            }
+                            let corners: Vec<(u32, bool)> = (0..4)
+                                .filter(|&v| v != opp)
+                                .map(|v| (tet.gid[v], tet.gid[v] < np))
+                                .collect();
+                            format!(
+                                "; elevated sign {sigma}: negative in the group {} (least {:.2e}), held {} (least {:.2e}); soft {soft} weight {weight:.0e} solves {solves}; corners (id, of T) {corners:?}; negative at {negative:?}",
+                                solved.0, solved.1, held.0, held.1
+                            )
+                        }
+                        _ => String::new(),
+                    };
                     format!(
-                        "{defect:?}: {} pins; still there ({held_wrong} held weights with the wrong sign; without a sign: {unsigned:?}; against the largest {lead:.2e}: {against:?}), side {:?} role {:?}",
+                        "{defect:?}: {} pins; still there ({held_wrong} held weights with the wrong sign; without a sign: {unsigned:?}; against the largest {lead:.2e}: {against:?}), side {:?} role {:?}{elevated}",
                         pins.len(),
                         tet.side,
                         tet.role
