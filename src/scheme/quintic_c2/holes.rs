@@ -211,6 +211,21 @@ fn elevation(face: &[[u8; 3]], r: usize) -> Vec<Vec<(usize, f64)>> {
     out
 }
 
+/// The weights of a tetrahedron on its face opposite local vertex `opp`: (index into `mi`, the
+/// multi-index over the face's three corners in local order).
+fn face_indices(mi: &[[u8; 4]], opp: usize) -> impl Iterator<Item = (usize, [u8; 3])> + '_ {
+    mi.iter()
+        .enumerate()
+        .filter(move |(_, l)| l[opp] == 0)
+        .map(move |(i, l)| {
+            let mut a = [0u8; 3];
+            for (c, v) in (0..4).filter(|&v| v != opp).enumerate() {
+                a[c] = l[v];
+            }
+            (i, a)
+        })
+}
+
 /// Whether the elevated mode elevates the crossed face only, the other faces in reach watched
 /// only by whether they turn (the default), or every boundary face in reach with its signs
 /// watched (`APATCH_HOLE_ELEVATE_SCOPE=all`, session 52's first form): on letter_P_poly
@@ -927,17 +942,8 @@ fn repair_defect(
             .filter(|&(k, o)| elevated_face(k, o))
             .collect();
         for (k, o) in face_list {
-            let (slots, idx): (Vec<u32>, Vec<[u8; 3]>) = mi
-                .iter()
-                .enumerate()
-                .filter(|(_, l)| l[o] == 0)
-                .map(|(i, l)| {
-                    let mut a = [0u8; 3];
-                    for (c, v) in (0..4).filter(|&v| v != o).enumerate() {
-                        a[c] = l[v];
-                    }
-                    (sys.slot_of[k as usize][i], a)
-                })
+            let (slots, idx): (Vec<u32>, Vec<[u8; 3]>) = face_indices(mi, o)
+                .map(|(i, a)| (sys.slot_of[k as usize][i], a))
                 .unzip();
             // The face's sign: Theorem 2.1's for its signed weights (their majority), else its
             // largest weight's.
@@ -1217,17 +1223,8 @@ fn repair_defect(
                     let elevated = match (elevate, defect) {
                         (Some(r), Defect::Face(_, opp)) => {
                             let w = sys.weights(t as usize, &trial);
-                            let (fw, idx): (Vec<(u32, f64)>, Vec<[u8; 3]>) = mi
-                                .iter()
-                                .enumerate()
-                                .filter(|(_, l)| l[opp] == 0)
-                                .map(|(i, l)| {
-                                    let mut a = [0u8; 3];
-                                    for (c, v) in (0..4).filter(|&v| v != opp).enumerate() {
-                                        a[c] = l[v];
-                                    }
-                                    ((sys.slot_of[t as usize][i], w[i]), a)
-                                })
+                            let (fw, idx): (Vec<(u32, f64)>, Vec<[u8; 3]>) = face_indices(mi, opp)
+                                .map(|(i, a)| ((sys.slot_of[t as usize][i], w[i]), a))
                                 .unzip();
                             let big = fw.iter().fold(1e-300_f64, |a, p| a.max(p.1.abs()));
                             let sigma = aux_of
