@@ -180,12 +180,16 @@ fn elevated_modes() -> Vec<Option<(usize, f64)>> {
     }
 }
 
+/// One coefficient of a face's elevation: its indices of degree 5 + r and its terms (position
+/// in the face's coefficients, factor).
+type ElevatedRow = ([usize; 3], Vec<(usize, f64)>);
+
 /// The degree elevation by `r` of a quintic on a triangle: for each coefficient of degree
-/// 5 + r (indices `b`), its terms over the quintic's coefficients `face` (positions in `face`,
-/// factor): c_b = Σ_a C(5; a) C(r; b − a) / C(5 + r; b) w_a, a convex combination. Elevated
+/// 5 + r, its indices `b` and its terms over the quintic's coefficients `face` (positions in
+/// `face`, factor): c_b = Σ_a C(5; a) C(r; b − a) / C(5 + r; b) w_a, a convex combination. Elevated
 /// coefficients converge to the polynomial's values, so their signs are a weaker sufficient
 /// condition for one sign on the face than the weights' own.
-fn elevation(face: &[[u8; 3]], r: usize) -> Vec<Vec<(usize, f64)>> {
+fn elevation(face: &[[u8; 3]], r: usize) -> Vec<ElevatedRow> {
     let fact = |k: usize| (1..=k).map(|i| i as f64).product::<f64>();
     let multi = |n: usize, a: [usize; 3]| fact(n) / (fact(a[0]) * fact(a[1]) * fact(a[2]));
     let d = 5 + r;
@@ -205,7 +209,7 @@ fn elevation(face: &[[u8; 3]], r: usize) -> Vec<Vec<(usize, f64)>> {
                     })
                 })
                 .collect();
-            out.push(row);
+            out.push((b, row));
         }
     }
     out
@@ -965,7 +969,7 @@ fn repair_defect(
                 continue;
             }
             let mut ids = Vec::new();
-            for erow in elevation(&idx, r) {
+            for (_, erow) in elevation(&idx, r) {
                 if !erow.iter().any(|&(i, _)| col.contains_key(&slots[i])) {
                     continue;
                 }
@@ -1033,9 +1037,7 @@ fn repair_defect(
         }
     };
     let face_slots = |k: u32, o: usize| -> Vec<u32> {
-        mi.iter()
-            .enumerate()
-            .filter(|(_, l)| l[o] == 0)
+        face_indices(mi, o)
             .map(|(i, _)| sys.slot_of[k as usize][i])
             .collect()
     };
@@ -1231,13 +1233,9 @@ fn repair_defect(
                                 .get(&(t, opp))
                                 .and_then(|ids| ids.first())
                                 .map_or(0.0, |&id| aux_sign[(id - nslots) as usize]);
-                            let d = 5 + r;
-                            let at: Vec<[usize; 3]> = (0..=d)
-                                .flat_map(|b0| (0..=d - b0).map(move |b1| [b0, b1, d - b0 - b1]))
-                                .collect();
                             let (mut held, mut solved) = ((0, 0.0_f64), (0, 0.0_f64));
                             let mut negative = Vec::new();
-                            for (erow, b) in elevation(&idx, r).into_iter().zip(at) {
+                            for (b, erow) in elevation(&idx, r) {
                                 let v: f64 = erow.iter().map(|&(i, f)| f * fw[i].1).sum();
                                 let share = sigma * v / big;
                                 if share < 0.0 {
@@ -1700,18 +1698,14 @@ mod tests {
             let rows = elevation(&face, r);
             let d = 5 + r;
             assert_eq!(rows.len(), (d + 1) * (d + 2) / 2);
-            let mut k = 0;
-            for b0 in 0..=d {
-                for b1 in 0..=d - b0 {
-                    let row = &rows[k];
-                    k += 1;
-                    let sum: f64 = row.iter().map(|t| t.1).sum();
-                    // Rational factors summing to one: a few roundings of numbers near 1.
-                    assert!((sum - 1.0).abs() < 1e-14, "r {r}: row sums to {sum}");
-                    assert!(row.iter().all(|t| t.1 > 0.0));
-                    if [b0, b1, d - b0 - b1].contains(&d) {
-                        assert_eq!(row.len(), 1, "a corner is its own weight");
-                    }
+            for (b, row) in &rows {
+                assert_eq!(b.iter().sum::<usize>(), d, "r {r}: indices {b:?}");
+                let sum: f64 = row.iter().map(|t| t.1).sum();
+                // Rational factors summing to one: a few roundings of numbers near 1.
+                assert!((sum - 1.0).abs() < 1e-14, "r {r}: row sums to {sum}");
+                assert!(row.iter().all(|t| t.1 > 0.0));
+                if b.contains(&d) {
+                    assert_eq!(row.len(), 1, "a corner is its own weight");
                 }
             }
             for l in [
@@ -1725,15 +1719,10 @@ mod tests {
                     .zip(&w)
                     .map(|(a, wi)| wi * bern(a.map(usize::from), l))
                     .sum();
-                let mut fe = 0.0;
-                let mut k = 0;
-                for b0 in 0..=d {
-                    for b1 in 0..=d - b0 {
-                        let c: f64 = rows[k].iter().map(|&(i, f)| f * w[i]).sum();
-                        fe += c * bern([b0, b1, d - b0 - b1], l);
-                        k += 1;
-                    }
-                }
+                let fe: f64 = rows
+                    .iter()
+                    .map(|(b, row)| row.iter().map(|&(i, f)| f * w[i]).sum::<f64>() * bern(*b, l))
+                    .sum();
                 // Sums of ~60 terms of size ≤ 1.6: rounding well below 1e-12.
                 assert!((f5 - fe).abs() < 1e-12, "r {r} at {l:?}: {f5} vs {fe}");
             }
