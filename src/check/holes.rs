@@ -18,12 +18,14 @@
 //! Patches with a shooting sheet rule (the 2001 scheme) are skipped: only their first root along
 //! each shooting line is surface, so F may change sign on their boundary faces beyond it.
 
+use super::anatomy::{anatomy, HeldBy};
 use super::eval::PatchEval;
 use super::{CrossedFace, HoleStats, Location};
 use crate::bb::index_of;
 use crate::complex::SheetRule;
 use glam::DVec3;
 use rayon::prelude::*;
+use std::collections::HashSet;
 
 /// Levels of four-way subdivision tried before a face counts as uncertified.
 pub const MAX_DEPTH: usize = 5;
@@ -48,8 +50,14 @@ struct FaceVerdict {
 }
 
 /// Examines the boundary faces `boundary` ((patch position in `evals`, the face's opposite
-/// tetrahedron-local vertex)).
-pub(super) fn measure(evals: &[PatchEval<'_>], boundary: &[(u32, u8)]) -> HoleStats {
+/// tetrahedron-local vertex)); each crossed face's [`anatomy`] is judged with the complex's
+/// interpolated vertices (`surface`, [`super::anatomy::key`]s) and `continuity`.
+pub(super) fn measure(
+    evals: &[PatchEval<'_>],
+    boundary: &[(u32, u8)],
+    surface: &HashSet<[u64; 3]>,
+    continuity: u8,
+) -> HoleStats {
     boundary
         .par_iter()
         .map(|&(p, opp)| {
@@ -69,6 +77,19 @@ pub(super) fn measure(evals: &[PatchEval<'_>], boundary: &[(u32, u8)]) -> HoleSt
                 s.crossing += 1;
                 s.crossing_by_role
                     .insert(e.patch.role.name().to_string(), 1);
+                let a = if e.patch.rational.is_empty() {
+                    Some(anatomy(
+                        e.patch,
+                        usize::from(opp),
+                        surface,
+                        continuity,
+                        ZERO,
+                    ))
+                } else {
+                    None
+                };
+                let held_by = a.as_ref().map_or(HeldBy::Unsigned, |a| a.held_by);
+                s.crossing_by_cause.insert(held_by.name().to_string(), 1);
                 s.worst = v.depth;
                 s.crossing_at = Some(Location::new(&[e], v.point, None));
                 let tet = e.patch.tet_points();
@@ -85,6 +106,14 @@ pub(super) fn measure(evals: &[PatchEval<'_>], boundary: &[(u32, u8)]) -> HoleSt
                     corners,
                     depth: v.depth,
                     point: v.point,
+                    sign: a.as_ref().map_or(0, |a| a.sign),
+                    against: a
+                        .as_ref()
+                        .filter(|a| a.held_by != HeldBy::Unsigned)
+                        .map(|a| a.index),
+                    against_share: a.as_ref().map_or(0.0, |a| a.share),
+                    against_order: a.as_ref().map(|a| a.order),
+                    held_by: held_by.name().to_string(),
                 });
             } else if v.certified {
                 s.certified += 1;
@@ -109,8 +138,13 @@ fn merge(a: HoleStats, b: HoleStats) -> HoleStats {
     for (k, v) in b.crossing_by_role {
         *crossing_by_role.entry(k).or_insert(0) += v;
     }
+    let mut crossing_by_cause = a.crossing_by_cause;
+    for (k, v) in b.crossing_by_cause {
+        *crossing_by_cause.entry(k).or_insert(0) += v;
+    }
     HoleStats {
         crossing_by_role,
+        crossing_by_cause,
         boundary_faces: a.boundary_faces + b.boundary_faces,
         certified: a.certified + b.certified,
         crossing: a.crossing + b.crossing,

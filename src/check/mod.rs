@@ -34,6 +34,7 @@
 //! patch's largest weight S: a root of the shooting polynomial φ(t) is simple when
 //! |φ′(t)| > tolerance · S.
 
+pub mod anatomy;
 pub mod distance;
 pub mod eval;
 mod faces;
@@ -284,6 +285,9 @@ pub struct HoleStats {
     pub crossing: usize,
     /// Crossed faces counted by the hull role of their patch ("face", "edge", …).
     pub crossing_by_role: std::collections::BTreeMap<String, usize>,
+    /// Crossed faces counted by what holds their coefficient most against the face's sign
+    /// ([`anatomy::HeldBy`]: "normal", "hessian", "weights", "unsigned").
+    pub crossing_by_cause: std::collections::BTreeMap<String, usize>,
     /// Faces neither certified nor found crossing (information).
     pub uncertified: usize,
     /// Boundary faces of shooting patches, not examined (their surface is the first root only).
@@ -315,6 +319,21 @@ pub struct CrossedFace {
     pub depth: f64,
     /// A point of the face where F has the minority sign.
     pub point: [f64; 3],
+    /// The sign the face's number 1 weights give it (+1, −1; 0 when none: no corner on the
+    /// surface, or only zero number 1 weights) ([`anatomy`]).
+    pub sign: i8,
+    /// The patch-local multi-index of the face's coefficient most against that sign (absent
+    /// when unsigned).
+    pub against: Option<[u8; 4]>,
+    /// That coefficient times the sign over the face's largest |coefficient| (negative).
+    pub against_share: f64,
+    /// Its distance from the nearest corner on the surface (n − its largest multiplicity
+    /// there): 1 the normal's, 2 the Hessian's (C2), more the solved weights'.
+    pub against_order: Option<u8>,
+    /// What fixes that coefficient: "normal" (the normals and the hull's geometry),
+    /// "hessian" (a jet's Hessian, C2), "weights" (the weights the scheme solves for), or
+    /// "unsigned".
+    pub held_by: String,
 }
 
 /// Everything [`check`] measured, with the options used.
@@ -430,7 +449,9 @@ pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
     let faces = faces::measure(&evals, opts);
     let interpolation = interp::measure(complex, &evals);
     let sheets = sheets::measure(&evals, opts);
-    let holes = holes::measure(&evals, &faces.boundary);
+    let surface: std::collections::HashSet<[u64; 3]> =
+        complex.vertices.iter().map(|&v| anatomy::key(v)).collect();
+    let holes = holes::measure(&evals, &faces.boundary, &surface, continuity);
     CheckReport {
         scheme: complex.scheme.clone(),
         continuity,

@@ -197,6 +197,18 @@ impl fmt::Display for CheckReport {
                 verdict(h.crossing == 0),
                 fmt_location_as("worst", &h.crossing_at)
             )?;
+            if !h.crossing_by_cause.is_empty() {
+                let causes: Vec<String> = h
+                    .crossing_by_cause
+                    .iter()
+                    .map(|(c, n)| format!("{n} {c}"))
+                    .collect();
+                writeln!(
+                    f,
+                    "                 held by (the coefficient most against the face's sign): {}",
+                    causes.join(", ")
+                )?;
+            }
         }
         let failures = self.failures();
         if failures.is_empty() {

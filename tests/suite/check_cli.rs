@@ -588,8 +588,9 @@ fn scene_mesh(scene: &Path) -> (apatch::mesh::Mesh, Vec<DVec3>, toml::Table) {
 /// `joint_stars` and `signs` crosses the outer faces of the edge tetrahedra at its caps' rims
 /// (128, docs/quintic.md, "Small reproducers"). Independent truth, from the exported patches:
 /// each listed face is a face of its patch that no other patch has, F has a strict sign at the
-/// listed point and the opposite one somewhere on a lattice of the face, and the list is as
-/// long as the report's count. A path in a missing directory is a clear error (exit 2) and
+/// listed point and the opposite one somewhere on a lattice of the face, the list is as
+/// long as the report's count, and each face's coefficient most against its sign (the
+/// anatomy, `check::anatomy`) is recomputed from its patch's weights. A path in a missing directory is a clear error (exit 2) and
 /// leaves no file.
 #[test]
 fn holes_file_lists_every_crossed_face() {
@@ -656,6 +657,7 @@ fn holes_file_lists_every_crossed_face() {
         let a = v.as_array().unwrap();
         [0, 1, 2].map(|i| a[i].as_f64().unwrap())
     };
+    let mut by_cause = std::collections::BTreeMap::new();
     for face in faces {
         let patch = &complex.patches[face["patch"].as_u64().unwrap() as usize];
         let corners: Vec<[f64; 3]> = face["corners"]
@@ -685,7 +687,65 @@ fn holes_file_lists_every_crossed_face() {
             })
         });
         assert!(opposite, "F keeps one sign on {face}");
+
+        // The anatomy: a face crossed has a coefficient against the sign its number 1 weights
+        // give (the Bernstein basis is positive), and the one named is the face's least
+        // coefficient times that sign, at its distance from the corners on the surface.
+        let opp = (0..4).find(|&k| !corners.contains(&patch.tet[k])).unwrap();
+        let on_surface = |k: usize| k != opp && complex.vertices.contains(&patch.tet[k]);
+        let n = patch.degree;
+        let face_w: Vec<([u8; 4], f64)> = apatch::bb::multi_indices(n.into())
+            .into_iter()
+            .zip(patch.weights.iter().copied())
+            .filter(|(l, _)| l[opp] == 0)
+            .collect();
+        let order = |l: &[u8; 4]| {
+            n - (0..4)
+                .filter(|&k| on_surface(k))
+                .map(|k| l[k])
+                .max()
+                .unwrap()
+        };
+        let sign = face["sign"].as_i64().unwrap() as f64;
+        assert!(sign == 1.0 || sign == -1.0, "{face}");
+        let first: f64 = face_w
+            .iter()
+            .filter(|(l, _)| order(l) == 1)
+            .map(|c| c.1)
+            .sum();
+        assert_eq!(first.signum(), sign, "{face}");
+        let largest = face_w.iter().fold(0.0_f64, |m, c| m.max(c.1.abs()));
+        let least = face_w
+            .iter()
+            .map(|c| sign * c.1)
+            .fold(f64::INFINITY, f64::min);
+        let index: Vec<u8> = face["against"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_u64().unwrap() as u8)
+            .collect();
+        let index: [u8; 4] = index.try_into().unwrap();
+        let w = patch.weights[apatch::bb::index_of(index)];
+        assert_eq!(index[opp], 0, "{face}");
+        assert_eq!(sign * w, least, "{face}");
+        let share = face["against_share"].as_f64().unwrap();
+        assert!(share < 0.0, "{face}");
+        // 1e-15: the same division, rounded once.
+        assert!((share - least / largest).abs() <= 1e-15, "{face}");
+        let o = order(&index);
+        assert_eq!(face["against_order"].as_u64(), Some(u64::from(o)), "{face}");
+        let held = match o {
+            1 => "normal",
+            2 => "hessian",
+            _ => "weights",
+        };
+        assert_eq!(face["held_by"], held, "{face}");
+        *by_cause.entry(held.to_string()).or_insert(0_u64) += 1;
     }
+    let counted: std::collections::BTreeMap<String, u64> =
+        serde_json::from_value(report["holes"]["crossing_by_cause"].clone()).unwrap();
+    assert_eq!(counted, by_cause);
 
     let bad = tmp("no_such_dir").join("holes.json");
     let o = apatch(&[
