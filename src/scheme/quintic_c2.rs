@@ -122,6 +122,12 @@ pub struct QuinticOptions {
     /// weights off is kept if, its dropped rows met again, the rows stay met within 10×
     /// the solve's residual.
     pub joint_sign_fit: usize,
+    /// With `joint_sign_fit`: what a miss of a weight on a boundary face of the hull costs in
+    /// the split sign program, in units of an inner weight's (1, the default: all alike). The
+    /// surface leaves the hull where a boundary face's weights miss (a hole), while an inner
+    /// weight's miss only loosens Theorem 2.1's certificate; `apatch check --holes` names the
+    /// boundary faces' misses (docs/quintic.md, session 55).
+    pub joint_sign_boundary: f64,
     /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2, and the
     /// stars one ring in) of the tetrahedra around every boundary face the surface crosses (a
     /// hole) and every patch it crosses twice along a j-line (a j-sheet), with all their
@@ -174,6 +180,7 @@ impl Default for QuinticOptions {
             sign_targets: 0.0,
             joint_sign_rounds: 0,
             joint_sign_fit: 0,
+            joint_sign_boundary: 1.0,
             relax_stars: true,
             consistent_stars: false,
             hessian_signs: false,
@@ -309,6 +316,16 @@ impl QuinticOptions {
                 },
                 "joint_sign_rounds" => o.joint_sign_rounds = count()?,
                 "joint_sign_fit" => o.joint_sign_fit = count()?,
+                "joint_sign_boundary" => match v
+                    .as_float()
+                    .or_else(|| v.as_integer().map(|i| i as f64))
+                {
+                    Some(t) if (1.0..=1e6).contains(&t) => o.joint_sign_boundary = t,
+                    _ => bail!(
+                        "{}: `scheme.joint_sign_boundary` must be a number in [1, 1e6], got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => o.signs = flag()?,
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
@@ -321,7 +338,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -452,6 +469,7 @@ pub fn build_prepared(
     sys.sign_targets = options.sign_targets;
     sys.joint_sign_rounds = options.joint_sign_rounds;
     sys.joint_sign_fit = options.joint_sign_fit;
+    sys.joint_sign_boundary = options.joint_sign_boundary;
     if !zero_points.is_empty() {
         sys.require_zero_bases(&tets, &flat::zero_triangles(hull, zero_points));
     }

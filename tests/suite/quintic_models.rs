@@ -16,7 +16,8 @@ use std::path::Path;
 /// rounds, `SIGN_PROGRAM=1` its linear program (HiGHS with the feature `highs`, else the
 /// interior point method), `TANGENT_CLEARANCE` the quintic's `tangent_clearance`,
 /// `SIGN_TARGETS` its `sign_targets`, `JOINT_SIGN_ROUNDS` its `joint_sign_rounds`,
-/// `JOINT_SIGN_FIT` its `joint_sign_fit`, `REPAIR_WIDEN` its `repair_widen` (to explore).
+/// `JOINT_SIGN_FIT` its `joint_sign_fit`, `JOINT_SIGN_BOUNDARY` its
+/// `joint_sign_boundary`, `REPAIR_WIDEN` its `repair_widen` (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -63,6 +64,10 @@ fn options() -> QuinticOptions {
             .ok()
             .and_then(|x| x.parse().ok())
             .unwrap_or(0),
+        joint_sign_boundary: std::env::var("JOINT_SIGN_BOUNDARY")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(1.0),
         sign_rounds: std::env::var("SIGN_ROUNDS")
             .ok()
             .and_then(|x| x.parse().ok())

@@ -230,6 +230,37 @@ fn joint_sign_rounds_key_is_read_and_checked() {
     }
 }
 
+/// `[scheme] joint_sign_boundary` is the cost of a boundary weight's miss, 1 by default (all
+/// alike), integers too; below 1, above 1e6 or not a number is an error naming the scene and
+/// the key.
+#[test]
+fn joint_sign_boundary_key_is_read_and_checked() {
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert_eq!(read("").unwrap().joint_sign_boundary, 1.0);
+    assert_eq!(
+        read("joint_sign_boundary = 10")
+            .unwrap()
+            .joint_sign_boundary,
+        10.0
+    );
+    assert_eq!(
+        read("joint_sign_boundary = 2.5")
+            .unwrap()
+            .joint_sign_boundary,
+        2.5
+    );
+    for bad in ["0.5", "-3", "1e7", "\"x\""] {
+        let e = read(&format!("joint_sign_boundary = {bad}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("joint_sign_boundary"),
+            "{e}"
+        );
+    }
+}
+
 /// `[scheme] sign_targets` is read as a number of medians (integers too), 0 by default, and
 /// a negative or non-numeric value is an error naming the scene and the key.
 #[test]

@@ -880,6 +880,9 @@ pub(super) fn refine_near<F: NormalSolve>(
 pub struct SignBox {
     /// The group's columns with a sign condition, with that sign (±1).
     pub signed: Vec<(usize, f64)>,
+    /// What a miss of each `signed` weight costs the split sign program
+    /// ([`super::signsplit::fit`]; empty: 1 each).
+    pub cost: Vec<f64>,
     /// How far on its side a clamped weight is put.
     pub margin: f64,
     /// Most rounds of [`sign_rounds`].
@@ -897,6 +900,18 @@ impl SignBox {
             .iter()
             .filter(|&&(j, s)| s * x[j] < -tiny)
             .count()
+    }
+
+    /// The cost of the weights of `x` off their sign by more than `tiny` (their number when
+    /// [`SignBox::cost`] is empty).
+    #[must_use]
+    pub fn off_cost(&self, x: &[f64], tiny: f64) -> f64 {
+        self.signed
+            .iter()
+            .enumerate()
+            .filter(|&(_, &(j, s))| s * x[j] < -tiny)
+            .map(|(i, _)| self.cost.get(i).copied().unwrap_or(1.0))
+            .sum()
     }
 
     /// Clamps every signed weight of `x` to at least the margin on its side; how many moved.

@@ -55,8 +55,8 @@ fn project_move<F: NormalSolve>(unit: &UnitRows, f: &F, q: &[Vec<f64>], d: &mut 
 }
 
 /// Runs `sb.fit` rounds of the split sign program from x (the solved group), with moves
-/// orthogonal to `q`; x is moved to the round with the fewest weights off their sign if that
-/// has fewer than x and misses the rows by at most `bound`: then its max |A x − c| is
+/// orthogonal to `q`; x is moved to the round with the fewest weights off their sign (each
+/// counted at its [`SignBox::cost`]) if that has fewer than x and misses the rows by at most `bound`: then its max |A x − c| is
 /// returned, else `None` (x left as it was).
 pub(super) fn fit<F: NormalSolve>(
     unit: &UnitRows,
@@ -79,16 +79,19 @@ pub(super) fn fit<F: NormalSolve>(
     let tiny = 1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let off_before = sb.off(x, tiny);
     let mut sign = vec![0.0; n];
-    for &(j, s) in &sb.signed {
+    let mut cost = vec![1.0; n];
+    for (i, &(j, s)) in sb.signed.iter().enumerate() {
         sign[j] = s;
+        cost[j] = sb.cost.get(i).copied().unwrap_or(1.0);
     }
+    let off_cost_before = sb.off_cost(x, tiny);
     let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
     // In units of the box's margin: stay ε/2 |z − x₀|² + Σ max(0, FIT_MARGIN − s z) over the
     // signed weights.
     let mut rho = RHO;
     let mut z = x0.clone();
     let mut u = vec![0.0; n];
-    let mut best: Option<(usize, Vec<f64>)> = None;
+    let mut best: Option<(f64, Vec<f64>)> = None;
     for round in 0..sb.fit {
         let t = std::time::Instant::now();
         // x step: x₀ + P (z − u − x₀).
@@ -105,12 +108,14 @@ pub(super) fn fit<F: NormalSolve>(
             let zj = if s == 0.0 {
                 a
             } else {
-                // In the weight's own sign and the unit: the hinge's slope −1 below the margin.
+                // In the weight's own sign and the unit: the hinge's slope −cost below the
+                // margin.
                 let w = s * a / margin;
+                let step = cost[j] / kappa;
                 let w = if w >= FIT_MARGIN {
                     w
-                } else if w + 1.0 / kappa < FIT_MARGIN {
-                    w + 1.0 / kappa
+                } else if w + step < FIT_MARGIN {
+                    w + step
                 } else {
                     FIT_MARGIN
                 };
@@ -123,14 +128,15 @@ pub(super) fn fit<F: NormalSolve>(
         }
         let (primal, dual) = (primal.sqrt(), rho * dual.sqrt());
         let off = sb.off(&xk, tiny);
+        let weighed = sb.off_cost(&xk, tiny);
         if trace {
             eprintln!(
-                "quintic-c2 sign fit, round {round}: {off} off their sign (was {off_before}), primal {primal:.2e}, dual {dual:.2e}, rho {rho}, {:.1} s",
+                "quintic-c2 sign fit, round {round}: {off} off their sign (was {off_before}; at their cost {weighed} was {off_cost_before}), primal {primal:.2e}, dual {dual:.2e}, rho {rho}, {:.1} s",
                 t.elapsed().as_secs_f64()
             );
         }
-        if best.as_ref().is_none_or(|b| off < b.0) {
-            best = Some((off, xk));
+        if best.as_ref().is_none_or(|b| weighed < b.0) {
+            best = Some((weighed, xk));
         }
         // Residual balancing; u is the scaled dual λ/ρ, so it scales by 1/the factor.
         if primal > BALANCE * dual {
@@ -156,7 +162,7 @@ pub(super) fn fit<F: NormalSolve>(
             "quintic-c2 sign fit: {off_before} -> {off} off their sign, residual {start:.2e} -> {res:.2e} (bound {bound:.2e})"
         );
     }
-    (res <= bound && off < off_before).then(|| {
+    (res <= bound && sb.off_cost(&y, tiny) < off_cost_before).then(|| {
         *x = y;
         res
     })

@@ -764,6 +764,7 @@ mod tests {
         let tol = 1e-12;
         let sb = cholesky::SignBox {
             signed,
+            cost: Vec::new(),
             margin: 0.1,
             rounds: 300,
             fit: 0,
@@ -844,6 +845,7 @@ mod tests {
             let sys = signed_system(m, n, seed, every, lo);
             let sb = |rounds, fit| cholesky::SignBox {
                 signed: sys.signed.clone(),
+                cost: Vec::new(),
                 margin: 0.1,
                 rounds,
                 fit,
@@ -870,6 +872,42 @@ mod tests {
         eprintln!("off: plain {plain}, alternating {alt}, fit {fit}");
         assert!(fit < alt, "{fit} vs {alt}");
         assert!(residual <= tol, "{residual:e}");
+    }
+
+    /// A cost on some signed weights' misses (`SignBox::cost`, `joint_sign_boundary`: the
+    /// hull's boundary faces) makes the split sign program leave fewer of those off, where the
+    /// rows do not allow every sign: the same system as above (every column signed, 500 rows
+    /// on 600 unknowns), every other signed weight made costly (10×).
+    #[test]
+    fn costly_misses_are_left_fewer() {
+        let (tol, n) = (1e-12, 600);
+        let sys = signed_system(500, n, 6, 1, -0.25);
+        let costly: Vec<bool> = (0..sys.signed.len()).map(|i| i % 2 == 0).collect();
+        let fit = |cost: Vec<f64>| {
+            let sb = cholesky::SignBox {
+                signed: sys.signed.clone(),
+                cost,
+                margin: 0.1,
+                rounds: 0,
+                fit: 100,
+            };
+            let (r, c, t) = (&sys.rows, &sys.c, &sys.target);
+            let x = solve_near_signed(r, n, c, t, tol, MAX_VALUES, Some(&sb))
+                .expect("small")
+                .x;
+            let off = |want: bool| {
+                sys.signed
+                    .iter()
+                    .zip(&costly)
+                    .filter(|&(&(j, s), &k)| k == want && s * x[j] < 0.0)
+                    .count()
+            };
+            (off(true), off(false))
+        };
+        let plain = fit(Vec::new());
+        let weighed = fit(costly.iter().map(|&k| if k { 10.0 } else { 1.0 }).collect());
+        eprintln!("off (costly, the rest): plain {plain:?}, weighed {weighed:?}");
+        assert!(weighed.0 < plain.0, "{plain:?} -> {weighed:?}");
     }
 
     /// A dropped row whose data contradict the kept rows (1e-3 off, at distance 1e-11 from

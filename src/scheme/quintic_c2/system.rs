@@ -198,6 +198,9 @@ pub struct System {
     /// Rounds of the split sign program in each group too large to pin, after its dropped
     /// rows are met (`QuinticOptions::joint_sign_fit`, 0 = off).
     pub joint_sign_fit: usize,
+    /// Cost of a boundary slot's sign miss in the split sign program, in units of an inner
+    /// one's (`QuinticOptions::joint_sign_boundary`, 1 = all alike).
+    pub joint_sign_boundary: f64,
 }
 
 /// Builds the slots and the C1/C2 equations of every shared face.
@@ -310,6 +313,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
         sign_targets: 0.0,
         joint_sign_rounds: 0,
         joint_sign_fit: 0,
+        joint_sign_boundary: 1.0,
     })
 }
 
@@ -1491,8 +1495,23 @@ impl System {
         } else {
             1.0
         };
+        let cost = if self.joint_sign_boundary == 1.0 {
+            Vec::new()
+        } else {
+            signed
+                .iter()
+                .map(|&(j, _)| {
+                    if self.boundary[g.unk[j] as usize] {
+                        self.joint_sign_boundary
+                    } else {
+                        1.0
+                    }
+                })
+                .collect()
+        };
         cholesky::SignBox {
             signed,
+            cost,
             margin: per * median,
             rounds: self.joint_sign_rounds,
             fit: self.joint_sign_fit,
