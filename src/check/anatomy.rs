@@ -11,6 +11,7 @@
 //! move: the normals or the hull (order 1), a jet's Hessian (order 2 in a C2 complex), or the
 //! weights the scheme solves for (the stars, edge middles and late weights).
 
+use super::faces::{point_key, PointKey};
 use crate::bb::multi_indices;
 use crate::complex::Patch;
 use std::collections::HashSet;
@@ -61,28 +62,22 @@ pub struct Anatomy {
     pub held_by: HeldBy,
 }
 
-/// Bit pattern of a point, for exact lookup: the schemes copy the interpolated vertices into
-/// the tetrahedra's corners, so a corner on the surface is bit-for-bit one of them.
-#[must_use]
-pub fn key(p: [f64; 3]) -> [u64; 3] {
-    p.map(|x| (x + 0.0).to_bits())
-}
-
 /// The anatomy of the face of `patch` opposite its local vertex `opp`: `surface` holds the
-/// [`key`]s of the complex's interpolated vertices, `continuity` the complex's promise (its
+/// [`point_key`]s of the complex's interpolated vertices (the schemes copy them into the
+/// tetrahedra's corners, so a corner on the surface is bit for bit one of them), `continuity` the complex's promise (its
 /// jets are of that order). `zero`: coefficients at or below this fraction of the face's
 /// largest count as zero.
 #[must_use]
 pub fn anatomy(
     patch: &Patch,
     opp: usize,
-    surface: &HashSet<[u64; 3]>,
+    surface: &HashSet<PointKey>,
     continuity: u8,
     zero: f64,
 ) -> Anatomy {
     let n = patch.degree;
     let on_surface: Vec<bool> = (0..4)
-        .map(|k| k != opp && surface.contains(&key(patch.tet[k])))
+        .map(|k| k != opp && surface.contains(&point_key(patch.tet[k])))
         .collect();
     let face: Vec<([u8; 4], f64)> = multi_indices(usize::from(n))
         .into_iter()
@@ -176,8 +171,8 @@ mod tests {
         }
     }
 
-    fn surface_of(p: &Patch, ks: &[usize]) -> HashSet<[u64; 3]> {
-        ks.iter().map(|&k| key(p.tet[k])).collect()
+    fn surface_of(p: &Patch, ks: &[usize]) -> HashSet<PointKey> {
+        ks.iter().map(|&k| point_key(p.tet[k])).collect()
     }
 
     /// On the face [p0 p1 p3] of a linear F (corners p0, p1 on the surface) every coefficient

@@ -20,6 +20,7 @@
 
 use super::anatomy::{anatomy, HeldBy};
 use super::eval::PatchEval;
+use super::faces::PointKey;
 use super::{CrossedFace, HoleStats, Location};
 use crate::bb::index_of;
 use crate::complex::SheetRule;
@@ -51,11 +52,11 @@ struct FaceVerdict {
 
 /// Examines the boundary faces `boundary` ((patch position in `evals`, the face's opposite
 /// tetrahedron-local vertex)); each crossed face's [`anatomy`] is judged with the complex's
-/// interpolated vertices (`surface`, [`super::anatomy::key`]s) and `continuity`.
+/// interpolated vertices (`surface`, [`super::faces::point_key`]s) and `continuity`.
 pub(super) fn measure(
     evals: &[PatchEval<'_>],
     boundary: &[(u32, u8)],
-    surface: &HashSet<[u64; 3]>,
+    surface: &HashSet<PointKey>,
     continuity: u8,
 ) -> HoleStats {
     boundary

@@ -449,8 +449,11 @@ pub fn check(complex: &PatchComplex, opts: &CheckOptions) -> CheckReport {
     let faces = faces::measure(&evals, opts);
     let interpolation = interp::measure(complex, &evals);
     let sheets = sheets::measure(&evals, opts);
-    let surface: std::collections::HashSet<[u64; 3]> =
-        complex.vertices.iter().map(|&v| anatomy::key(v)).collect();
+    let surface: std::collections::HashSet<faces::PointKey> = complex
+        .vertices
+        .iter()
+        .map(|&v| faces::point_key(v))
+        .collect();
     let holes = holes::measure(&evals, &faces.boundary, &surface, continuity);
     CheckReport {
         scheme: complex.scheme.clone(),

@@ -56,8 +56,8 @@ fn project_move<F: NormalSolve>(unit: &UnitRows, f: &F, q: &[Vec<f64>], d: &mut 
 
 /// Runs `sb.fit` rounds of the split sign program from x (the solved group), with moves
 /// orthogonal to `q`; x is moved to the round with the fewest weights off their sign (each
-/// counted at its [`SignBox::cost`]) if that has fewer than x and misses the rows by at most `bound`: then its max |A x − c| is
-/// returned, else `None` (x left as it was).
+/// counted at its [`SignBox::cost`]) if that has fewer than x and misses the rows by at most
+/// `bound`: then its max |A x − c| is returned, else `None` (x left as it was).
 pub(super) fn fit<F: NormalSolve>(
     unit: &UnitRows,
     f: &F,
@@ -127,9 +127,9 @@ pub(super) fn fit<F: NormalSolve>(
             z[j] = zj;
         }
         let (primal, dual) = (primal.sqrt(), rho * dual.sqrt());
-        let off = sb.off(&xk, tiny);
         let weighed = sb.off_cost(&xk, tiny);
         if trace {
+            let off = sb.off(&xk, tiny);
             eprintln!(
                 "quintic-c2 sign fit, round {round}: {off} off their sign (was {off_before}; at their cost {weighed} was {off_cost_before}), primal {primal:.2e}, dual {dual:.2e}, rho {rho}, {:.1} s",
                 t.elapsed().as_secs_f64()
