@@ -636,7 +636,7 @@ pub(super) struct UnitRows {
     /// ĉ: each right-hand side over its row's norm.
     pub(super) c: Vec<f64>,
     /// Each row's norm as given.
-    scale: Vec<f64>,
+    pub(super) scale: Vec<f64>,
 }
 
 impl UnitRows {
@@ -853,14 +853,16 @@ pub(super) fn refine_near<F: NormalSolve>(
     if let Some(sb) = signs.filter(|sb| sb.fit > 0 && (meet || best.0 <= tol)) {
         // The sign program inside the group, moving orthogonally to the basis the dropped
         // rows were met with. The other dropped rows see the move (by up to their distance
-        // from the kept span, 3.2e-8, times its length), so they are met again after it; a
-        // start that met `tol` must still meet it, one that did not may miss by up to 10×
-        // more (the check then measures what that does to the jumps).
+        // from the kept span, 3.2e-8, times its length): the fit takes the directions of those
+        // it misses out of its move (`signsplit::seal`), and what is still missed is met
+        // again after it; a start that met `tol` must still meet it, one that did not may
+        // miss by up to 10× more (the check then measures what that does to the jumps).
         if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
             let bound = if best.0 <= tol { tol } else { 10.0 * best.0 };
             let mut x = best.1.clone();
             let loose = if meet { f64::INFINITY } else { bound };
-            if let Some(mut got) = super::signsplit::fit(unit, f, &mut x, &basis, sb, loose) {
+            if let Some(mut got) = super::signsplit::fit(unit, f, &mut x, &basis, sb, loose, bound)
+            {
                 if meet && got > tol {
                     drop(basis);
                     got = meet_dropped(unit, f, &mut x, tol, &MEET_OWN_WEIGHTS).0;
@@ -1023,7 +1025,7 @@ const MEET_FRACTION: f64 = 1e-2;
 /// Smallest distance of a missed row from the kept rows' span that [`meet_dropped`] moves
 /// along: 1e-12 (a pivot of 1e-24) is far above the double-double projection's rounding
 /// (~1e-16 of the row) and far below the rows a drop threshold of 1e-15 drops (≤ 3.2e-8).
-const MEET_MIN_DISTANCE: f64 = 1e-12;
+pub(super) const MEET_MIN_DISTANCE: f64 = 1e-12;
 /// A unit row sees a unit direction q of the kept rows' null space when |a · q| is above this:
 /// a kept row sees only q's rounding (~1e-16 after two projections), a dropped row within
 /// [`MEET_MIN_DISTANCE`] of the span sees at most that distance, and rows seeing less than
@@ -1265,7 +1267,7 @@ struct Move {
     fitted: f64,
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 

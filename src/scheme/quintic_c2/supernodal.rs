@@ -910,6 +910,90 @@ mod tests {
         assert!(weighed.0 < plain.0, "{plain:?} -> {weighed:?}");
     }
 
+    /// The split sign program's move lies in the kept rows' null space, which rows dropped as
+    /// nearly dependent see by their distance from the kept span: 20 rows at distance 1e-9
+    /// (a kept row plus 1e-9 of one column, consistent data: the factor drops them at its
+    /// 1e-15 pivot threshold, the meet meets them) are missed by the fit's move (measured:
+    /// 1.6e-10 for a move of ~0.1), and the seal takes their directions out of the move: the
+    /// rows are met to the tolerance again and the fit still leaves fewer weights off.
+    #[test]
+    fn the_sign_fit_move_is_sealed_against_dropped_rows_it_misses() {
+        use cholesky::NormalSolve;
+        let (tol, n, delta) = (1e-12, 600, 1e-9);
+        let sys = signed_system(500, n, 6, 1, -0.25);
+        // The solved group, and 20 near rows its values meet (as most of fandisk's dropped
+        // rows are met without a move): no meet needs them, so the fit's move is free to
+        // miss them.
+        let x0 = solve_near_signed(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES, None)
+            .expect("small")
+            .x;
+        let (mut rows, mut c) = (sys.rows.clone(), sys.c.clone());
+        let mut seed = 41_u64;
+        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
+        for k in 0..20 {
+            let i = 25 * k;
+            let j = ((lcg(&mut seed) + 1.0) * 0.5 * n as f64) as usize % n;
+            let mut row = rows[i].clone();
+            row.push((j, delta));
+            rows.push(row);
+            c.push(c[i] + delta * x0[j]);
+        }
+        let unit = UnitRows::new(&rows, &c);
+        let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
+        let (f, dropped) = normal
+            .factor::<fx128>(cholesky::PRECISE_PIVOT)
+            .map(with_dropped)
+            .expect("small");
+        assert_eq!(dropped, 20, "the near rows are the ones dropped");
+        let mut r = vec![0.0; rows.len()];
+        let met = unit.residual(&x0, &mut r);
+        assert!(met <= tol, "the start meets the rows: {met:e}");
+        let q: Vec<Vec<f64>> = Vec::new();
+        let _ = &f as &dyn NormalSolve;
+        let sb = cholesky::SignBox {
+            signed: sys.signed.clone(),
+            cost: Vec::new(),
+            margin: 0.1,
+            rounds: 0,
+            fit: 100,
+        };
+        let tiny = 1e-12;
+        let before = sb.off(&x0, tiny);
+        // Without the seal (a goal of ∞) the near rows see the move.
+        let mut open = x0.clone();
+        let unsealed = crate::scheme::quintic_c2::signsplit::fit(
+            &unit,
+            &f,
+            &mut open,
+            &q,
+            &sb,
+            f64::INFINITY,
+            f64::INFINITY,
+        )
+        .expect("the fit gains signs");
+        let mut x = x0.clone();
+        let sealed = crate::scheme::quintic_c2::signsplit::fit(
+            &unit,
+            &f,
+            &mut x,
+            &q,
+            &sb,
+            f64::INFINITY,
+            tol,
+        )
+        .expect("the sealed fit gains signs");
+        let (off_open, off) = (sb.off(&open, tiny), sb.off(&x, tiny));
+        eprintln!(
+            "off {before} -> {off_open} unsealed (residual {unsealed:.2e}), {off} sealed (residual {sealed:.2e})"
+        );
+        assert!(
+            unsealed > 100.0 * tol,
+            "the near rows see the move: {unsealed:e}"
+        );
+        assert!(sealed <= tol, "{sealed:e}");
+        assert!(off < before, "{before} -> {off}");
+    }
+
     /// A dropped row whose data contradict the kept rows (1e-3 off, at distance 1e-11 from
     /// their span: met only by a move of 1e8) is left missed rather than met by that move.
     #[test]
