@@ -861,8 +861,7 @@ pub(super) fn refine_near<F: NormalSolve>(
             let bound = if best.0 <= tol { tol } else { 10.0 * best.0 };
             let mut x = best.1.clone();
             let loose = if meet { f64::INFINITY } else { bound };
-            if let Some(mut got) = super::signsplit::fit(unit, f, &mut x, &basis, sb, loose, bound)
-            {
+            if let Some(mut got) = super::signsplit::fit(unit, f, &mut x, &basis, sb, loose, tol) {
                 if meet && got > tol {
                     drop(basis);
                     got = meet_dropped(unit, f, &mut x, tol, &MEET_OWN_WEIGHTS).0;

@@ -45,10 +45,17 @@ const RHO: f64 = 1.0;
 const BALANCE: f64 = 10.0;
 
 /// `d ← (I − Q Qᵀ) Π d`: d's projection onto the kept rows' null space, less its part in
-/// span Q (Q orthonormal and in that null space).
-fn project_move<F: NormalSolve>(unit: &UnitRows, f: &F, q: &[Vec<f64>], d: &mut Vec<f64>) {
+/// span Q (Q = `q` and `sealed`, orthonormal and in that null space; two slices, so that
+/// neither is copied: each vector is the group's length).
+fn project_move<F: NormalSolve>(
+    unit: &UnitRows,
+    f: &F,
+    q: &[Vec<f64>],
+    sealed: &[Vec<f64>],
+    d: &mut Vec<f64>,
+) {
     f.project(&unit.rows, std::slice::from_mut(d));
-    for qk in q {
+    for qk in q.iter().chain(sealed) {
         let h: f64 = qk.iter().zip(d.iter()).map(|(a, b)| a * b).sum();
         d.iter_mut().zip(qk).for_each(|(v, w)| *v -= h * w);
     }
@@ -79,8 +86,8 @@ const REFIT: f64 = 0.25;
 /// ([`super::cholesky::meet_dropped`]) needs the miss over δ: on fandisk's boundary-weighted
 /// fit (session 55) its second round asked a move of 2.1 (10× x's largest value) and the fit
 /// was discarded. Directions are orthogonalised against `q` and `sealed`; rows are taken
-/// worst first, [`SEAL_ROWS`] a round, until the goal is met or `sealed` holds
-/// [`SEAL_BASIS`]. Returns the residual of x₀ + d.
+/// worst first, [`SEAL_ROWS`] a round, until the goal is met or `sealed` holds `limit`.
+/// Returns the residual of x₀ + d.
 fn seal<F: NormalSolve>(
     unit: &UnitRows,
     f: &F,
@@ -89,6 +96,7 @@ fn seal<F: NormalSolve>(
     x0: &[f64],
     d: &mut [f64],
     goal: f64,
+    limit: usize,
 ) -> f64 {
     let (m, n) = (unit.rows.len(), x0.len());
     let mut r0 = vec![0.0; m];
@@ -99,7 +107,7 @@ fn seal<F: NormalSolve>(
     let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
     let mut used = vec![false; m];
     let mut round = 0;
-    while res > goal && sealed.len() < SEAL_BASIS {
+    while res > goal && sealed.len() < limit {
         let t = std::time::Instant::now();
         // Rows missed beyond the goal where the move, not x₀, misses them.
         let miss = |i: usize| r[i].abs() * unit.scale[i];
@@ -110,7 +118,7 @@ fn seal<F: NormalSolve>(
             .collect();
         missed.sort_by(|&a, &b| miss(b).total_cmp(&miss(a)).then(a.cmp(&b)));
         let all_missed = missed.len();
-        missed.truncate(SEAL_ROWS.min(SEAL_BASIS - sealed.len()));
+        missed.truncate(SEAL_ROWS.min(limit - sealed.len()));
         if missed.is_empty() {
             break;
         }
@@ -185,6 +193,7 @@ impl Admm {
         unit: &UnitRows,
         f: &F,
         q: &[Vec<f64>],
+        sealed: &[Vec<f64>],
         x0: &[f64],
         sb: &SignBox,
         rounds: usize,
@@ -200,7 +209,7 @@ impl Admm {
             let (z, u, rho) = (&mut self.z, &mut self.u, self.rho);
             // x step: x₀ + P (z − u − x₀).
             let mut d: Vec<f64> = (0..n).map(|j| z[j] - u[j] - x0[j]).collect();
-            project_move(unit, f, q, &mut d);
+            project_move(unit, f, q, sealed, &mut d);
             let xk: Vec<f64> = (0..n).map(|j| x0[j] + d[j]).collect();
             // z step, per weight: argmin ε/2 (z − x₀)² + ρ/2 (z − v)² + hinge, v = x + u.
             let kappa = STAY + rho;
@@ -299,7 +308,7 @@ pub(super) fn fit<F: NormalSolve>(
     let counts = (off_before, off_cost_before);
     // In units of the box's margin: stay ε/2 |z − x₀|² + Σ max(0, FIT_MARGIN − s z) over the
     // signed weights.
-    let (_, mut xb) = admm.run(unit, f, q, &x0, sb, sb.fit, tiny, counts)?;
+    let (_, mut xb) = admm.run(unit, f, q, &[], &x0, sb, sb.fit, tiny, counts)?;
     let mut sealed: Vec<Vec<f64>> = Vec::new();
     let mut d: Vec<f64>;
     let mut pass = 0;
@@ -307,11 +316,9 @@ pub(super) fn fit<F: NormalSolve>(
         // The best round's move projected twice more: one projection of fandisk's moves left
         // the rows missed by 1.3e-7 (nearly dependent kept rows amplify its rounding), the
         // next removes most of what the first left.
-        let qs: Vec<Vec<f64>> = q.iter().chain(&sealed).cloned().collect();
         d = (0..n).map(|j| xb[j] - x0[j]).collect();
-        project_move(unit, f, &qs, &mut d);
-        project_move(unit, f, &qs, &mut d);
-        drop(qs);
+        project_move(unit, f, q, &sealed, &mut d);
+        project_move(unit, f, q, &sealed, &mut d);
         if trace {
             let y: Vec<f64> = (0..n).map(|j| x0[j] + d[j]).collect();
             let res = unit.residual(&y, &mut r);
@@ -321,14 +328,15 @@ pub(super) fn fit<F: NormalSolve>(
             );
         }
         let had = sealed.len();
-        seal(unit, f, q, &mut sealed, &x0, &mut d, goal);
+        // Each pass may fill its share of the basis, the last all of it.
+        let limit = SEAL_BASIS * (pass + 1) / SEAL_PASSES;
+        seal(unit, f, q, &mut sealed, &x0, &mut d, goal, limit);
         pass += 1;
         if sealed.len() == had || pass == SEAL_PASSES || sealed.len() >= SEAL_BASIS {
             break;
         }
-        let qs: Vec<Vec<f64>> = q.iter().chain(&sealed).cloned().collect();
         let rounds = ((sb.fit as f64 * REFIT).ceil() as usize).max(1);
-        match admm.run(unit, f, &qs, &x0, sb, rounds, tiny, counts) {
+        match admm.run(unit, f, q, &sealed, &x0, sb, rounds, tiny, counts) {
             Some((_, x)) => xb = x,
             None => break,
         }
