@@ -88,6 +88,7 @@ const REFIT: f64 = 0.25;
 /// was discarded. Directions are orthogonalised against `q` and `sealed`; rows are taken
 /// worst first, [`SEAL_ROWS`] a round, until the goal is met or `sealed` holds `limit`.
 /// Returns the residual of x₀ + d.
+#[allow(clippy::too_many_arguments)]
 fn seal<F: NormalSolve>(
     unit: &UnitRows,
     f: &F,
