@@ -1024,7 +1024,7 @@ const MEET_FRACTION: f64 = 1e-2;
 /// Smallest distance of a missed row from the kept rows' span that [`meet_dropped`] moves
 /// along: 1e-12 (a pivot of 1e-24) is far above the double-double projection's rounding
 /// (~1e-16 of the row) and far below the rows a drop threshold of 1e-15 drops (≤ 3.2e-8).
-pub(super) const MEET_MIN_DISTANCE: f64 = 1e-12;
+const MEET_MIN_DISTANCE: f64 = 1e-12;
 /// A unit row sees a unit direction q of the kept rows' null space when |a · q| is above this:
 /// a kept row sees only q's rounding (~1e-16 after two projections), a dropped row within
 /// [`MEET_MIN_DISTANCE`] of the span sees at most that distance, and rows seeing less than
@@ -1045,6 +1045,58 @@ const MEET_GROWTH: f64 = 10.0;
 /// taken), and its rounds 4–5 build on that. Where the basis, not the trade, limits the rounds
 /// (more near rows than [`MEET_BASIS`]), the plain fit ends lower (`supernodal`'s tests).
 pub(super) const MEET_OWN_WEIGHTS: [f64; 1] = [10.0];
+
+/// The rows `rows` of Â projected onto the kept rows' null space (Π a, |Π a| the row's
+/// distance from the kept span), as dense vectors of length `n`. Twice: the first
+/// projection's Â p is rounded to ~1e-17 of the row, which is 1e-9 of a projection 1e-8
+/// long; the second removes what that left in the kept span.
+pub(super) fn projected_rows<F: NormalSolve>(
+    arows: &[Vec<(u32, f64)>],
+    f: &F,
+    rows: &[usize],
+    n: usize,
+) -> Vec<Vec<f64>> {
+    let mut ps: Vec<Vec<f64>> = rows
+        .iter()
+        .map(|&i| {
+            let mut p = vec![0.0; n];
+            for &(j, a) in &arows[i] {
+                p[j as usize] = a;
+            }
+            p
+        })
+        .collect();
+    f.project(arows, &mut ps);
+    f.project(arows, &mut ps);
+    ps
+}
+
+/// p's part orthogonal to the orthonormal vectors of `q` and `more` (Gram–Schmidt, twice),
+/// normalised, with p's length before: `None` where p is shorter than [`MEET_MIN_DISTANCE`]
+/// (a row that near the kept span sees no move) or lies within 1e-3 of their span (its
+/// direction would be mostly rounding).
+pub(super) fn new_direction(
+    mut p: Vec<f64>,
+    q: &[Vec<f64>],
+    more: &[Vec<f64>],
+) -> Option<(Vec<f64>, f64)> {
+    let norm0 = dot(&p, &p).sqrt();
+    if norm0 < MEET_MIN_DISTANCE {
+        return None;
+    }
+    for _ in 0..2 {
+        for qk in q.iter().chain(more) {
+            let h = dot(qk, &p);
+            p.iter_mut().zip(qk).for_each(|(v, w)| *v -= h * w);
+        }
+    }
+    let norm = dot(&p, &p).sqrt();
+    if norm < 1e-3 * norm0 {
+        return None;
+    }
+    p.iter_mut().for_each(|v| *v /= norm);
+    Some((p, norm0))
+}
 
 /// Meets the rows a factor dropped but x misses: rows off the kept rows' span by δ (pivot δ²
 /// below the drop threshold) are missed by δ times x's distance from the exact solution along
@@ -1092,39 +1144,14 @@ pub(super) fn meet_dropped<F: NormalSolve>(
         });
         let all_missed = missed.len();
         missed.truncate(MEET_ROWS.min(MEET_BASIS - q.len()));
-        let mut ps: Vec<Vec<f64>> = missed
-            .iter()
-            .map(|&i| {
-                let mut p = vec![0.0; n];
-                for &(j, a) in &arows[i] {
-                    p[j as usize] = a;
-                }
-                p
-            })
-            .collect();
-        // Twice: the first projection's Â p is rounded to ~1e-17 of the row, which is 1e-9 of
-        // a projection 1e-8 long; the second removes what that left in the kept span.
-        f.project(arows, &mut ps);
-        f.project(arows, &mut ps);
+        let ps = projected_rows(arows, f, &missed, n);
         // Extend the orthonormal basis Q (Gram–Schmidt against all of it, twice).
         let mut added = 0;
         let mut nearest = f64::INFINITY;
-        for (&i, mut p) in missed.iter().zip(ps) {
-            let norm0 = dot(&p, &p).sqrt();
-            if norm0 < MEET_MIN_DISTANCE {
+        for (&i, p) in missed.iter().zip(ps) {
+            let Some((p, norm0)) = new_direction(p, &q, &[]) else {
                 continue;
-            }
-            for _ in 0..2 {
-                for qk in &q {
-                    let h = dot(qk, &p);
-                    p.iter_mut().zip(qk).for_each(|(v, w)| *v -= h * w);
-                }
-            }
-            let norm = dot(&p, &p).sqrt();
-            if norm < 1e-3 * norm0 {
-                continue;
-            }
-            p.iter_mut().for_each(|v| *v /= norm);
+            };
             seen.push(
                 arows
                     .par_iter()

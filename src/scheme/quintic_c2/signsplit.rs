@@ -22,7 +22,7 @@
 //! rows Q was made for are met by x₀ and see a move only through its Q part (a move in the
 //! kept rows' null space meets a row a as Π a · move, and Π a lies in Q's span).
 
-use super::cholesky::{dot, NormalSolve, SignBox, UnitRows, MEET_MIN_DISTANCE};
+use super::cholesky::{dot, new_direction, projected_rows, NormalSolve, SignBox, UnitRows};
 
 /// ε of the stay term, in units of the box's margin: fixing a weight that is off by one unit
 /// gains about 1 in the hinge and moving it by that costs ε/2, so a sign is worth moving its
@@ -123,38 +123,13 @@ fn seal<F: NormalSolve>(
         if missed.is_empty() {
             break;
         }
-        let mut ps: Vec<Vec<f64>> = missed
-            .iter()
-            .map(|&i| {
-                let mut p = vec![0.0; n];
-                for &(j, a) in &unit.rows[i] {
-                    p[j as usize] = a;
-                }
-                p
-            })
-            .collect();
-        // Twice, as in `meet_dropped`: the second removes what the first's rounding left in
-        // the kept span.
-        f.project(&unit.rows, &mut ps);
-        f.project(&unit.rows, &mut ps);
+        let ps = projected_rows(&unit.rows, f, &missed, n);
         let mut added = 0;
-        for (&i, mut p) in missed.iter().zip(ps) {
+        for (&i, p) in missed.iter().zip(ps) {
             used[i] = true;
-            let norm0 = dot(&p, &p).sqrt();
-            if norm0 < MEET_MIN_DISTANCE {
+            let Some((p, _)) = new_direction(p, q, sealed) else {
                 continue;
-            }
-            for _ in 0..2 {
-                for qk in q.iter().chain(sealed.iter()) {
-                    let h = dot(qk, &p);
-                    p.iter_mut().zip(qk).for_each(|(v, w)| *v -= h * w);
-                }
-            }
-            let norm = dot(&p, &p).sqrt();
-            if norm < 1e-3 * norm0 {
-                continue;
-            }
-            p.iter_mut().for_each(|v| *v /= norm);
+            };
             let h = dot(&p, d);
             d.iter_mut().zip(&p).for_each(|(v, w)| *v -= h * w);
             sealed.push(p);
