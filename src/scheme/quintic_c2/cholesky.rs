@@ -636,7 +636,7 @@ pub(super) struct UnitRows {
     /// ĉ: each right-hand side over its row's norm.
     pub(super) c: Vec<f64>,
     /// Each row's norm as given.
-    pub(super) scale: Vec<f64>,
+    scale: Vec<f64>,
 }
 
 impl UnitRows {
@@ -853,15 +853,15 @@ pub(super) fn refine_near<F: NormalSolve>(
     if let Some(sb) = signs.filter(|sb| sb.fit > 0 && (meet || best.0 <= tol)) {
         // The sign program inside the group, moving orthogonally to the basis the dropped
         // rows were met with. The other dropped rows see the move (by up to their distance
-        // from the kept span, 3.2e-8, times its length): the fit takes the directions of those
-        // it misses out of its move (`signsplit::seal`), and what is still missed is met
-        // again after it; a start that met `tol` must still meet it, one that did not may
-        // miss by up to 10× more (the check then measures what that does to the jumps).
+        // from the kept span, 3.2e-8, times its length), so they are met again after it; a
+        // start that met `tol` must still meet it, one that did not may miss by up to 10×
+        // more (the check then measures what that does to the jumps).
         if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
             let bound = if best.0 <= tol { tol } else { 10.0 * best.0 };
             let mut x = best.1.clone();
             let loose = if meet { f64::INFINITY } else { bound };
-            if let Some(mut got) = super::signsplit::fit(unit, f, &mut x, &basis, sb, loose, tol) {
+            if let Some(mut got) = super::signsplit::fit(unit, f, &mut x, &basis, sb, loose) {
+                save_fit(&best.1, &x);
                 if meet && got > tol {
                     drop(basis);
                     got = meet_dropped(unit, f, &mut x, tol, &MEET_OWN_WEIGHTS).0;
@@ -873,6 +873,33 @@ pub(super) fn refine_near<F: NormalSolve>(
         }
     }
     Some(best)
+}
+
+/// Writes the group's values before and after the split sign program to the file
+/// `APATCH_JOINT_FIT_SAVE` names, if set (exploration only: on fandisk the fit ends ~70 min
+/// into the run, and what follows it, the dropped rows' meet, is what session 56 found
+/// wanting; with the two vectors and the group's factor a variant of that meet can be tried
+/// without the solve, the meet before the fit and the fit). Format: n as u64, then x₀'s and
+/// the fitted x's n values, f64 little-endian; written to `<file>.tmp` and renamed, so a
+/// file there is whole. A failed write is reported, not fatal.
+fn save_fit(x0: &[f64], x: &[f64]) {
+    let Some(path) = std::env::var_os("APATCH_JOINT_FIT_SAVE") else {
+        return;
+    };
+    let path = std::path::PathBuf::from(path);
+    let mut bytes = Vec::with_capacity(8 + 16 * x.len());
+    bytes.extend_from_slice(&(x.len() as u64).to_le_bytes());
+    for v in x0.iter().chain(x) {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    let tmp = path.with_extension("tmp");
+    let written = std::fs::write(&tmp, &bytes).and_then(|()| std::fs::rename(&tmp, &path));
+    if let Err(e) = written {
+        eprintln!(
+            "quintic-c2: could not save the sign fit to {}: {e}",
+            path.display()
+        );
+    }
 }
 
 /// Theorem 2.1's signs on a group's own weights, for [`sign_rounds`]: each weight of `signed`
@@ -1046,58 +1073,6 @@ const MEET_GROWTH: f64 = 10.0;
 /// (more near rows than [`MEET_BASIS`]), the plain fit ends lower (`supernodal`'s tests).
 pub(super) const MEET_OWN_WEIGHTS: [f64; 1] = [10.0];
 
-/// The rows `rows` of Â projected onto the kept rows' null space (Π a, |Π a| the row's
-/// distance from the kept span), as dense vectors of length `n`. Twice: the first
-/// projection's Â p is rounded to ~1e-17 of the row, which is 1e-9 of a projection 1e-8
-/// long; the second removes what that left in the kept span.
-pub(super) fn projected_rows<F: NormalSolve>(
-    arows: &[Vec<(u32, f64)>],
-    f: &F,
-    rows: &[usize],
-    n: usize,
-) -> Vec<Vec<f64>> {
-    let mut ps: Vec<Vec<f64>> = rows
-        .iter()
-        .map(|&i| {
-            let mut p = vec![0.0; n];
-            for &(j, a) in &arows[i] {
-                p[j as usize] = a;
-            }
-            p
-        })
-        .collect();
-    f.project(arows, &mut ps);
-    f.project(arows, &mut ps);
-    ps
-}
-
-/// p's part orthogonal to the orthonormal vectors of `q` and `more` (Gram–Schmidt, twice),
-/// normalised, with p's length before: `None` where p is shorter than [`MEET_MIN_DISTANCE`]
-/// (a row that near the kept span sees no move) or lies within 1e-3 of their span (its
-/// direction would be mostly rounding).
-pub(super) fn new_direction(
-    mut p: Vec<f64>,
-    q: &[Vec<f64>],
-    more: &[Vec<f64>],
-) -> Option<(Vec<f64>, f64)> {
-    let norm0 = dot(&p, &p).sqrt();
-    if norm0 < MEET_MIN_DISTANCE {
-        return None;
-    }
-    for _ in 0..2 {
-        for qk in q.iter().chain(more) {
-            let h = dot(qk, &p);
-            p.iter_mut().zip(qk).for_each(|(v, w)| *v -= h * w);
-        }
-    }
-    let norm = dot(&p, &p).sqrt();
-    if norm < 1e-3 * norm0 {
-        return None;
-    }
-    p.iter_mut().for_each(|v| *v /= norm);
-    Some((p, norm0))
-}
-
 /// Meets the rows a factor dropped but x misses: rows off the kept rows' span by δ (pivot δ²
 /// below the drop threshold) are missed by δ times x's distance from the exact solution along
 /// them. Each round takes the worst missed rows (at most [`MEET_ROWS`]) and projects them onto
@@ -1144,14 +1119,39 @@ pub(super) fn meet_dropped<F: NormalSolve>(
         });
         let all_missed = missed.len();
         missed.truncate(MEET_ROWS.min(MEET_BASIS - q.len()));
-        let ps = projected_rows(arows, f, &missed, n);
+        let mut ps: Vec<Vec<f64>> = missed
+            .iter()
+            .map(|&i| {
+                let mut p = vec![0.0; n];
+                for &(j, a) in &arows[i] {
+                    p[j as usize] = a;
+                }
+                p
+            })
+            .collect();
+        // Twice: the first projection's Â p is rounded to ~1e-17 of the row, which is 1e-9 of
+        // a projection 1e-8 long; the second removes what that left in the kept span.
+        f.project(arows, &mut ps);
+        f.project(arows, &mut ps);
         // Extend the orthonormal basis Q (Gram–Schmidt against all of it, twice).
         let mut added = 0;
         let mut nearest = f64::INFINITY;
-        for (&i, p) in missed.iter().zip(ps) {
-            let Some((p, norm0)) = new_direction(p, &q, &[]) else {
+        for (&i, mut p) in missed.iter().zip(ps) {
+            let norm0 = dot(&p, &p).sqrt();
+            if norm0 < MEET_MIN_DISTANCE {
                 continue;
-            };
+            }
+            for _ in 0..2 {
+                for qk in &q {
+                    let h = dot(qk, &p);
+                    p.iter_mut().zip(qk).for_each(|(v, w)| *v -= h * w);
+                }
+            }
+            let norm = dot(&p, &p).sqrt();
+            if norm < 1e-3 * norm0 {
+                continue;
+            }
+            p.iter_mut().for_each(|v| *v /= norm);
             seen.push(
                 arows
                     .par_iter()
@@ -1293,7 +1293,7 @@ struct Move {
     fitted: f64,
 }
 
-pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
+fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 

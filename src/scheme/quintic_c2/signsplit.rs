@@ -22,7 +22,7 @@
 //! rows Q was made for are met by x₀ and see a move only through its Q part (a move in the
 //! kept rows' null space meets a row a as Π a · move, and Π a lies in Q's span).
 
-use super::cholesky::{dot, new_direction, projected_rows, NormalSolve, SignBox, UnitRows};
+use super::cholesky::{NormalSolve, SignBox, UnitRows};
 
 /// ε of the stay term, in units of the box's margin: fixing a weight that is off by one unit
 /// gains about 1 in the hinge and moving it by that costs ε/2, so a sign is worth moving its
@@ -45,208 +45,19 @@ const RHO: f64 = 1.0;
 const BALANCE: f64 = 10.0;
 
 /// `d ← (I − Q Qᵀ) Π d`: d's projection onto the kept rows' null space, less its part in
-/// span Q (Q = `q` and `sealed`, orthonormal and in that null space; two slices, so that
-/// neither is copied: each vector is the group's length).
-fn project_move<F: NormalSolve>(
-    unit: &UnitRows,
-    f: &F,
-    q: &[Vec<f64>],
-    sealed: &[Vec<f64>],
-    d: &mut Vec<f64>,
-) {
+/// span Q (Q orthonormal and in that null space).
+fn project_move<F: NormalSolve>(unit: &UnitRows, f: &F, q: &[Vec<f64>], d: &mut Vec<f64>) {
     f.project(&unit.rows, std::slice::from_mut(d));
-    for qk in q.iter().chain(sealed) {
+    for qk in q {
         let h: f64 = qk.iter().zip(d.iter()).map(|(a, b)| a * b).sum();
         d.iter_mut().zip(qk).for_each(|(v, w)| *v -= h * w);
-    }
-}
-
-/// Rows a round of [`seal`] takes: the worst the move misses.
-const SEAL_ROWS: usize = 32;
-
-/// Most directions [`seal`] takes out of a fit's moves, over all its passes: each is a dense
-/// vector of the group's length (14.6 MB on fandisk's joint group, whose factors already hold
-/// ~17 GB), so 128 of them add ~1.9 GB.
-const SEAL_BASIS: usize = 128;
-
-/// Passes of seal and refit: after a seal the fit resumes for [`REFIT`] of its rounds with
-/// the sealed directions out of every move, so that the signs the seal cost are sought
-/// again elsewhere; the last pass only seals.
-const SEAL_PASSES: usize = 3;
-
-/// The share of `SignBox::fit`'s rounds a refit runs.
-const REFIT: f64 = 0.25;
-
-/// Makes the move `d` (from x₀, in the kept rows' null space and orthogonal to `q`) blind to
-/// the dropped rows it misses by more than `goal` (or x₀'s own residual, if larger), adding
-/// the directions taken out to `sealed`. A dropped row a sees a move in the null space only
-/// through its projection Π a (|Π a| = its distance δ from the kept span), so the move misses
-/// it by Π a · d: taking Π a's direction out of d meets it again as x₀ did, with a change no
-/// longer than d's part along it. Meeting the row's miss by a move along Π a instead
-/// ([`super::cholesky::meet_dropped`]) needs the miss over δ: on fandisk's boundary-weighted
-/// fit (session 55) its second round asked a move of 2.1 (10× x's largest value) and the fit
-/// was discarded. Directions are orthogonalised against `q` and `sealed`; rows are taken
-/// worst first, [`SEAL_ROWS`] a round, until the goal is met or `sealed` holds `limit`.
-/// Returns the residual of x₀ + d.
-#[allow(clippy::too_many_arguments)]
-fn seal<F: NormalSolve>(
-    unit: &UnitRows,
-    f: &F,
-    q: &[Vec<f64>],
-    sealed: &mut Vec<Vec<f64>>,
-    x0: &[f64],
-    d: &mut [f64],
-    goal: f64,
-    limit: usize,
-) -> f64 {
-    let (m, n) = (unit.rows.len(), x0.len());
-    let mut r0 = vec![0.0; m];
-    let goal = goal.max(unit.residual(x0, &mut r0));
-    let mut r = vec![0.0; m];
-    let at = |d: &[f64]| -> Vec<f64> { x0.iter().zip(d).map(|(a, b)| a + b).collect() };
-    let mut res = unit.residual(&at(d), &mut r);
-    let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
-    let mut used = vec![false; m];
-    let mut round = 0;
-    while res > goal && sealed.len() < limit {
-        let t = std::time::Instant::now();
-        // Rows missed beyond the goal where the move, not x₀, misses them.
-        let miss = |i: usize| r[i].abs() * unit.scale[i];
-        let mut missed: Vec<usize> = (0..m)
-            .filter(|&i| {
-                !used[i] && miss(i) > goal && (r[i] - r0[i]).abs() * unit.scale[i] > 0.1 * goal
-            })
-            .collect();
-        missed.sort_by(|&a, &b| miss(b).total_cmp(&miss(a)).then(a.cmp(&b)));
-        let all_missed = missed.len();
-        missed.truncate(SEAL_ROWS.min(limit - sealed.len()));
-        if missed.is_empty() {
-            break;
-        }
-        let ps = projected_rows(&unit.rows, f, &missed, n);
-        let mut added = 0;
-        for (&i, p) in missed.iter().zip(ps) {
-            used[i] = true;
-            let Some((p, _)) = new_direction(p, q, sealed) else {
-                continue;
-            };
-            let h = dot(&p, d);
-            d.iter_mut().zip(&p).for_each(|(v, w)| *v -= h * w);
-            sealed.push(p);
-            added += 1;
-        }
-        let before = res;
-        res = unit.residual(&at(d), &mut r);
-        if trace {
-            eprintln!(
-                "quintic-c2 sign fit seal, round {round}: {all_missed} rows missed, {added} directions taken out ({} in all), residual {before:.2e} -> {res:.2e} (goal {goal:.2e}), {:.1} s",
-                sealed.len(),
-                t.elapsed().as_secs_f64()
-            );
-        }
-        round += 1;
-    }
-    res
-}
-
-/// The split program's state between rounds, kept across a seal so that a refit resumes.
-struct Admm {
-    /// Each column's sign (0: unsigned) and the cost of its miss.
-    sign: Vec<f64>,
-    cost: Vec<f64>,
-    /// The z iterate, the scaled dual and the penalty.
-    z: Vec<f64>,
-    u: Vec<f64>,
-    rho: f64,
-}
-
-impl Admm {
-    /// `rounds` rounds from x₀ with moves orthogonal to `q`; the round with the fewest
-    /// weights off their sign (at their cost) and that count.
-    #[allow(clippy::too_many_arguments)]
-    fn run<F: NormalSolve>(
-        &mut self,
-        unit: &UnitRows,
-        f: &F,
-        q: &[Vec<f64>],
-        sealed: &[Vec<f64>],
-        x0: &[f64],
-        sb: &SignBox,
-        rounds: usize,
-        tiny: f64,
-        counts: (usize, f64),
-    ) -> Option<(f64, Vec<f64>)> {
-        let (margin, n) = (sb.margin, x0.len());
-        let (off_before, off_cost_before) = counts;
-        let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
-        let mut best: Option<(f64, Vec<f64>)> = None;
-        for round in 0..rounds {
-            let t = std::time::Instant::now();
-            let (z, u, rho) = (&mut self.z, &mut self.u, self.rho);
-            // x step: x₀ + P (z − u − x₀).
-            let mut d: Vec<f64> = (0..n).map(|j| z[j] - u[j] - x0[j]).collect();
-            project_move(unit, f, q, sealed, &mut d);
-            let xk: Vec<f64> = (0..n).map(|j| x0[j] + d[j]).collect();
-            // z step, per weight: argmin ε/2 (z − x₀)² + ρ/2 (z − v)² + hinge, v = x + u.
-            let kappa = STAY + rho;
-            let (mut primal, mut dual) = (0.0, 0.0);
-            for j in 0..n {
-                let v = xk[j] + u[j];
-                let a = (STAY * x0[j] + rho * v) / kappa;
-                let s = self.sign[j];
-                let zj = if s == 0.0 {
-                    a
-                } else {
-                    // In the weight's own sign and the unit: the hinge's slope −cost below the
-                    // margin.
-                    let w = s * a / margin;
-                    let step = self.cost[j] / kappa;
-                    let w = if w >= FIT_MARGIN {
-                        w
-                    } else if w + step < FIT_MARGIN {
-                        w + step
-                    } else {
-                        FIT_MARGIN
-                    };
-                    s * w * margin
-                };
-                primal += (xk[j] - zj).powi(2);
-                dual += (zj - z[j]).powi(2);
-                u[j] += xk[j] - zj;
-                z[j] = zj;
-            }
-            let (primal, dual) = (primal.sqrt(), rho * dual.sqrt());
-            let weighed = sb.off_cost(&xk, tiny);
-            if trace {
-                let off = sb.off(&xk, tiny);
-                eprintln!(
-                    "quintic-c2 sign fit, round {round}: {off} off their sign (was {off_before}; at their cost {weighed} was {off_cost_before}), primal {primal:.2e}, dual {dual:.2e}, rho {rho}, {:.1} s",
-                    t.elapsed().as_secs_f64()
-                );
-            }
-            if best.as_ref().is_none_or(|b| weighed < b.0) {
-                best = Some((weighed, xk));
-            }
-            // Residual balancing; u is the scaled dual λ/ρ, so it scales by 1/the factor.
-            if primal > BALANCE * dual {
-                self.rho *= 2.0;
-                u.iter_mut().for_each(|v| *v *= 0.5);
-            } else if dual > BALANCE * primal {
-                self.rho *= 0.5;
-                u.iter_mut().for_each(|v| *v *= 2.0);
-            }
-        }
-        best
     }
 }
 
 /// Runs `sb.fit` rounds of the split sign program from x (the solved group), with moves
 /// orthogonal to `q`; x is moved to the round with the fewest weights off their sign (each
 /// counted at its [`SignBox::cost`]) if that has fewer than x and misses the rows by at most
-/// `bound`: then its max |A x − c| is returned, else `None` (x left as it was). Where the
-/// best round's move misses the rows by more than `goal` (dropped rows see it), it is made
-/// blind to the rows it misses ([`seal`]) and the fit resumes with those directions out of
-/// its moves ([`SEAL_PASSES`]).
+/// `bound`: then its max |A x − c| is returned, else `None` (x left as it was).
 pub(super) fn fit<F: NormalSolve>(
     unit: &UnitRows,
     f: &F,
@@ -254,7 +65,6 @@ pub(super) fn fit<F: NormalSolve>(
     q: &[Vec<f64>],
     sb: &SignBox,
     bound: f64,
-    goal: f64,
 ) -> Option<f64> {
     let margin = sb.margin;
     if sb.fit == 0 || sb.signed.is_empty() || margin.is_nan() || margin <= 0.0 {
@@ -268,55 +78,82 @@ pub(super) fn fit<F: NormalSolve>(
     // Weights this small are zero up to the solves' rounding (as `sign_rounds`).
     let tiny = 1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let off_before = sb.off(x, tiny);
-    let off_cost_before = sb.off_cost(x, tiny);
-    let mut admm = Admm {
-        sign: vec![0.0; n],
-        cost: vec![1.0; n],
-        z: x0.clone(),
-        u: vec![0.0; n],
-        rho: RHO,
-    };
+    let mut sign = vec![0.0; n];
+    let mut cost = vec![1.0; n];
     for (i, &(j, s)) in sb.signed.iter().enumerate() {
-        admm.sign[j] = s;
-        admm.cost[j] = sb.cost.get(i).copied().unwrap_or(1.0);
+        sign[j] = s;
+        cost[j] = sb.cost.get(i).copied().unwrap_or(1.0);
     }
+    let off_cost_before = sb.off_cost(x, tiny);
     let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
-    let counts = (off_before, off_cost_before);
     // In units of the box's margin: stay ε/2 |z − x₀|² + Σ max(0, FIT_MARGIN − s z) over the
     // signed weights.
-    let (_, mut xb) = admm.run(unit, f, q, &[], &x0, sb, sb.fit, tiny, counts)?;
-    let mut sealed: Vec<Vec<f64>> = Vec::new();
-    let mut d: Vec<f64>;
-    let mut pass = 0;
-    loop {
-        // The best round's move projected twice more: one projection of fandisk's moves left
-        // the rows missed by 1.3e-7 (nearly dependent kept rows amplify its rounding), the
-        // next removes most of what the first left.
-        d = (0..n).map(|j| xb[j] - x0[j]).collect();
-        project_move(unit, f, q, &sealed, &mut d);
-        project_move(unit, f, q, &sealed, &mut d);
+    let mut rho = RHO;
+    let mut z = x0.clone();
+    let mut u = vec![0.0; n];
+    let mut best: Option<(f64, Vec<f64>)> = None;
+    for round in 0..sb.fit {
+        let t = std::time::Instant::now();
+        // x step: x₀ + P (z − u − x₀).
+        let mut d: Vec<f64> = (0..n).map(|j| z[j] - u[j] - x0[j]).collect();
+        project_move(unit, f, q, &mut d);
+        let xk: Vec<f64> = (0..n).map(|j| x0[j] + d[j]).collect();
+        // z step, per weight: argmin ε/2 (z − x₀)² + ρ/2 (z − v)² + hinge, v = x + u.
+        let kappa = STAY + rho;
+        let (mut primal, mut dual) = (0.0, 0.0);
+        for j in 0..n {
+            let v = xk[j] + u[j];
+            let a = (STAY * x0[j] + rho * v) / kappa;
+            let s = sign[j];
+            let zj = if s == 0.0 {
+                a
+            } else {
+                // In the weight's own sign and the unit: the hinge's slope −cost below the
+                // margin.
+                let w = s * a / margin;
+                let step = cost[j] / kappa;
+                let w = if w >= FIT_MARGIN {
+                    w
+                } else if w + step < FIT_MARGIN {
+                    w + step
+                } else {
+                    FIT_MARGIN
+                };
+                s * w * margin
+            };
+            primal += (xk[j] - zj).powi(2);
+            dual += (zj - z[j]).powi(2);
+            u[j] += xk[j] - zj;
+            z[j] = zj;
+        }
+        let (primal, dual) = (primal.sqrt(), rho * dual.sqrt());
+        let weighed = sb.off_cost(&xk, tiny);
         if trace {
-            let y: Vec<f64> = (0..n).map(|j| x0[j] + d[j]).collect();
-            let res = unit.residual(&y, &mut r);
-            let off = sb.off(&y, tiny);
+            let off = sb.off(&xk, tiny);
             eprintln!(
-                "quintic-c2 sign fit, pass {pass}: before the seal {off} off their sign, residual {res:.2e}"
+                "quintic-c2 sign fit, round {round}: {off} off their sign (was {off_before}; at their cost {weighed} was {off_cost_before}), primal {primal:.2e}, dual {dual:.2e}, rho {rho}, {:.1} s",
+                t.elapsed().as_secs_f64()
             );
         }
-        let had = sealed.len();
-        // Each pass may fill its share of the basis, the last all of it.
-        let limit = SEAL_BASIS * (pass + 1) / SEAL_PASSES;
-        seal(unit, f, q, &mut sealed, &x0, &mut d, goal, limit);
-        pass += 1;
-        if sealed.len() == had || pass == SEAL_PASSES || sealed.len() >= SEAL_BASIS {
-            break;
+        if best.as_ref().is_none_or(|b| weighed < b.0) {
+            best = Some((weighed, xk));
         }
-        let rounds = ((sb.fit as f64 * REFIT).ceil() as usize).max(1);
-        match admm.run(unit, f, q, &sealed, &x0, sb, rounds, tiny, counts) {
-            Some((_, x)) => xb = x,
-            None => break,
+        // Residual balancing; u is the scaled dual λ/ρ, so it scales by 1/the factor.
+        if primal > BALANCE * dual {
+            rho *= 2.0;
+            u.iter_mut().for_each(|v| *v *= 0.5);
+        } else if dual > BALANCE * primal {
+            rho *= 0.5;
+            u.iter_mut().for_each(|v| *v *= 2.0);
         }
     }
+    let (_, xb) = best?;
+    // The best round's move projected twice more: one projection of fandisk's moves left the
+    // rows missed by 1.3e-7 (nearly dependent kept rows amplify its rounding), the next
+    // removes most of what the first left.
+    let mut d: Vec<f64> = (0..n).map(|j| xb[j] - x0[j]).collect();
+    project_move(unit, f, q, &mut d);
+    project_move(unit, f, q, &mut d);
     let y: Vec<f64> = (0..n).map(|j| x0[j] + d[j]).collect();
     let res = unit.residual(&y, &mut r);
     let off = sb.off(&y, tiny);
