@@ -838,7 +838,25 @@ pub(super) fn refine_near<F: NormalSolve>(
         }
     }
     let mut basis = Vec::new();
-    if meet && best.0 > tol {
+    // A saved sign fit of this group (exploration, `APATCH_JOINT_FIT_LOAD`): its start stands
+    // for the meet before the fit, its fitted values for the fit.
+    let loaded = signs
+        .filter(|sb| sb.fit > 0 && meet)
+        .and_then(|_| std::env::var_os("APATCH_JOINT_FIT_LOAD"))
+        .and_then(
+            |path| match read_fit(std::path::Path::new(&path), best.1.len()) {
+                Ok(v) => Some(v),
+                Err(e) => {
+                    eprintln!("quintic-c2: saved sign fit not used: {e}");
+                    None
+                }
+            },
+        );
+    if let Some((x0, _)) = &loaded {
+        let mut r = vec![0.0; m];
+        best = (unit.residual(x0, &mut r), x0.clone(), best.2);
+    }
+    if meet && best.0 > tol && loaded.is_none() {
         // The rows still missed are dropped ones, nearly dependent on the kept rows: met by a
         // move in the kept rows' null space ([`meet_dropped`]), with the factor that gave `best`.
         if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
@@ -860,11 +878,28 @@ pub(super) fn refine_near<F: NormalSolve>(
             let bound = if best.0 <= tol { tol } else { 10.0 * best.0 };
             let mut x = best.1.clone();
             let loose = if meet { f64::INFINITY } else { bound };
-            if let Some(mut got) = super::signsplit::fit(unit, f, &mut x, &basis, sb, loose) {
-                save_fit(&best.1, &x);
+            let fitted = match loaded {
+                Some((_, xf)) => {
+                    x = xf;
+                    let mut r = vec![0.0; m];
+                    Some(unit.residual(&x, &mut r))
+                }
+                None => super::signsplit::fit(unit, f, &mut x, &basis, sb, loose),
+            };
+            if let Some(mut got) = fitted {
+                if let Some(path) = std::env::var_os("APATCH_JOINT_FIT_SAVE") {
+                    let path = std::path::PathBuf::from(path);
+                    if let Err(e) = write_fit(&path, &best.1, &x) {
+                        eprintln!(
+                            "quintic-c2: could not save the sign fit to {}: {e}",
+                            path.display()
+                        );
+                    }
+                }
                 if meet && got > tol {
                     drop(basis);
-                    got = meet_dropped(unit, f, &mut x, tol, &MEET_OWN_WEIGHTS).0;
+                    let weights = meet_weights_override().unwrap_or(MEET_OWN_WEIGHTS.to_vec());
+                    got = meet_dropped(unit, f, &mut x, tol, &weights).0;
                 }
                 if got <= bound {
                     best = (got, x, best.2);
@@ -875,31 +910,72 @@ pub(super) fn refine_near<F: NormalSolve>(
     Some(best)
 }
 
-/// Writes the group's values before and after the split sign program to the file
-/// `APATCH_JOINT_FIT_SAVE` names, if set (exploration only: on fandisk the fit ends ~70 min
-/// into the run, and what follows it, the dropped rows' meet, is what session 56 found
-/// wanting; with the two vectors and the group's factor a variant of that meet can be tried
-/// without the solve, the meet before the fit and the fit). Format: n as u64, then x₀'s and
-/// the fitted x's n values, f64 little-endian; written to `<file>.tmp` and renamed, so a
-/// file there is whole. A failed write is reported, not fatal.
-fn save_fit(x0: &[f64], x: &[f64]) {
-    let Some(path) = std::env::var_os("APATCH_JOINT_FIT_SAVE") else {
-        return;
-    };
-    let path = std::path::PathBuf::from(path);
+/// The weights of Q's own rows for the meet after the split sign program, from
+/// `APATCH_MEET_WEIGHTS` (exploration: comma-separated, each tried every round, the best move
+/// taken; e.g. `1,10`), or `None` if unset or unreadable.
+fn meet_weights_override() -> Option<Vec<f64>> {
+    let v = std::env::var("APATCH_MEET_WEIGHTS").ok()?;
+    let w: Vec<f64> = v
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .ok()?;
+    (!w.is_empty() && w.iter().all(|x| x.is_finite() && *x > 0.0)).then_some(w)
+}
+
+/// Writes a group's values before and after the split sign program to `path`
+/// (exploration: `APATCH_JOINT_FIT_SAVE` names the file, `APATCH_JOINT_FIT_LOAD` reads it
+/// back). On fandisk the fit ends ~70 min into the run, and what follows it, the dropped
+/// rows' meet, is what a weighted fit needs changed (session 56); from the saved values a
+/// run needs only the group's factor (~25 min) to get there. Format: n as u64, then x₀'s and
+/// the fitted x's n values, f64 little-endian; written to `<path>.tmp` and renamed, so a file
+/// at `path` is whole.
+pub(super) fn write_fit(path: &std::path::Path, x0: &[f64], x: &[f64]) -> std::io::Result<()> {
+    debug_assert_eq!(x0.len(), x.len());
     let mut bytes = Vec::with_capacity(8 + 16 * x.len());
     bytes.extend_from_slice(&(x.len() as u64).to_le_bytes());
     for v in x0.iter().chain(x) {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
     let tmp = path.with_extension("tmp");
-    let written = std::fs::write(&tmp, &bytes).and_then(|()| std::fs::rename(&tmp, &path));
-    if let Err(e) = written {
-        eprintln!(
-            "quintic-c2: could not save the sign fit to {}: {e}",
+    std::fs::write(&tmp, &bytes)?;
+    std::fs::rename(&tmp, path)
+}
+
+/// Reads what [`write_fit`] wrote, for a group of `n` unknowns: (x₀, fitted x), or what is
+/// wrong with the file (unreadable, another group's length, cut short, not finite).
+pub(super) fn read_fit(path: &std::path::Path, n: usize) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let head: [u8; 8] = bytes
+        .get(..8)
+        .and_then(|b| b.try_into().ok())
+        .ok_or_else(|| format!("{}: shorter than its header", path.display()))?;
+    let len = u64::from_le_bytes(head);
+    if len != n as u64 {
+        return Err(format!(
+            "{}: a group of {len} unknowns, this one has {n}",
             path.display()
-        );
+        ));
     }
+    if bytes.len() != 8 + 16 * n {
+        return Err(format!(
+            "{}: {} bytes, {} expected for {n} unknowns",
+            path.display(),
+            bytes.len(),
+            8 + 16 * n
+        ));
+    }
+    let values: Vec<f64> = bytes[8..]
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+        .collect();
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return Err(format!("{}: value {i} is not finite", path.display()));
+    }
+    let fitted = values[n..].to_vec();
+    let mut start = values;
+    start.truncate(n);
+    Ok((start, fitted))
 }
 
 /// Theorem 2.1's signs on a group's own weights, for [`sign_rounds`]: each weight of `signed`
@@ -1095,6 +1171,13 @@ pub(super) fn meet_dropped<F: NormalSolve>(
 ) -> (f64, Vec<Vec<f64>>) {
     let arows = &unit.rows;
     let (m, n) = (arows.len(), x.len());
+    // Exploration (`APATCH_MEET_GROWTH`): a larger move allowed, for the meet after a
+    // weighted sign fit (session 55's refused 2.1).
+    let growth = std::env::var("APATCH_MEET_GROWTH")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|g| g.is_finite() && *g > 0.0)
+        .unwrap_or(MEET_GROWTH);
     let mut r = vec![0.0; m];
     let mut res = unit.residual(x, &mut r);
     let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
@@ -1213,7 +1296,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
                 .iter()
                 .zip(x.iter())
                 .fold(0.0_f64, |a, (p, q)| a.max((p - q).abs()));
-            if moved.is_nan() || moved > MEET_GROWTH * reach.max(f64::MIN_POSITIVE) {
+            if moved.is_nan() || moved > growth * reach.max(f64::MIN_POSITIVE) {
                 if trace {
                     eprintln!(
                         "quintic-c2 meet dropped, round {round}: weight {weight}: move {moved:.2e} refused"
@@ -1824,6 +1907,40 @@ fn conjugate_gradients_many(
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+
+    /// A saved sign fit reads back to the bit (values that are not short decimals, −0.0 and
+    /// subnormals among them), and a file of another group's length, one cut short or one
+    /// with a NaN is refused with the file named, not read as a fit.
+    #[test]
+    fn a_saved_sign_fit_reads_back_exactly_and_bad_files_are_refused() {
+        let dir = std::env::temp_dir().join(format!("apatch_fit_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let path = dir.join("fit.bin");
+        let x0: Vec<f64> = (0..7).map(|i| (f64::from(i) * 0.7).sin() / 3.0).collect();
+        let mut x = x0.clone();
+        x[2] = -0.0;
+        x[5] = f64::MIN_POSITIVE / 8.0;
+        write_fit(&path, &x0, &x).expect("written");
+        assert!(
+            !path.with_extension("tmp").exists(),
+            "the temporary was renamed"
+        );
+        let (a, b) = read_fit(&path, 7).expect("read back");
+        let bits = |v: &[f64]| v.iter().map(|t| t.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a), bits(&x0));
+        assert_eq!(bits(&b), bits(&x));
+        let e = read_fit(&path, 6).expect_err("another group");
+        assert!(e.contains("fit.bin") && e.contains("7 unknowns"), "{e}");
+        let bytes = std::fs::read(&path).expect("bytes");
+        std::fs::write(&path, &bytes[..bytes.len() - 8]).expect("cut");
+        let e = read_fit(&path, 7).expect_err("cut short");
+        assert!(e.contains("bytes"), "{e}");
+        x[3] = f64::NAN;
+        write_fit(&path, &x0, &x).expect("written");
+        let e = read_fit(&path, 7).expect_err("a NaN");
+        assert!(e.contains("value 10 is not finite"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
 
     /// A seeded uniform number in [−1, 1) (the random systems of these and `pinned`'s tests).
     pub(in crate::scheme::quintic_c2) fn lcg(seed: &mut u64) -> f64 {
