@@ -853,7 +853,6 @@ pub(super) fn refine_near<F: NormalSolve>(
             },
         );
     if let Some((x0, _)) = &loaded {
-        let mut r = vec![0.0; m];
         best = (unit.residual(x0, &mut r), x0.clone(), best.2);
     }
     if meet && best.0 > tol && loaded.is_none() {
@@ -878,22 +877,20 @@ pub(super) fn refine_near<F: NormalSolve>(
             let bound = if best.0 <= tol { tol } else { 10.0 * best.0 };
             let mut x = best.1.clone();
             let loose = if meet { f64::INFINITY } else { bound };
+            let was_loaded = loaded.is_some();
             let fitted = match loaded {
                 Some((_, xf)) => {
                     x = xf;
-                    let mut r = vec![0.0; m];
                     Some(unit.residual(&x, &mut r))
                 }
                 None => super::signsplit::fit(unit, f, &mut x, &basis, sb, loose),
             };
             if let Some(mut got) = fitted {
-                if let Some(path) = std::env::var_os("APATCH_JOINT_FIT_SAVE") {
-                    let path = std::path::PathBuf::from(path);
-                    if let Err(e) = write_fit(&path, &best.1, &x) {
-                        eprintln!(
-                            "quintic-c2: could not save the sign fit to {}: {e}",
-                            path.display()
-                        );
+                // A fit read from a file is not written back.
+                let save = std::env::var_os("APATCH_JOINT_FIT_SAVE").filter(|_| !was_loaded);
+                if let Some(path) = save {
+                    if let Err(e) = write_fit(std::path::Path::new(&path), &best.1, &x) {
+                        eprintln!("quintic-c2: could not save the sign fit: {e:#}");
                     }
                 }
                 if meet && got > tol {
@@ -928,18 +925,17 @@ fn meet_weights_override() -> Option<Vec<f64>> {
 /// back). On fandisk the fit ends ~70 min into the run, and what follows it, the dropped
 /// rows' meet, is what a weighted fit needs changed (session 56); from the saved values a
 /// run needs only the group's factor (~25 min) to get there. Format: n as u64, then x₀'s and
-/// the fitted x's n values, f64 little-endian; written to `<path>.tmp` and renamed, so a file
-/// at `path` is whole.
-pub(super) fn write_fit(path: &std::path::Path, x0: &[f64], x: &[f64]) -> std::io::Result<()> {
+/// the fitted x's n values, f64 little-endian; written through
+/// [`crate::export::write_atomically`], so a file at `path` is whole.
+pub(super) fn write_fit(path: &std::path::Path, x0: &[f64], x: &[f64]) -> anyhow::Result<()> {
     debug_assert_eq!(x0.len(), x.len());
-    let mut bytes = Vec::with_capacity(8 + 16 * x.len());
-    bytes.extend_from_slice(&(x.len() as u64).to_le_bytes());
-    for v in x0.iter().chain(x) {
-        bytes.extend_from_slice(&v.to_le_bytes());
-    }
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, &bytes)?;
-    std::fs::rename(&tmp, path)
+    crate::export::write_atomically(path, |out| {
+        out.write_all(&(x.len() as u64).to_le_bytes())?;
+        for v in x0.iter().chain(x) {
+            out.write_all(&v.to_le_bytes())?;
+        }
+        Ok(())
+    })
 }
 
 /// Reads what [`write_fit`] wrote, for a group of `n` unknowns: (x₀, fitted x), or what is
@@ -1922,7 +1918,7 @@ pub(super) mod tests {
         x[5] = f64::MIN_POSITIVE / 8.0;
         write_fit(&path, &x0, &x).expect("written");
         assert!(
-            !path.with_extension("tmp").exists(),
+            !crate::trace::output::temp_path(&path).exists(),
             "the temporary was renamed"
         );
         let (a, b) = read_fit(&path, 7).expect("read back");
