@@ -880,8 +880,12 @@ pub(super) fn refine_near<F: NormalSolve>(
             let was_loaded = loaded.is_some();
             let fitted = match loaded {
                 Some((_, xf)) => {
+                    // Settled as the fit settles its own move (a fit saved before that was
+                    // projected twice).
                     x = xf;
-                    Some(unit.residual(&x, &mut r))
+                    Some(super::signsplit::settle(
+                        unit, f, &basis, &best.1, &mut x, &mut r,
+                    ))
                 }
                 None => super::signsplit::fit(unit, f, &mut x, &basis, sb, loose),
             };

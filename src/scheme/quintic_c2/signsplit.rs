@@ -54,6 +54,42 @@ fn project_move<F: NormalSolve>(unit: &UnitRows, f: &F, q: &[Vec<f64>], d: &mut 
     }
 }
 
+/// Most projections [`settle`] makes of a move: on fandisk's joint group one projection of the
+/// fit's move left the rows missed by 1.3e-7 and each of the next two removed most of what the
+/// one before left (nearly dependent kept rows amplify the projection's rounding).
+const SETTLE: usize = 8;
+
+/// Projects y's move from x₀ onto the kept rows' null space (less its part in span `q`) again
+/// and again while that lowers max |A y − c|, at most [`SETTLE`] times: the fit's last round
+/// is one projection of a long move, whose rounding the rows see. Returns the residual of the
+/// y kept (the lowest; y as it came if no projection lowers it).
+pub(super) fn settle<F: NormalSolve>(
+    unit: &UnitRows,
+    f: &F,
+    q: &[Vec<f64>],
+    x0: &[f64],
+    y: &mut Vec<f64>,
+    r: &mut [f64],
+) -> f64 {
+    let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
+    let mut res = unit.residual(y, r);
+    for round in 0..SETTLE {
+        let mut d: Vec<f64> = y.iter().zip(x0).map(|(a, b)| a - b).collect();
+        project_move(unit, f, q, &mut d);
+        let z: Vec<f64> = x0.iter().zip(&d).map(|(a, b)| a + b).collect();
+        let got = unit.residual(&z, r);
+        if trace {
+            eprintln!("quintic-c2 sign fit, settling the move, projection {round}: residual {res:.2e} -> {got:.2e}");
+        }
+        if got.is_nan() || got >= res {
+            break;
+        }
+        (*y, res) = (z, got);
+    }
+    // r holds the last projection's residuals, which may not be y's.
+    unit.residual(y, r)
+}
+
 /// Runs `sb.fit` rounds of the split sign program from x (the solved group), with moves
 /// orthogonal to `q`; x is moved to the round with the fewest weights off their sign (each
 /// counted at its [`SignBox::cost`]) if that has fewer than x and misses the rows by at most
@@ -147,15 +183,8 @@ pub(super) fn fit<F: NormalSolve>(
             u.iter_mut().for_each(|v| *v *= 2.0);
         }
     }
-    let (_, xb) = best?;
-    // The best round's move projected twice more: one projection of fandisk's moves left the
-    // rows missed by 1.3e-7 (nearly dependent kept rows amplify its rounding), the next
-    // removes most of what the first left.
-    let mut d: Vec<f64> = (0..n).map(|j| xb[j] - x0[j]).collect();
-    project_move(unit, f, q, &mut d);
-    project_move(unit, f, q, &mut d);
-    let y: Vec<f64> = (0..n).map(|j| x0[j] + d[j]).collect();
-    let res = unit.residual(&y, &mut r);
+    let (_, mut y) = best?;
+    let res = settle(unit, f, q, &x0, &mut y, &mut r);
     let off = sb.off(&y, tiny);
     if trace {
         eprintln!(

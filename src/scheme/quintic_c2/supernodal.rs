@@ -910,6 +910,61 @@ mod tests {
         assert!(weighed.0 < plain.0, "{plain:?} -> {weighed:?}");
     }
 
+    /// A long move whose projection onto the rows' null space was rounded (here: 1e-6 of a
+    /// row-space vector added to it) is settled back onto the rows by `signsplit::settle`
+    /// (the sign fit's last step), its null-space part kept; a settled move is left as it is.
+    #[test]
+    fn a_rounded_move_settles_back_onto_the_rows() {
+        let (tol, n, m) = (1e-12, 600, 300);
+        let sys = signed_system(m, n, 9, 3, 0.5);
+        let unit = UnitRows::new(&sys.rows, &sys.c);
+        let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
+        let (f, _) = normal
+            .factor::<fx128>(cholesky::PRECISE_PIVOT)
+            .map(with_dropped)
+            .expect("small");
+        let x0 = solve_near(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES)
+            .expect("small")
+            .x;
+        let mut r = vec![0.0; m];
+        assert!(unit.residual(&x0, &mut r) <= tol);
+        // A null-space move of length ~1 per weight, and 1e-6 of Âᵀ w off the null space.
+        let mut seed = 31_u64;
+        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
+        let mut d: Vec<Vec<f64>> = vec![(0..n).map(|_| lcg(&mut seed)).collect()];
+        cholesky::NormalSolve::project(&f, &unit.rows, &mut d);
+        let d = d.remove(0);
+        let mut y: Vec<f64> = x0.iter().zip(&d).map(|(a, b)| a + b).collect();
+        for row in &unit.rows {
+            let w = 1e-6 * lcg(&mut seed);
+            row.iter().for_each(|&(j, a)| y[j as usize] += w * a);
+        }
+        let before = unit.residual(&y, &mut r);
+        assert!(before > 1e-8, "the error is seen: {before:e}");
+        let after = super::super::signsplit::settle(&unit, &f, &[], &x0, &mut y, &mut r);
+        assert!(after <= tol, "{before:e} -> {after:e}");
+        assert_eq!(
+            after,
+            unit.residual(&y, &mut r),
+            "the residual returned is y's"
+        );
+        // The null-space part is what it was: what settling removed lies in the row space.
+        let kept = y
+            .iter()
+            .zip(&x0)
+            .zip(&d)
+            .fold(0.0_f64, |a, ((p, q), e)| a.max((p - q - e).abs()));
+        eprintln!("settled {before:e} -> {after:e}, null-space part moved by {kept:e}");
+        // Π removes the row-space error exactly and leaves d; what is left is the projections'
+        // rounding, far below the 1e-6 error removed.
+        assert!(kept < 1e-9, "{kept:e}");
+        // Settled again: no projection lowers it, so y is left alone.
+        let y1 = y.clone();
+        let again = super::super::signsplit::settle(&unit, &f, &[], &x0, &mut y, &mut r);
+        assert!(again <= after);
+        assert!(again < after || y == y1);
+    }
+
     /// A dropped row whose data contradict the kept rows (1e-3 off, at distance 1e-11 from
     /// their span: met only by a move of 1e8) is left missed rather than met by that move.
     #[test]
