@@ -875,6 +875,13 @@ pub(super) fn refine_near<F: NormalSolve>(
         // more (the check then measures what that does to the jumps).
         if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
             let bound = if best.0 <= tol { tol } else { 10.0 * best.0 };
+            // Exploration (`APATCH_JOINT_FIT_BOUND`): a fit kept up to another miss, so that
+            // `check` can say what a miss beyond the bound does to the jumps.
+            let bound = std::env::var("APATCH_JOINT_FIT_BOUND")
+                .ok()
+                .and_then(|v| v.parse::<f64>().ok())
+                .filter(|b| b.is_finite() && *b > 0.0)
+                .unwrap_or(bound);
             let mut x = best.1.clone();
             let loose = if meet { f64::INFINITY } else { bound };
             let was_loaded = loaded.is_some();
