@@ -877,11 +877,7 @@ pub(super) fn refine_near<F: NormalSolve>(
             let bound = if best.0 <= tol { tol } else { 10.0 * best.0 };
             // Exploration (`APATCH_JOINT_FIT_BOUND`): a fit kept up to another miss, so that
             // `check` can say what a miss beyond the bound does to the jumps.
-            let bound = std::env::var("APATCH_JOINT_FIT_BOUND")
-                .ok()
-                .and_then(|v| v.parse::<f64>().ok())
-                .filter(|b| b.is_finite() && *b > 0.0)
-                .unwrap_or(bound);
+            let bound = positive_env("APATCH_JOINT_FIT_BOUND").unwrap_or(bound);
             let mut x = best.1.clone();
             let loose = if meet { f64::INFINITY } else { bound };
             let was_loaded = loaded.is_some();
@@ -916,6 +912,15 @@ pub(super) fn refine_near<F: NormalSolve>(
         }
     }
     Some(best)
+}
+
+/// The positive finite number the environment variable `name` holds (the exploration
+/// overrides' form), or `None` if it is unset or holds anything else.
+fn positive_env(name: &str) -> Option<f64> {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v > 0.0)
 }
 
 /// The weights of Q's own rows for the meet after the split sign program, from
@@ -1180,11 +1185,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
     let (m, n) = (arows.len(), x.len());
     // Exploration (`APATCH_MEET_GROWTH`): a larger move allowed, for the meet after a
     // weighted sign fit (session 55's refused 2.1).
-    let growth = std::env::var("APATCH_MEET_GROWTH")
-        .ok()
-        .and_then(|v| v.parse::<f64>().ok())
-        .filter(|g| g.is_finite() && *g > 0.0)
-        .unwrap_or(MEET_GROWTH);
+    let growth = positive_env("APATCH_MEET_GROWTH").unwrap_or(MEET_GROWTH);
     let mut r = vec![0.0; m];
     let mut res = unit.residual(x, &mut r);
     let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
