@@ -903,7 +903,23 @@ pub(super) fn refine_near<F: NormalSolve>(
                 if meet && got > tol {
                     drop(basis);
                     let weights = meet_weights_override().unwrap_or(MEET_OWN_WEIGHTS.to_vec());
-                    got = meet_dropped(unit, f, &mut x, tol, &weights).0;
+                    let q;
+                    (got, q) = meet_dropped(unit, f, &mut x, tol, &weights);
+                    // Exploration (`APATCH_FIT_CYCLES=n`): the fit and the meet in turns.
+                    if let Some(cycles) = positive_env("APATCH_FIT_CYCLES") {
+                        got = fit_meet_cycles(
+                            unit,
+                            f,
+                            &mut x,
+                            q,
+                            got,
+                            tol,
+                            &weights,
+                            sb,
+                            cycles as usize,
+                            bound,
+                        );
+                    }
                 }
                 if got <= bound {
                     best = (got, x, best.2);
@@ -912,6 +928,63 @@ pub(super) fn refine_near<F: NormalSolve>(
         }
     }
     Some(best)
+}
+
+/// Rounds of each new fit in [`fit_meet_cycles`] (`APATCH_REFIT_ROUNDS`, default 60): the
+/// cycles start from a fitted x, so fewer rounds than the first fit's are asked.
+const REFIT_ROUNDS: usize = 60;
+
+/// Exploration (`APATCH_FIT_CYCLES=n`, session 58): after the meet that follows the sign fit,
+/// `cycles` turns of a new sign fit from x, its moves orthogonal to the directions `q` the
+/// meet just used, and a meet again. A meet given room (`APATCH_MEET_GROWTH`) reaches the
+/// rows a weighted fit leaves missed, but its long moves along their projections undo the
+/// signs; a fit orthogonal to those projections cannot disturb those rows again (each sees
+/// a move only through its projection, which lies in span q), so it may win the signs back
+/// while the rows stay met, and the meet after it has only the rows the new move reached.
+/// x is left at the turn with the lowest sign cost among those that miss the rows by at most
+/// `bound` (the last turn if none does); returns its max |A x − c|.
+#[allow(clippy::too_many_arguments)]
+fn fit_meet_cycles<F: NormalSolve>(
+    unit: &UnitRows,
+    f: &F,
+    x: &mut Vec<f64>,
+    mut q: Vec<Vec<f64>>,
+    mut got: f64,
+    tol: f64,
+    weights: &[f64],
+    sb: &SignBox,
+    cycles: usize,
+    bound: f64,
+) -> f64 {
+    let rounds = positive_env("APATCH_REFIT_ROUNDS").map_or(REFIT_ROUNDS, |v| v as usize);
+    let refit = SignBox {
+        fit: rounds,
+        ..sb.clone()
+    };
+    let tiny = |x: &[f64]| 1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let mut best: Option<(f64, f64, Vec<f64>)> =
+        (got <= bound).then(|| (sb.off_cost(x, tiny(x)), got, x.clone()));
+    for cycle in 0..cycles {
+        let fitted = super::signsplit::fit(unit, f, x, &q, &refit, f64::INFINITY);
+        drop(std::mem::take(&mut q));
+        (got, q) = meet_dropped(unit, f, x, tol, weights);
+        let cost = sb.off_cost(x, tiny(x));
+        eprintln!(
+            "quintic-c2 fit/meet cycle {cycle}: fit {}, {} off their sign (cost {cost}), residual after the meet {got:.2e} (bound {bound:.2e})",
+            fitted.map_or("not taken".to_string(), |r| format!("residual {r:.2e}")),
+            sb.off(x, tiny(x)),
+        );
+        if got <= bound && best.as_ref().is_none_or(|b| cost < b.0) {
+            best = Some((cost, got, x.clone()));
+        }
+    }
+    match best {
+        Some((_, g, y)) => {
+            *x = y;
+            g
+        }
+        None => got,
+    }
 }
 
 /// The positive finite number the environment variable `name` holds (the exploration
