@@ -942,7 +942,10 @@ const REFIT_ROUNDS: usize = 60;
 /// a move only through its projection, which lies in span q), so it may win the signs back
 /// while the rows stay met, and the meet after it has only the rows the new move reached.
 /// x is left at the turn with the lowest sign cost among those that miss the rows by at most
-/// `bound` (the last turn if none does); returns its max |A x − c|.
+/// `bound` (the last turn if none does); returns its max |A x − c|. On fandisk (session 58,
+/// docs/quintic.md) one turn did not converge: the new fit won the signs back (1433 → 905
+/// off) but its move reached near rows outside q (4.67e-11 → 2.25e-8), which the meet after
+/// it could again meet only by a long move (refused at 1.03e-10).
 #[allow(clippy::too_many_arguments)]
 fn fit_meet_cycles<F: NormalSolve>(
     unit: &UnitRows,
