@@ -964,18 +964,17 @@ fn fit_meet_cycles<F: NormalSolve>(
         fit: rounds,
         ..sb.clone()
     };
-    let tiny = |x: &[f64]| 1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let mut best: Option<(f64, f64, Vec<f64>)> =
-        (got <= bound).then(|| (sb.off_cost(x, tiny(x)), got, x.clone()));
+        (got <= bound).then(|| (sb.off_cost(x, zero_up_to_rounding(x)), got, x.clone()));
     for cycle in 0..cycles {
         let fitted = super::signsplit::fit(unit, f, x, &q, &refit, f64::INFINITY);
         drop(std::mem::take(&mut q));
         (got, q) = meet_dropped(unit, f, x, tol, weights);
-        let cost = sb.off_cost(x, tiny(x));
+        let cost = sb.off_cost(x, zero_up_to_rounding(x));
         eprintln!(
             "quintic-c2 fit/meet cycle {cycle}: fit {}, {} off their sign (cost {cost}), residual after the meet {got:.2e} (bound {bound:.2e})",
             fitted.map_or("not taken".to_string(), |r| format!("residual {r:.2e}")),
-            sb.off(x, tiny(x)),
+            sb.off(x, zero_up_to_rounding(x)),
         );
         if got <= bound && best.as_ref().is_none_or(|b| cost < b.0) {
             best = Some((cost, got, x.clone()));
@@ -1066,6 +1065,13 @@ pub(super) fn read_fit(path: &std::path::Path, n: usize) -> Result<(Vec<f64>, Ve
     Ok((start, fitted))
 }
 
+/// How far off its sign a weight of x may be and still count as on it: weights this small
+/// are zero up to the solves' rounding (1e-12 of x's largest value), for
+/// [`SignBox::off`] / [`SignBox::off_cost`] in the sign rounds and fits.
+pub(super) fn zero_up_to_rounding(x: &[f64]) -> f64 {
+    1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()))
+}
+
 /// Theorem 2.1's signs on a group's own weights, for [`sign_rounds`]: each weight of `signed`
 /// (column, ±1) is clamped to at least `margin` on its side, for at most `rounds` rounds.
 #[derive(Clone, Debug, Default)]
@@ -1142,7 +1148,7 @@ pub(super) fn sign_rounds<F: NormalSolve>(
     // this by [`meet_dropped`]) may miss by a little more.
     let bound = if start <= tol { tol } else { 10.0 * start };
     // Weights this small are zero up to the solves' rounding (as `project`).
-    let tiny = 1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let tiny = zero_up_to_rounding(x);
     let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
     let mut best = (sb.off(x, tiny), start, x.clone());
     let before = best.0;

@@ -111,8 +111,7 @@ pub(super) fn fit<F: NormalSolve>(
     let x0 = x.clone();
     let mut r = vec![0.0; m];
     let start = unit.residual(x, &mut r);
-    // Weights this small are zero up to the solves' rounding (as `sign_rounds`).
-    let tiny = 1e-12 * x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let tiny = super::cholesky::zero_up_to_rounding(x);
     let off_before = sb.off(x, tiny);
     let mut sign = vec![0.0; n];
     let mut cost = vec![1.0; n];
