@@ -1785,6 +1785,7 @@ fn unmet_row(g: &Group, x: &[f64], i: usize) -> Option<f64> {
 /// each relaxed Hessian weight's distance from its estimate counts w times the others', so the
 /// solve moves the jets (fitted into Theorem 2.1's signs by `hessian_signs`) only as far as the
 /// stars' equations need: between the Hessians free (w = 1) and fixed (`APATCH_JOINT_LEVEL=1`).
+/// Only the first solve is weighted: the sign pins of a small group re-solve it unweighted.
 fn hessian_weight() -> Option<f64> {
     std::env::var("APATCH_HESSIAN_WEIGHT")
         .ok()
