@@ -1465,33 +1465,29 @@ impl System {
             && (self.joint_sign_rounds > 0 || self.joint_sign_fit > 0)
             && g.unk.len() > PIN_MAX_UNKNOWNS)
             .then(|| self.sign_box(g));
-        let weight = hessian_weight().filter(|_| {
-            g.unk.iter().any(|&s| {
-                unkey(self.keys[s as usize])
-                    .iter()
-                    .any(|p| p.0 < self.np && p.1 == 3)
-            })
+        // Exploration (`APATCH_HESSIAN_WEIGHT`): the group's Hessian weights weighted, if it has
+        // any.
+        let np = self.np;
+        let weights = hessian_weight().and_then(|w| {
+            let cw: Vec<f64> = g
+                .unk
+                .iter()
+                .map(|&s| {
+                    let jet = unkey(self.keys[s as usize])
+                        .iter()
+                        .any(|p| p.0 < np && p.1 == 3);
+                    if jet {
+                        w
+                    } else {
+                        1.0
+                    }
+                })
+                .collect();
+            cw.iter().any(|&x| x != 1.0).then_some(cw)
         });
-        let mut sol = match weight {
+        let mut sol = match weights {
             None => solve_rows_signed(&g.rows, g.unk.len(), &g.c, &g.tgt, g.scale, signs.as_ref()),
-            Some(w) => {
-                let np = self.np;
-                let cw: Vec<f64> = g
-                    .unk
-                    .iter()
-                    .map(|&s| {
-                        let jet = unkey(self.keys[s as usize])
-                            .iter()
-                            .any(|p| p.0 < np && p.1 == 3);
-                        if jet {
-                            w
-                        } else {
-                            1.0
-                        }
-                    })
-                    .collect();
-                solve_rows_weighted(&g.rows, &g.c, &g.tgt, &cw, g.scale, signs.as_ref())
-            }
+            Some(cw) => solve_rows_weighted(&g.rows, &g.c, &g.tgt, &cw, g.scale, signs.as_ref()),
         };
         let (mut pinned, mut given_up) = (0, 0);
         // Beyond the in-house factor a group goes to the supernodal one, and every pin round
@@ -1777,7 +1773,7 @@ fn unmet_points(g: &Group, x: &[f64], st: u8, np: u32, keys: &[u128]) -> Vec<u32
 /// (1e-9 of the group's reach) or by NaN.
 fn unmet_row(g: &Group, x: &[f64], i: usize) -> Option<f64> {
     let r: f64 = g.rows[i].iter().map(|&(j, k)| k * x[j]).sum::<f64>() - g.c[i];
-    let rel = large_tolerance().unwrap_or(1e-9).min(1e-9);
+    let rel = large_tolerance().map_or(CONSISTENT, |t| t.min(CONSISTENT));
     (r.is_nan() || r.abs() > rel * g.reach).then_some(r)
 }
 
@@ -1796,16 +1792,20 @@ fn hessian_weight() -> Option<f64> {
 /// Exploration (`APATCH_LARGE_CONSISTENT=r`): a large group counts as met only if it misses
 /// its rows by at most `r` of its reach, and names the points of the rows it misses by more
 /// (so that the next pass relaxes them), instead of [`consistent`]'s 1e-9.
+/// Read once: [`unmet_row`] asks for every row of a group.
 fn large_tolerance() -> Option<f64> {
-    std::env::var("APATCH_LARGE_CONSISTENT")
-        .ok()
-        .and_then(|v| v.parse::<f64>().ok())
-        .filter(|r| r.is_finite() && *r > 0.0)
+    static TOLERANCE: std::sync::OnceLock<Option<f64>> = std::sync::OnceLock::new();
+    *TOLERANCE.get_or_init(|| {
+        std::env::var("APATCH_LARGE_CONSISTENT")
+            .ok()
+            .and_then(|v| v.parse::<f64>().ok())
+            .filter(|r| r.is_finite() && *r > 0.0)
+    })
 }
 
 /// [`consistent`] with the tolerance of [`large_tolerance`] where one is set.
 fn large_consistent(sol: &dense::Solution, reach: f64) -> bool {
-    large_tolerance().is_none_or(|r| !(sol.residual.is_nan() || sol.residual > r * reach))
+    large_tolerance().is_none_or(|r| consistent_within(sol, reach, r))
 }
 
 /// Prints every row of `g` that `x` misses by more than 1e-9 of the group's reach
@@ -1857,7 +1857,15 @@ fn group_points(slots: impl Iterator<Item = u32>, st: u8, np: u32, keys: &[u128]
 /// Whether a group's solution meets its equations (to 1e-9 of `scale`, the group's reach: far
 /// above the rounding of the solves, far below any inconsistency the systems have shown).
 fn consistent(sol: &dense::Solution, scale: f64) -> bool {
-    !(sol.residual.is_nan() || sol.residual > 1e-9 * scale || sol.x.iter().any(|x| !x.is_finite()))
+    consistent_within(sol, scale, CONSISTENT)
+}
+
+/// How far a group may miss its rows and count as met: this share of its reach.
+const CONSISTENT: f64 = 1e-9;
+
+/// Whether `sol` is finite and meets its rows to `rel` of `scale`.
+fn consistent_within(sol: &dense::Solution, scale: f64, rel: f64) -> bool {
+    !(sol.residual.is_nan() || sol.residual > rel * scale || sol.x.iter().any(|x| !x.is_finite()))
 }
 
 /// A group's weights closest to `tgt` subject to `rows`·x = `c`: dense up to
