@@ -8,6 +8,7 @@
 //! single-sheeted (see [`QuinticOptions`]). The result is C2 across every shared face
 //! and interpolates T's points with ∇F ∥ their normals.
 
+pub mod beta;
 pub mod checkpoint;
 pub mod cholesky;
 mod dd;

@@ -794,6 +794,12 @@ pub(super) fn refine_near<F: NormalSolve>(
             f.correct(arows, &mut r, &mut x);
             let before = res;
             res = residual_of(&x, &mut r);
+            if std::env::var_os("APATCH_REFINE_TRACE").is_some() {
+                // Opt-in report on stderr (exploration; results unaffected).
+                eprintln!(
+                    "quintic-c2 refine: drop {drop:e}, {dropped} dropped, step {step}: residual {before:.3e} -> {res:.3e}"
+                );
+            }
             if step == 0 {
                 first_step_helped = res < 0.5 * before;
             }

@@ -350,7 +350,7 @@ pub fn solve_near_signed(
             &unit,
             target,
             tol,
-            &[cholesky::PRECISE_PIVOT],
+            &[precise_pivot()],
             true,
             signs,
             |drop| normal.factor::<fx128>(drop).map(with_dropped),
@@ -365,6 +365,17 @@ pub fn solve_near_signed(
         rank: rows.len() - dropped,
         residual,
     })
+}
+
+/// The double-double factor's drop threshold: [`cholesky::PRECISE_PIVOT`], or
+/// `APATCH_PRECISE_PIVOT` (exploration, session 60: rows snapped to their construction's β
+/// made fandisk's double-double factor at 1e-15 keep pivots that blow its correction up).
+fn precise_pivot() -> f64 {
+    std::env::var("APATCH_PRECISE_PIVOT")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .filter(|v: &f64| *v > 0.0)
+        .unwrap_or(cholesky::PRECISE_PIVOT)
 }
 
 #[cfg(test)]

@@ -344,13 +344,13 @@ fn face_equations(
     out: &mut Vec<Equation>,
 ) -> Result<()> {
     let (ta, tb) = (&tets[a.0 as usize], &tets[b.0 as usize]);
-    let tet = Tet::new(ta.pts).ok_or_else(|| {
-        Error::Invalid(format!(
+    if Tet::new(ta.pts).is_none() {
+        return Err(Error::Invalid(format!(
             "quintic-c2: degenerate tetrahedron {:?} (hull triangle {})",
             ta.pts, ta.triangle
-        ))
-    })?;
-    let beta = tet.bary(tb.pts[b.1]);
+        )));
+    }
+    let beta = super::beta::of_face(ta.pts, tb.pts[b.1]);
     // Local index in B of each of A's vertices (A's opposite vertex has none).
     let mut to_b = [usize::MAX; 4];
     for (ka, slot) in to_b.iter_mut().enumerate() {
@@ -377,10 +377,7 @@ fn face_equations(
             lb[b.1] = r;
             let mut terms: Vec<(u32, f64)> = vec![(slot_of[b.0 as usize][index(lb)], 1.0)];
             for g in &gammas {
-                let mut coef = crate::bb::rational::multinomial(*g);
-                for k in 0..4 {
-                    coef *= beta[k].powi(i32::from(g[k]));
-                }
+                let coef = super::beta::coefficient(&beta, *g);
                 if coef == 0.0 {
                     continue;
                 }
