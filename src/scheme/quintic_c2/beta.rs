@@ -44,17 +44,14 @@ fn mode() -> Mode {
     })
 }
 
-/// β of `p` in the tetrahedron `v` for a face's conditions: the f64 barycentric map, or with
-/// `APATCH_FACE_BETA=exact` / `snapped` [`exact`] / [`snapped`]. `v` must not be degenerate (the caller has checked it with
-/// [`crate::bb::Tet::new`]).
+/// β of `p` in the tetrahedron `tet` for a face's conditions: its f64 barycentric map, or
+/// with `APATCH_FACE_BETA=exact` / `snapped` [`exact`] / [`snapped`] on its vertices.
 #[must_use]
-pub fn of_face(v: [DVec3; 4], p: DVec3) -> [Dd; 4] {
+pub fn of_face(tet: &crate::bb::Tet, p: DVec3) -> [Dd; 4] {
     match mode() {
-        Mode::F64 => {
-            crate::bb::Tet::new(v).map_or([Dd::of(f64::NAN); 4], |t| t.bary(p).map(Dd::of))
-        }
-        Mode::Exact => exact(v, p),
-        Mode::Snapped => snapped(exact(v, p)),
+        Mode::F64 => tet.bary(p).map(Dd::of),
+        Mode::Exact => exact(tet.v, p),
+        Mode::Snapped => snapped(exact(tet.v, p)),
     }
 }
 

@@ -344,13 +344,13 @@ fn face_equations(
     out: &mut Vec<Equation>,
 ) -> Result<()> {
     let (ta, tb) = (&tets[a.0 as usize], &tets[b.0 as usize]);
-    if Tet::new(ta.pts).is_none() {
-        return Err(Error::Invalid(format!(
+    let tet = Tet::new(ta.pts).ok_or_else(|| {
+        Error::Invalid(format!(
             "quintic-c2: degenerate tetrahedron {:?} (hull triangle {})",
             ta.pts, ta.triangle
-        )));
-    }
-    let beta = super::beta::of_face(ta.pts, tb.pts[b.1]);
+        ))
+    })?;
+    let beta = super::beta::of_face(&tet, tb.pts[b.1]);
     // Local index in B of each of A's vertices (A's opposite vertex has none).
     let mut to_b = [usize::MAX; 4];
     for (ka, slot) in to_b.iter_mut().enumerate() {
