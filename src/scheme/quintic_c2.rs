@@ -129,6 +129,13 @@ pub struct QuinticOptions {
     /// weight's miss only loosens Theorem 2.1's certificate; `apatch check --holes` names the
     /// boundary faces' misses (docs/quintic.md, session 55).
     pub joint_sign_boundary: f64,
+    /// β of the shared faces in the C1/C2 rows ([`beta::FaceBeta`]): `"f64"` (the default,
+    /// the f64 barycentric map), `"exact"` (double-double from the stored points) or
+    /// `"snapped"` (exact, with the construction's zeros and integers restored: the edge
+    /// tetrahedron pairs' rows exactly collinear). On fandisk snapped rows leave the joint
+    /// group's sign fit 421 weights off instead of 1020 and the holes 623 instead of 723
+    /// (docs/quintic.md, sessions 60–61); the small scenes pass with any of the three.
+    pub face_beta: beta::FaceBeta,
     /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2, and the
     /// stars one ring in) of the tetrahedra around every boundary face the surface crosses (a
     /// hole) and every patch it crosses twice along a j-line (a j-sheet), with all their
@@ -182,6 +189,7 @@ impl Default for QuinticOptions {
             joint_sign_rounds: 0,
             joint_sign_fit: 0,
             joint_sign_boundary: 1.0,
+            face_beta: beta::FaceBeta::F64,
             relax_stars: true,
             consistent_stars: false,
             hessian_signs: false,
@@ -327,6 +335,16 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "face_beta" => {
+                    o.face_beta = match v.as_str().and_then(beta::FaceBeta::named) {
+                        Some(m) => m,
+                        None => bail!(
+                            "{}: `scheme.face_beta` must be one of {}, got {v}",
+                            scene.display(),
+                            beta::FaceBeta::NAMES.map(|n| format!("\"{n}\"")).join(", ")
+                        ),
+                    }
+                }
                 "signs" => o.signs = flag()?,
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
@@ -339,7 +357,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `face_beta`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -465,7 +483,7 @@ pub fn build_prepared(
         EdgePoint::Midpoint
     };
     let (tets, _pos) = system::tetrahedra_with(hull, rule)?;
-    let mut sys = system::assemble(&tets, np)?;
+    let mut sys = system::assemble_with(&tets, np, options.face_beta.or_env())?;
     sys.star_tau = options.star_tau;
     sys.sign_targets = options.sign_targets;
     sys.joint_sign_rounds = options.joint_sign_rounds;

@@ -68,6 +68,8 @@ fn options() -> QuinticOptions {
             .ok()
             .and_then(|x| x.parse().ok())
             .unwrap_or(1.0),
+        // The default rows; `APATCH_FACE_BETA` picks others here as in any build.
+        face_beta: apatch::scheme::quintic_c2::beta::FaceBeta::default(),
         sign_rounds: std::env::var("SIGN_ROUNDS")
             .ok()
             .and_then(|x| x.parse().ok())

@@ -261,6 +261,33 @@ fn joint_sign_boundary_key_is_read_and_checked() {
     }
 }
 
+/// `[scheme] face_beta` names the rows' β of the shared faces: "f64" by default, "exact" or
+/// "snapped"; any other name or type is an error naming the scene, the key and the choices.
+#[test]
+fn face_beta_key_is_read_and_checked() {
+    use apatch::scheme::quintic_c2::beta::FaceBeta;
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert_eq!(read("").unwrap().face_beta, FaceBeta::F64);
+    for (name, mode) in [
+        ("f64", FaceBeta::F64),
+        ("exact", FaceBeta::Exact),
+        ("snapped", FaceBeta::Snapped),
+    ] {
+        assert_eq!(
+            read(&format!("face_beta = \"{name}\"")).unwrap().face_beta,
+            mode
+        );
+    }
+    for bad in ["\"Snapped\"", "\"rounded\"", "1", "true"] {
+        let e = read(&format!("face_beta = {bad}")).unwrap_err().to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("face_beta") && e.contains("\"snapped\""),
+            "{e}"
+        );
+    }
+}
+
 /// `[scheme] sign_targets` is read as a number of medians (integers too), 0 by default, and
 /// a negative or non-numeric value is an error naming the scene and the key.
 #[test]

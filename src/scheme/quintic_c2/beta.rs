@@ -7,15 +7,15 @@
 //! β = (0, 0, −1, 2), the collinear case (2.10), (2.11). Stored in f64 the midpoint is off the
 //! apexes' line by its rounding, and β computed from the stored points has components of
 //! ~1e-14 where the construction has zeros (fandisk: on 29753 of its 31334 faces between edge
-//! tetrahedra), so those faces' equations couple weights the scheme keeps apart.
+//! tetrahedra), so those faces' equations couple weights the scheme keeps apart, and the
+//! joint group's rows come out nearly dependent (~1e-11 off the kept rows' span), which its
+//! sign fit and the meet after it fight over.
 //!
-//! The rows use the f64 barycentric map ([`crate::bb::Tet::bary`]), as they always have.
-//! Session 60 asked whether fandisk's nearly dependent rows (~1e-11 off the kept rows' span,
-//! which the joint group's sign fit and the meet after it fight over) are this rounding; two
-//! other β are here for that, as exploration (`APATCH_FACE_BETA`): `exact`, β in double-double
-//! from the stored points ([`exact`]), and `snapped`, that with the construction's zeros and
-//! integers restored ([`snapped`]). What they did is in docs/quintic.md, "β of the shared
-//! faces, exact and snapped (session 60)".
+//! Three β, the scene's choice (`[scheme] face_beta`, [`FaceBeta`]): the f64 barycentric map
+//! ([`crate::bb::Tet::bary`], the default, as the rows always were), [`exact`] (double-double
+//! from the stored points) and [`snapped`] (that with the construction's zeros and integers
+//! restored). What they do is in docs/quintic.md, "β of the shared faces, exact and snapped
+//! (session 60)" and "Snapped β as a scene key (session 61)".
 
 use super::dd::{Dd, Real as _};
 use glam::DVec3;
@@ -26,32 +26,54 @@ use glam::DVec3;
 /// `apatch check` allows the jumps.
 pub const SNAP: f64 = 1e-12;
 
-/// Which β [`of_face`] gives (`APATCH_FACE_BETA`: unset, the f64 barycentric map; `exact`;
-/// `snapped`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Mode {
+/// Which β the C1/C2 rows carry (`[scheme] face_beta`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FaceBeta {
+    /// The f64 barycentric map and f64 products (`"f64"`, the default; the rows before
+    /// session 61, bit for bit).
+    #[default]
     F64,
+    /// [`exact`], coefficients formed in double-double and rounded once (`"exact"`).
     Exact,
+    /// [`snapped`] [`exact`], coefficients as for `Exact` (`"snapped"`): the edge tetrahedron
+    /// pairs' rows exactly collinear.
     Snapped,
 }
 
-fn mode() -> Mode {
-    static MODE: std::sync::OnceLock<Mode> = std::sync::OnceLock::new();
-    *MODE.get_or_init(|| match std::env::var("APATCH_FACE_BETA").as_deref() {
-        Ok("exact") => Mode::Exact,
-        Ok("snapped") => Mode::Snapped,
-        _ => Mode::F64,
-    })
+impl FaceBeta {
+    /// The scene key's names, in the order the error message lists them.
+    pub const NAMES: [&'static str; 3] = ["f64", "exact", "snapped"];
+
+    /// The mode a scene key's value names, `None` for any other string.
+    #[must_use]
+    pub fn named(name: &str) -> Option<FaceBeta> {
+        match name {
+            "f64" => Some(FaceBeta::F64),
+            "exact" => Some(FaceBeta::Exact),
+            "snapped" => Some(FaceBeta::Snapped),
+            _ => None,
+        }
+    }
+
+    /// `self`, unless the exploration override `APATCH_FACE_BETA` names another mode (to
+    /// compare the three on a scene without editing it; a resumed complex must be resumed
+    /// with the rows it was solved with).
+    #[must_use]
+    pub fn or_env(self) -> FaceBeta {
+        std::env::var("APATCH_FACE_BETA")
+            .ok()
+            .and_then(|v| FaceBeta::named(&v))
+            .unwrap_or(self)
+    }
 }
 
-/// β of `p` in the tetrahedron `tet` for a face's conditions: its f64 barycentric map, or
-/// with `APATCH_FACE_BETA=exact` / `snapped` [`exact`] / [`snapped`] on its vertices.
+/// β of `p` in the tetrahedron `tet` for a face's conditions, as `mode` asks.
 #[must_use]
-pub fn of_face(tet: &crate::bb::Tet, p: DVec3) -> [Dd; 4] {
-    match mode() {
-        Mode::F64 => tet.bary(p).map(Dd::of),
-        Mode::Exact => exact(tet.v, p),
-        Mode::Snapped => snapped(exact(tet.v, p)),
+pub fn of_face(tet: &crate::bb::Tet, p: DVec3, mode: FaceBeta) -> [Dd; 4] {
+    match mode {
+        FaceBeta::F64 => tet.bary(p).map(Dd::of),
+        FaceBeta::Exact => exact(tet.v, p),
+        FaceBeta::Snapped => snapped(exact(tet.v, p)),
     }
 }
 
@@ -120,11 +142,11 @@ pub fn snapped(beta: [Dd; 4]) -> [Dd; 4] {
     out
 }
 
-/// The coefficient r!/γ! · β^γ of a condition (2.8), (2.9), formed in double-double and
-/// rounded once.
+/// The coefficient r!/γ! · β^γ of a condition (2.8), (2.9): in f64 as before session 61 for
+/// [`FaceBeta::F64`], else formed in double-double and rounded once.
 #[must_use]
-pub fn coefficient(beta: &[Dd; 4], gamma: [u8; 4]) -> f64 {
-    if mode() == Mode::F64 {
+pub fn coefficient(beta: &[Dd; 4], gamma: [u8; 4], mode: FaceBeta) -> f64 {
+    if mode == FaceBeta::F64 {
         // The f64 products the rows were formed with before session 60, bit for bit.
         let mut coef = crate::bb::rational::multinomial(gamma);
         for k in 0..4 {
@@ -235,8 +257,8 @@ mod tests {
     fn coefficients_are_the_multinomial_products() {
         let b = [Dd::of(0.5), Dd::of(-1.5), Dd::of(3.0), Dd::of(-1.0)];
         // 2!/(1! 1!) · 0.5 · (−1.5) = −1.5; 2!/2! · 3² = 9; 1 · (−1) = −1 (all exact in f64).
-        assert_eq!(coefficient(&b, [1, 1, 0, 0]), -1.5);
-        assert_eq!(coefficient(&b, [0, 0, 2, 0]), 9.0);
-        assert_eq!(coefficient(&b, [0, 0, 0, 1]), -1.0);
+        assert_eq!(coefficient(&b, [1, 1, 0, 0], FaceBeta::Exact), -1.5);
+        assert_eq!(coefficient(&b, [0, 0, 2, 0], FaceBeta::Exact), 9.0);
+        assert_eq!(coefficient(&b, [0, 0, 0, 1], FaceBeta::Exact), -1.0);
     }
 }

@@ -763,7 +763,9 @@ impl NormalSolve for Factor {
 /// thresholds `drops` in turn (the next only if the last factor's first correction did not
 /// help; with how many rows each dropped): iterative refinement with each, then
 /// conjugate gradients preconditioned by each, until max |A x − c| ≤ `tol`. Returns the best
-/// (residual, x, rows dropped), or `None` when `make` made no factor.
+/// (residual, x, rows dropped), or `None` when `make` made no factor. In the last solve
+/// (`meet`: the dropped rows met afterwards) a factor whose first correction grew the
+/// residual is released before the next one is made, so only one is held at a time.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn refine_near<F: NormalSolve>(
     unit: &UnitRows,
@@ -781,7 +783,14 @@ pub(super) fn refine_near<F: NormalSolve>(
     let res0 = residual_of(target, &mut r);
     let mut best = (res0, target.to_vec(), 0);
     let mut factors: Vec<(F, usize)> = Vec::new();
+    let mut grew = false;
     for &drop in drops {
+        if meet && grew {
+            // The last solve's factors are the large double-double ones (fandisk's: ~11.6 GB
+            // each); one whose first correction grew the residual is no preconditioner
+            // either, so it goes before the next is made.
+            factors.pop();
+        }
         factors.push(make(drop)?);
         let &(ref f, dropped) = factors.last().expect("just pushed");
         let mut x = target.to_vec();
@@ -802,6 +811,7 @@ pub(super) fn refine_near<F: NormalSolve>(
             }
             if step == 0 {
                 first_step_helped = res < 0.5 * before;
+                grew = res > before;
             }
             if res < best.0 {
                 best = (res, x.clone(), dropped);
@@ -2003,6 +2013,65 @@ fn conjugate_gradients_many(
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+
+    /// A stand-in factor of Â Âᵀ = I that multiplies by `gain` (1: exact; 1e3: a first
+    /// correction that grows the residual ~1000×), counting how many are alive at once.
+    struct Counted {
+        gain: f64,
+        live: std::rc::Rc<std::cell::Cell<(usize, usize)>>,
+    }
+
+    impl NormalSolve for Counted {
+        fn solve_normal(&self, r: &mut [f64]) {
+            r.iter_mut().for_each(|v| *v *= self.gain);
+        }
+    }
+
+    impl Drop for Counted {
+        fn drop(&mut self) {
+            let (now, peak) = self.live.get();
+            self.live.set((now - 1, peak));
+        }
+    }
+
+    /// In the last solve (`meet`) a factor whose first correction grew the residual is gone
+    /// before the next drop threshold's factor is made (fandisk's double-double factors are
+    /// ~11.6 GB each); elsewhere both stay, as preconditioners for conjugate gradients. Either
+    /// way the second, exact factor meets the rows.
+    #[test]
+    fn a_grown_factor_is_released_before_the_next_in_the_last_solve() {
+        // Unit rows x_j = c_j: Â Âᵀ = I.
+        let n = 5;
+        let rows: Vec<Row> = (0..n).map(|j| vec![(j, 1.0)]).collect();
+        let c: Vec<f64> = (0..n).map(|j| 0.25 * j as f64 - 0.5).collect();
+        let unit = UnitRows::new(&rows, &c);
+        for meet in [true, false] {
+            let live = std::rc::Rc::new(std::cell::Cell::new((0, 0)));
+            let got = refine_near(
+                &unit,
+                &vec![0.0; n],
+                1e-14,
+                &[1.0, 2.0],
+                meet,
+                None,
+                |drop| {
+                    let (now, peak) = live.get();
+                    live.set((now + 1, peak.max(now + 1)));
+                    let gain = if drop == 1.0 { 1e3 } else { 1.0 };
+                    let f = Counted {
+                        gain,
+                        live: live.clone(),
+                    };
+                    Some((f, 0))
+                },
+            );
+            let (residual, x, _) = got.expect("factors made");
+            // The exact factor's one correction leaves only the rounding of c (~1e-16).
+            assert!(residual <= 1e-14, "meet {meet}: residual {residual:e}");
+            assert_eq!(x, c, "meet {meet}");
+            assert_eq!(live.get(), (0, if meet { 1 } else { 2 }), "meet {meet}");
+        }
+    }
 
     /// A saved sign fit reads back to the bit (values that are not short decimals, −0.0 and
     /// subnormals among them), and a file of another group's length, one cut short or one

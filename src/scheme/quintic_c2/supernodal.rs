@@ -346,15 +346,10 @@ pub fn solve_near_signed(
         normal.factor::<f64>(drop).map(with_dropped)
     })?;
     if best.0 > tol {
-        let precise = cholesky::refine_near(
-            &unit,
-            target,
-            tol,
-            &[precise_pivot()],
-            true,
-            signs,
-            |drop| normal.factor::<fx128>(drop).map(with_dropped),
-        );
+        let precise =
+            cholesky::refine_near(&unit, target, tol, &precise_pivots(), true, signs, |drop| {
+                normal.factor::<fx128>(drop).map(with_dropped)
+            });
         if let Some(p) = precise.filter(|p| p.0 < best.0) {
             best = p;
         }
@@ -367,16 +362,26 @@ pub fn solve_near_signed(
     })
 }
 
-/// The double-double factor's drop threshold: [`cholesky::PRECISE_PIVOT`], or
-/// `APATCH_PRECISE_PIVOT` (exploration, session 60: rows snapped to their construction's β
-/// made fandisk's double-double factor at 1e-15 keep pivots that blow its correction up).
-fn precise_pivot() -> f64 {
-    std::env::var("APATCH_PRECISE_PIVOT")
+/// The double-double factor's drop thresholds in turn: [`cholesky::PRECISE_PIVOT`], then
+/// [`PRECISE_RETRY_PIVOT`] when that factor's first correction does not help; or the one
+/// `APATCH_PRECISE_PIVOT` names (exploration).
+fn precise_pivots() -> Vec<f64> {
+    match std::env::var("APATCH_PRECISE_PIVOT")
         .ok()
         .and_then(|v| v.parse().ok())
         .filter(|v: &f64| *v > 0.0)
-        .unwrap_or(cholesky::PRECISE_PIVOT)
+    {
+        Some(t) => vec![t],
+        None => vec![cholesky::PRECISE_PIVOT, PRECISE_RETRY_PIVOT],
+    }
 }
+
+/// The double-double factor's second drop threshold. Rows within ~1e-6 of the kept rows'
+/// span are dropped too (pivots are squared distances) and met afterwards by
+/// [`cholesky::meet_dropped`]. fandisk's joint group with snapped β (`face_beta =
+/// "snapped"`, session 60) keeps, at 1e-15, pivots whose first correction takes the residual
+/// 0.740 → 4.7e20; at 1e-12 it drops 185458 rows and the correction gives 5.1e-9.
+pub const PRECISE_RETRY_PIVOT: f64 = 1e-12;
 
 #[cfg(test)]
 mod tests {

@@ -29,6 +29,7 @@
 //!    paper's b_3110) and 11.
 //! 6. everything else in the edge tetrahedra (number 14, 15, 17 and the free ones of λ4 > 2).
 
+use super::beta::FaceBeta;
 use super::jets::Jet;
 use super::signs::{self, SignStats};
 use super::{cholesky, dense, sparse, supernodal};
@@ -203,11 +204,21 @@ pub struct System {
     pub joint_sign_boundary: f64,
 }
 
-/// Builds the slots and the C1/C2 equations of every shared face.
+/// Builds the slots and the C1/C2 equations of every shared face, with the f64 β
+/// ([`FaceBeta::F64`], unless `APATCH_FACE_BETA` names another).
 ///
 /// # Errors
 /// A face shared by more than two tetrahedra, or a degenerate tetrahedron.
 pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
+    assemble_with(tets, np, FaceBeta::default().or_env())
+}
+
+/// [`assemble`] with the rows' β of the shared faces computed as `face_beta` asks
+/// (`[scheme] face_beta`).
+///
+/// # Errors
+/// As [`assemble`].
+pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<System> {
     let mi = multi_indices(N);
     let mut map: HashMap<u128, u32> = HashMap::new();
     let mut keys = Vec::new();
@@ -295,7 +306,7 @@ pub fn assemble(tets: &[HullTet], np: u32) -> Result<System> {
             std::mem::swap(&mut a, &mut b);
             stable_swaps += 1;
         }
-        face_equations(tets, &slot_of, a, b, &mi, &mut equations)?;
+        face_equations(tets, &slot_of, a, b, &mi, face_beta, &mut equations)?;
     }
     if stable_swaps > 0 && std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
         // Opt-in report on stderr (exploration; results unaffected).
@@ -341,6 +352,7 @@ fn face_equations(
     a: (u32, usize),
     b: (u32, usize),
     mi: &[[u8; 4]],
+    face_beta: FaceBeta,
     out: &mut Vec<Equation>,
 ) -> Result<()> {
     let (ta, tb) = (&tets[a.0 as usize], &tets[b.0 as usize]);
@@ -350,7 +362,7 @@ fn face_equations(
             ta.pts, ta.triangle
         ))
     })?;
-    let beta = super::beta::of_face(&tet, tb.pts[b.1]);
+    let beta = super::beta::of_face(&tet, tb.pts[b.1], face_beta);
     // Local index in B of each of A's vertices (A's opposite vertex has none).
     let mut to_b = [usize::MAX; 4];
     for (ka, slot) in to_b.iter_mut().enumerate() {
@@ -377,7 +389,7 @@ fn face_equations(
             lb[b.1] = r;
             let mut terms: Vec<(u32, f64)> = vec![(slot_of[b.0 as usize][index(lb)], 1.0)];
             for g in &gammas {
-                let coef = super::beta::coefficient(&beta, *g);
+                let coef = super::beta::coefficient(&beta, *g, face_beta);
                 if coef == 0.0 {
                     continue;
                 }
@@ -2111,6 +2123,57 @@ fn pin_signs(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An edge tetrahedron pair [p_i, p_j, q0, s], [p_i, p_j, q1, s] with s the stored
+    /// midpoint of the apexes (Def. 3.6 (5)(ii)): β = (0, 0, −1, 2). With `face_beta =
+    /// "snapped"` the shared face's rows are the collinear case exactly, each C1 row B's
+    /// weight = −(q0's) + 2 (s's) and each C2 row (q0²) − 4 (q0 s) + 4 (s²); with the f64 map
+    /// they carry the midpoint's rounding as extra terms, which the snap removes without
+    /// moving any coefficient by more than SNAP (1e-12) of the row's largest.
+    #[test]
+    fn snapped_rows_of_an_edge_pair_are_collinear() {
+        // Coordinates whose midpoint does not round-trip (as in beta's tests).
+        let (pi, pj) = (DVec3::new(0.1, 0.2, 0.3), DVec3::new(0.7, -0.1, 0.35));
+        let (q0, q1) = (DVec3::new(0.41, 0.47, 0.9), DVec3::new(0.43, 0.13, -0.3));
+        let s = 0.5 * (q0 + q1);
+        let tet = |apex: DVec3, gid: u32| HullTet {
+            gid: [0, 1, gid, 4],
+            pts: [pi, pj, apex, s],
+            role: Role::Edge,
+            element: 0,
+            triangle: 0,
+            side: Side::Outer,
+        };
+        let tets = [tet(q0, 2), tet(q1, 3)];
+        let rows = |mode| {
+            let sys = assemble_with(&tets, 2, mode).unwrap();
+            sys.equations
+                .iter()
+                .map(|e| {
+                    let mut c: Vec<f64> = e.terms.iter().map(|t| t.1).collect();
+                    c.sort_by(f64::total_cmp);
+                    c
+                })
+                .collect::<Vec<_>>()
+        };
+        let snapped = rows(FaceBeta::Snapped);
+        // 15 C1 rows (degree-4 face indices) and 10 C2 rows (degree 3).
+        assert_eq!(snapped.len(), 25);
+        let (c1, c2) = (vec![-2.0, 1.0, 1.0], vec![-4.0, -1.0, 1.0, 4.0]);
+        assert_eq!(snapped.iter().filter(|r| **r == c1).count(), 15);
+        assert_eq!(snapped.iter().filter(|r| **r == c2).count(), 10);
+        let plain = rows(FaceBeta::F64);
+        let extra = plain.iter().filter(|r| r.len() > 4).count();
+        assert!(extra > 0, "the f64 rows should carry the rounding's terms");
+        for (p, q) in plain.iter().zip(&snapped) {
+            // The same rows up to terms below SNAP (1e-12) of the largest, 4.
+            let kept: Vec<f64> = p.iter().copied().filter(|c| c.abs() > 4e-12).collect();
+            assert_eq!(kept.len(), q.len(), "{p:?} vs {q:?}");
+            for (a, b) in kept.iter().zip(q) {
+                assert!((a - b).abs() <= 4e-12, "{p:?} vs {q:?}");
+            }
+        }
+    }
 
     /// A group of three edge-middle slots over T's points 0–3 (`np` = 10) and two rows, of
     /// which `x` meets only the first.
