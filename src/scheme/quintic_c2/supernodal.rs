@@ -14,7 +14,8 @@
 //! vanish (faer's dynamic regularization). As there, f64 comes first (drop thresholds
 //! [`cholesky::DEPENDENT_PIVOT`], then [`cholesky::RETRY_PIVOT`]), and where its pivots of
 //! nearly dependent rows are rounding and the rows are missed, the factor runs again in
-//! double-double (faer's `fx128`, rows dropped at [`cholesky::PRECISE_PIVOT`]): the rounded
+//! double-double (faer's `fx128`, rows dropped at [`cholesky::PRECISE_PIVOT`], then at
+//! [`PRECISE_RETRY_PIVOT`] if that factor's first correction does not help): the rounded
 //! cylinder's joint group needs it (the f64 factors miss its rows by 5.9e-9, the double-double
 //! one meets them to 3e-14, as the in-house double-double factor does).
 //!
@@ -312,7 +313,8 @@ impl cholesky::NormalSolve for Supernodal<'_, fx128> {
 /// [`cholesky::solve_near`] for a group beyond the in-house factor: the x closest to `target`
 /// with A x = c, refined until max |A x − c| ≤ `tol` (the same refinement and conjugate
 /// gradients): with an f64 factor first, then, if that falls short, a double-double one
-/// dropping rows at [`cholesky::PRECISE_PIVOT`]; Â Âᵀ is formed and ordered once for all of
+/// dropping rows at [`cholesky::PRECISE_PIVOT`] (or [`PRECISE_RETRY_PIVOT`], one factor held
+/// at a time); Â Âᵀ is formed and ordered once for all of
 /// them ([`Normal`]). `None` when this factor would hold more than `max_values` values
 /// ([`MAX_VALUES`] in the solves).
 #[must_use]
