@@ -15,7 +15,7 @@
 //! ([`crate::bb::Tet::bary`], the default, as the rows always were), [`exact`] (double-double
 //! from the stored points) and [`snapped`] (that with the construction's zeros and integers
 //! restored). What they do is in docs/quintic.md, "β of the shared faces, exact and snapped
-//! (session 60)" and "Snapped β as a scene key (session 61)".
+//! (session 60)" and "Snapped β as a scene key; … (session 61)".
 
 use super::dd::{Dd, Real as _};
 use glam::DVec3;
@@ -44,15 +44,14 @@ impl FaceBeta {
     /// The scene key's names, in the order the error message lists them.
     pub const NAMES: [&'static str; 3] = ["f64", "exact", "snapped"];
 
+    /// The modes [`Self::NAMES`] name, in the same order.
+    const MODES: [FaceBeta; 3] = [FaceBeta::F64, FaceBeta::Exact, FaceBeta::Snapped];
+
     /// The mode a scene key's value names, `None` for any other string.
     #[must_use]
     pub fn named(name: &str) -> Option<FaceBeta> {
-        match name {
-            "f64" => Some(FaceBeta::F64),
-            "exact" => Some(FaceBeta::Exact),
-            "snapped" => Some(FaceBeta::Snapped),
-            _ => None,
-        }
+        let at = Self::NAMES.iter().position(|&n| n == name)?;
+        Some(Self::MODES[at])
     }
 
     /// `self`, unless the exploration override `APATCH_FACE_BETA` names another mode (to
