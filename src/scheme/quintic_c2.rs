@@ -489,6 +489,10 @@ pub fn build_prepared(
     sys.joint_sign_rounds = options.joint_sign_rounds;
     sys.joint_sign_fit = options.joint_sign_fit;
     sys.joint_sign_boundary = options.joint_sign_boundary;
+    if let Some(path) = resume::restage_requested() {
+        // Exploration: the joint group's values read back, the stages after it solved again.
+        sys.preset = Some(resume::slot_values(&sys, &tets, &path)?);
+    }
     if !zero_points.is_empty() {
         sys.require_zero_bases(&tets, &flat::zero_triangles(hull, zero_points));
     }

@@ -15,6 +15,16 @@ use std::path::Path;
 /// The environment variable naming the complex to resume from.
 pub const RESUME_VAR: &str = "APATCH_QUINTIC_RESUME";
 
+/// The environment variable naming a complex whose groups too large to pin (fandisk's joint
+/// group) are taken up, the stages after them solved again ([`System::preset`]).
+pub const RESTAGE_VAR: &str = "APATCH_QUINTIC_RESTAGE";
+
+/// The complex named by [`RESTAGE_VAR`], if set.
+#[must_use]
+pub fn restage_requested() -> Option<std::path::PathBuf> {
+    std::env::var_os(RESTAGE_VAR).map(Into::into)
+}
+
 /// The complex named by [`RESUME_VAR`], if set.
 #[must_use]
 pub fn requested() -> Option<std::path::PathBuf> {

@@ -202,6 +202,11 @@ pub struct System {
     /// Cost of a boundary slot's sign miss in the split sign program, in units of an inner
     /// one's (`QuinticOptions::joint_sign_boundary`, 1 = all alike).
     pub joint_sign_boundary: f64,
+    /// Exploration (`APATCH_QUINTIC_RESTAGE=patches.json`, [`super::resume`]): every slot's
+    /// value in a complex exported from this scene; groups too large to pin take their values
+    /// from it instead of being solved, so the stages after fandisk's joint group (~80 min)
+    /// can be tried again in minutes.
+    pub preset: Option<Vec<f64>>,
 }
 
 /// Builds the slots and the C1/C2 equations of every shared face, with the f64 β
@@ -325,6 +330,7 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
         joint_sign_rounds: 0,
         joint_sign_fit: 0,
         joint_sign_boundary: 1.0,
+        preset: None,
     })
 }
 
@@ -1465,6 +1471,18 @@ impl System {
         eqs_of: &[Vec<u32>],
         pin: bool,
     ) -> GroupSolution {
+        if let Some(v) = self.preset.as_ref().filter(|_| g.unk.len() > PIN_MAX_UNKNOWNS) {
+            // Exploration: the group's values as an earlier run of this scene left them.
+            let x: Vec<f64> = g.unk.iter().map(|&s| v[s as usize]).collect();
+            let residual = g
+                .rows
+                .iter()
+                .zip(&g.c)
+                .map(|(row, c)| (row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c).abs())
+                .fold(0.0, f64::max);
+            let rank = g.m.min(x.len());
+            return (dense::Solution { x, rank, residual }, 0, 0);
+        }
         if self.sign_targets > 0.0 {
             self.move_targets_into_signs(g);
         }
