@@ -1450,6 +1450,20 @@ impl System {
             })
             .fold(0.0, f64::max)
             / wmax;
+        if let Some(path) = std::env::var_os("APATCH_SLOT_DUMP") {
+            // Opt-in exploration: per tetrahedron and weight, its slot's stage and required
+            // sign (i8 each, 2 × 56 bytes a tetrahedron, in the complex's patch order).
+            let mut bytes = Vec::with_capacity(self.slot_of.len() * NW * 2);
+            for slots in &self.slot_of {
+                for &s in slots {
+                    bytes.push(stage_of[s as usize]);
+                    bytes.push(self.req[s as usize] as u8);
+                }
+            }
+            if let Err(e) = std::fs::write(&path, bytes) {
+                eprintln!("quintic-c2: slot dump not written: {e}");
+            }
+        }
         let (pinned, given_up) = (stats.signs.pinned, stats.signs.given_up);
         stats.signs = self.sign_stats(&value, &stage_of);
         stats.signs.pinned = pinned;
@@ -1471,7 +1485,11 @@ impl System {
         eqs_of: &[Vec<u32>],
         pin: bool,
     ) -> GroupSolution {
-        if let Some(v) = self.preset.as_ref().filter(|_| g.unk.len() > PIN_MAX_UNKNOWNS) {
+        if let Some(v) = self
+            .preset
+            .as_ref()
+            .filter(|_| g.unk.len() > PIN_MAX_UNKNOWNS)
+        {
             // Exploration: the group's values as an earlier run of this scene left them.
             let x: Vec<f64> = g.unk.iter().map(|&s| v[s as usize]).collect();
             let residual = g
@@ -1521,8 +1539,26 @@ impl System {
         // would factor it again (fandisk's joint group: 17 minutes, 16.5 GB each).
         if pin && g.unk.len() <= PIN_MAX_UNKNOWNS && consistent(&sol, g.reach) {
             let conds = self.sign_conditions(&g.unk, &g.col, value, known, stage_of, st, eqs_of);
+            // Opt-in exploration on stderr (`APATCH_PIN_TRACE`; results unaffected): each
+            // group's conditions missed before and after its pins, at the pins' rounding.
+            let trace = std::env::var_os("APATCH_PIN_TRACE").is_some();
+            let tiny = 1e-9 * g.scale;
+            let missed = |x: &[f64]| conds.iter().filter(|k| k.value(x) < -tiny).count();
+            let before = if trace { missed(&sol.x) } else { 0 };
             (pinned, given_up) =
                 pin_signs(&mut sol, &mut g.rows, &mut g.c, &conds, &g.tgt, g.scale);
+            if trace {
+                let own = conds
+                    .iter()
+                    .filter(|k| k.row.len() == 1 && k.offset == 0.0)
+                    .count();
+                eprintln!(
+                    "quintic-c2 pins: stage {st} unknowns {} conditions {} (own {own}) missed {before} -> {} pinned {pinned} given up {given_up}",
+                    g.unk.len(),
+                    conds.len(),
+                    missed(&sol.x)
+                );
+            }
         }
         (sol, pinned, given_up)
     }
