@@ -123,6 +123,12 @@ pub(super) fn fit<F: NormalSolve>(
     let trace = std::env::var_os("APATCH_SOLVE_TRACE").is_some();
     // In units of the box's margin: stay ε/2 |z − x₀|² + Σ max(0, FIT_MARGIN − s z) over the
     // signed weights.
+    // Exploration (`APATCH_FIT_MARGIN`): another margin, in the same units.
+    let fit_margin = std::env::var("APATCH_FIT_MARGIN")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .unwrap_or(FIT_MARGIN);
     let mut rho = RHO;
     let mut z = x0.clone();
     let mut u = vec![0.0; n];
@@ -147,12 +153,12 @@ pub(super) fn fit<F: NormalSolve>(
                 // margin.
                 let w = s * a / margin;
                 let step = cost[j] / kappa;
-                let w = if w >= FIT_MARGIN {
+                let w = if w >= fit_margin {
                     w
-                } else if w + step < FIT_MARGIN {
+                } else if w + step < fit_margin {
                     w + step
                 } else {
-                    FIT_MARGIN
+                    fit_margin
                 };
                 s * w * margin
             };
