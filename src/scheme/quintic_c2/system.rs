@@ -1490,8 +1490,17 @@ impl System {
             .as_ref()
             .filter(|_| g.unk.len() > PIN_MAX_UNKNOWNS)
         {
-            // Exploration: the group's values as an earlier run of this scene left them.
-            let x: Vec<f64> = g.unk.iter().map(|&s| v[s as usize]).collect();
+            // Exploration: the group's values as an earlier run of this scene left them, or
+            // (`APATCH_RESTAGE_FIT=file`, what `APATCH_JOINT_FIT_SAVE` wrote) its sign fit's.
+            let fitted = std::env::var_os("APATCH_RESTAGE_FIT").and_then(|path| {
+                cholesky::read_fit(std::path::Path::new(&path), g.unk.len())
+                    .map_err(|e| eprintln!("quintic-c2: saved sign fit not used: {e}"))
+                    .ok()
+            });
+            let x: Vec<f64> = match fitted {
+                Some((_, x)) => x,
+                None => g.unk.iter().map(|&s| v[s as usize]).collect(),
+            };
             let residual = g
                 .rows
                 .iter()
