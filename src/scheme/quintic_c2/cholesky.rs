@@ -1007,7 +1007,7 @@ fn fit_meet_cycles<F: NormalSolve>(
 
 /// The positive finite number the environment variable `name` holds (the exploration
 /// overrides' form), or `None` if it is unset or holds anything else.
-fn positive_env(name: &str) -> Option<f64> {
+pub(super) fn positive_env(name: &str) -> Option<f64> {
     std::env::var(name)
         .ok()
         .and_then(|v| v.parse::<f64>().ok())

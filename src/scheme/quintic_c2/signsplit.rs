@@ -124,11 +124,7 @@ pub(super) fn fit<F: NormalSolve>(
     // In units of the box's margin: stay ε/2 |z − x₀|² + Σ max(0, FIT_MARGIN − s z) over the
     // signed weights.
     // Exploration (`APATCH_FIT_MARGIN`): another margin, in the same units.
-    let fit_margin = std::env::var("APATCH_FIT_MARGIN")
-        .ok()
-        .and_then(|v| v.parse::<f64>().ok())
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .unwrap_or(FIT_MARGIN);
+    let fit_margin = super::cholesky::positive_env("APATCH_FIT_MARGIN").unwrap_or(FIT_MARGIN);
     let mut rho = RHO;
     let mut z = x0.clone();
     let mut u = vec![0.0; n];
