@@ -136,6 +136,14 @@ pub struct QuinticOptions {
     /// group's sign fit 421 weights off instead of 1020 and the holes 623 instead of 723
     /// (docs/quintic.md, sessions 60–61); the small scenes pass with any of the three.
     pub face_beta: beta::FaceBeta,
+    /// The double-double factor's drop threshold (a pivot is a row's squared distance from
+    /// the rows before it, relative) for the groups beyond the in-house factor (fandisk's
+    /// joint group), instead of [`cholesky::PRECISE_PIVOT`] (1e-15) and, when that factor's
+    /// first correction does not help, [`supernodal::PRECISE_RETRY_PIVOT`] (1e-12). A scene
+    /// known to need the second (fandisk with snapped β: the first factor's correction takes
+    /// the residual 0.74 → 4.7e20) names it and skips the first factor (~12–20 min, 11.6 GB).
+    /// Rows dropped are met afterwards ([`cholesky::meet_dropped`]). `None` by default.
+    pub precise_pivot: Option<f64>,
     /// After the solve, re-solve the late weights (no point of T at multiplicity ≥ 2, and the
     /// stars one ring in) of the tetrahedra around every boundary face the surface crosses (a
     /// hole) and every patch it crosses twice along a j-line (a j-sheet), with all their
@@ -190,6 +198,7 @@ impl Default for QuinticOptions {
             joint_sign_fit: 0,
             joint_sign_boundary: 1.0,
             face_beta: beta::FaceBeta::F64,
+            precise_pivot: None,
             relax_stars: true,
             consistent_stars: false,
             hessian_signs: false,
@@ -223,6 +232,11 @@ pub enum HessianRepair {
 /// The largest [`QuinticOptions::repair_widen`]: 2 + 8 = 10 rings of points round a defect
 /// already reach across most of a model's features, and every ring grows the local group.
 pub const MAX_REPAIR_WIDEN: usize = 8;
+
+/// The largest [`QuinticOptions::precise_pivot`]: pivots are squared distances relative to
+/// the row, so 1e-6 drops rows up to 1e-3 of their length from the span of the others, which
+/// are independent rows for the factor to keep, not rounding for the meet to mend.
+pub const MAX_PRECISE_PIVOT: f64 = 1e-6;
 
 /// Default [`QuinticOptions::lift`].
 pub const LIFT: f64 = 3.0;
@@ -345,6 +359,16 @@ impl QuinticOptions {
                         ),
                     }
                 }
+                "precise_pivot" => match v
+                    .as_float()
+                    .or_else(|| v.as_integer().map(|i| i as f64))
+                {
+                    Some(t) if t > 0.0 && t <= MAX_PRECISE_PIVOT => o.precise_pivot = Some(t),
+                    _ => bail!(
+                        "{}: `scheme.precise_pivot` must be a number in (0, {MAX_PRECISE_PIVOT:e}], got {v}",
+                        scene.display()
+                    ),
+                },
                 "signs" => o.signs = flag()?,
                 "curvature" => {
                     let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
@@ -357,7 +381,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `face_beta`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -489,6 +513,7 @@ pub fn build_prepared(
     sys.joint_sign_rounds = options.joint_sign_rounds;
     sys.joint_sign_fit = options.joint_sign_fit;
     sys.joint_sign_boundary = options.joint_sign_boundary;
+    sys.precise_pivot = options.precise_pivot;
     if let Some(path) = resume::restage_requested() {
         // Exploration: the joint group's values read back, the stages after it solved again.
         sys.preset = Some(resume::slot_values(&sys, &tets, &path)?);

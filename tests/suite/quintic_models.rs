@@ -70,6 +70,8 @@ fn options() -> QuinticOptions {
             .unwrap_or(1.0),
         // The default rows; `APATCH_FACE_BETA` picks others here as in any build.
         face_beta: apatch::scheme::quintic_c2::beta::FaceBeta::default(),
+        // The default thresholds; `APATCH_PRECISE_PIVOT` picks another here as in any build.
+        precise_pivot: None,
         sign_rounds: std::env::var("SIGN_ROUNDS")
             .ok()
             .and_then(|x| x.parse().ok())

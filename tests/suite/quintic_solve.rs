@@ -261,6 +261,29 @@ fn joint_sign_boundary_key_is_read_and_checked() {
     }
 }
 
+/// `[scheme] precise_pivot` is the double-double factor's one drop threshold, unset by
+/// default (1e-15, then 1e-12); zero, negative, above 1e-6 or not a number is an error naming
+/// the scene and the key.
+#[test]
+fn precise_pivot_key_is_read_and_checked() {
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert_eq!(read("").unwrap().precise_pivot, None);
+    assert_eq!(
+        read("precise_pivot = 1e-12").unwrap().precise_pivot,
+        Some(1e-12)
+    );
+    for bad in ["0", "-1e-12", "1e-3", "1", "\"x\""] {
+        let e = read(&format!("precise_pivot = {bad}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("precise_pivot"),
+            "{e}"
+        );
+    }
+}
+
 /// `[scheme] face_beta` names the rows' β of the shared faces: "f64" by default, "exact" or
 /// "snapped"; any other name or type is an error naming the scene, the key and the choices.
 #[test]

@@ -326,12 +326,15 @@ pub fn solve_near(
     tol: f64,
     max_values: usize,
 ) -> Option<Solution> {
-    solve_near_signed(rows, n, c, target, tol, max_values, None)
+    solve_near_signed(rows, n, c, target, tol, max_values, None, None)
 }
 
 /// [`solve_near`], then with `signs` alternating projections between Theorem 2.1's signs and
 /// the rows with the same factor ([`cholesky::sign_rounds`]), before the dropped rows are met.
+/// `pivot`, if given, is the double-double factor's one drop threshold instead of
+/// [`cholesky::PRECISE_PIVOT`] then [`PRECISE_RETRY_PIVOT`] (`[scheme] precise_pivot`).
 #[must_use]
+#[allow(clippy::too_many_arguments)]
 pub fn solve_near_signed(
     rows: &[Row],
     n: usize,
@@ -340,6 +343,7 @@ pub fn solve_near_signed(
     tol: f64,
     max_values: usize,
     signs: Option<&cholesky::SignBox>,
+    pivot: Option<f64>,
 ) -> Option<Solution> {
     let unit = UnitRows::new(rows, c);
     let normal = Normal::of(&unit.rows, n, max_values)?;
@@ -348,10 +352,15 @@ pub fn solve_near_signed(
         normal.factor::<f64>(drop).map(with_dropped)
     })?;
     if best.0 > tol {
-        let precise =
-            cholesky::refine_near(&unit, target, tol, &precise_pivots(), true, signs, |drop| {
-                normal.factor::<fx128>(drop).map(with_dropped)
-            });
+        let precise = cholesky::refine_near(
+            &unit,
+            target,
+            tol,
+            &precise_pivots(pivot),
+            true,
+            signs,
+            |drop| normal.factor::<fx128>(drop).map(with_dropped),
+        );
         if let Some(p) = precise.filter(|p| p.0 < best.0) {
             best = p;
         }
@@ -365,14 +374,10 @@ pub fn solve_near_signed(
 }
 
 /// The double-double factor's drop thresholds in turn: [`cholesky::PRECISE_PIVOT`], then
-/// [`PRECISE_RETRY_PIVOT`] when that factor's first correction does not help; or the one
-/// `APATCH_PRECISE_PIVOT` names (exploration).
-fn precise_pivots() -> Vec<f64> {
-    match std::env::var("APATCH_PRECISE_PIVOT")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .filter(|v: &f64| *v > 0.0)
-    {
+/// [`PRECISE_RETRY_PIVOT`] when that factor's first correction does not help; or the scene's
+/// one (`pivot`); or the one `APATCH_PRECISE_PIVOT` names (exploration, before either).
+fn precise_pivots(pivot: Option<f64>) -> Vec<f64> {
+    match cholesky::positive_env("APATCH_PRECISE_PIVOT").or(pivot) {
         Some(t) => vec![t],
         None => vec![cholesky::PRECISE_PIVOT, PRECISE_RETRY_PIVOT],
     }
@@ -623,6 +628,30 @@ mod tests {
         );
     }
 
+    /// A scene's `precise_pivot` is the double-double factor's one threshold: the pair 1e-7
+    /// apart (pivot 1e-14) that the default first threshold (1e-15) keeps is dropped at 1e-12
+    /// and met afterwards (`cholesky::meet_dropped`), at the same solution.
+    #[test]
+    fn a_scene_pivot_replaces_the_default_thresholds() {
+        let t = 1e-7_f64;
+        let rows = pair_rows(t);
+        let c = [1.0, t.cos() + 0.25 * t.sin()];
+        let solve = |pivot| {
+            solve_near_signed(&rows, 2, &c, &[0.0, 0.0], 1e-13, MAX_VALUES, None, pivot)
+                .expect("tiny")
+        };
+        let (kept, dropped) = (solve(None), solve(Some(1e-12)));
+        assert_eq!((kept.rank, dropped.rank), (2, 1));
+        assert!(dropped.residual <= 1e-13, "{:e}", dropped.residual);
+        // x = (1, 0.25), conditioned ~1e7 by the pair (see the test above): 1e-8.
+        for x in [&kept.x, &dropped.x] {
+            assert!(
+                (x[0] - 1.0).abs() < 1e-8 && (x[1] - 0.25).abs() < 1e-8,
+                "{x:?}"
+            );
+        }
+    }
+
     /// Rows a double-double factor drops (off the others' span by ~1e-9, a pivot of ~1e-18,
     /// below `PRECISE_PIVOT`) but whose data are consistent are still met
     /// (`cholesky::meet_dropped`), at the same closest solution as the dense pivoted QR, which
@@ -788,8 +817,8 @@ mod tests {
             fit: 0,
         };
         let plain = solve_near(&rows, n, &c, &target, tol, MAX_VALUES).expect("small");
-        let signed_sol =
-            solve_near_signed(&rows, n, &c, &target, tol, MAX_VALUES, Some(&sb)).expect("small");
+        let signed_sol = solve_near_signed(&rows, n, &c, &target, tol, MAX_VALUES, Some(&sb), None)
+            .expect("small");
         let (before, after) = (sb.off(&plain.x, 0.0), sb.off(&signed_sol.x, 0.0));
         assert!(before > 20, "the targets leave weights off: {before}");
         assert_eq!(after, 0, "{before} off before the rounds");
@@ -870,7 +899,7 @@ mod tests {
             };
             let solve = |b: Option<cholesky::SignBox>| {
                 let (r, c, t) = (&sys.rows, &sys.c, &sys.target);
-                solve_near_signed(r, n, c, t, tol, MAX_VALUES, b.as_ref()).expect("small")
+                solve_near_signed(r, n, c, t, tol, MAX_VALUES, b.as_ref(), None).expect("small")
             };
             let off = |x: &[f64]| sb(0, 0).off(x, 0.0);
             let (plain, alt, fit) = (
@@ -910,7 +939,7 @@ mod tests {
                 fit: 100,
             };
             let (r, c, t) = (&sys.rows, &sys.c, &sys.target);
-            let x = solve_near_signed(r, n, c, t, tol, MAX_VALUES, Some(&sb))
+            let x = solve_near_signed(r, n, c, t, tol, MAX_VALUES, Some(&sb), None)
                 .expect("small")
                 .x;
             let off = |want: bool| {
@@ -995,9 +1024,18 @@ mod tests {
         use cholesky::NormalSolve;
         let (tol, n, delta) = (1e-12, 600, 1e-9);
         let sys = signed_system(500, n, 6, 1, -0.25);
-        let x0 = solve_near_signed(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES, None)
-            .expect("small")
-            .x;
+        let x0 = solve_near_signed(
+            &sys.rows,
+            n,
+            &sys.c,
+            &sys.target,
+            tol,
+            MAX_VALUES,
+            None,
+            None,
+        )
+        .expect("small")
+        .x;
         // The near rows, consistent with x0.
         let (mut rows, mut c) = (sys.rows.clone(), sys.c.clone());
         let mut seed = 41_u64;

@@ -202,6 +202,10 @@ pub struct System {
     /// Cost of a boundary slot's sign miss in the split sign program, in units of an inner
     /// one's (`QuinticOptions::joint_sign_boundary`, 1 = all alike).
     pub joint_sign_boundary: f64,
+    /// The double-double factor's one drop threshold for groups beyond the in-house factor
+    /// (`QuinticOptions::precise_pivot`; `None`: [`super::cholesky::PRECISE_PIVOT`], then
+    /// [`super::supernodal::PRECISE_RETRY_PIVOT`]).
+    pub precise_pivot: Option<f64>,
     /// Exploration (`APATCH_QUINTIC_RESTAGE=patches.json`, [`super::resume`]): every slot's
     /// value in a complex exported from this scene; groups too large to pin take their values
     /// from it instead of being solved, so the stages after fandisk's joint group (~80 min)
@@ -330,6 +334,7 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
         joint_sign_rounds: 0,
         joint_sign_fit: 0,
         joint_sign_boundary: 1.0,
+        precise_pivot: None,
         preset: None,
     })
 }
@@ -1540,8 +1545,24 @@ impl System {
             cw.iter().any(|&x| x != 1.0).then_some(cw)
         });
         let mut sol = match weights {
-            None => solve_rows_signed(&g.rows, g.unk.len(), &g.c, &g.tgt, g.scale, signs.as_ref()),
-            Some(cw) => solve_rows_weighted(&g.rows, &g.c, &g.tgt, &cw, g.scale, signs.as_ref()),
+            None => solve_rows_signed(
+                &g.rows,
+                g.unk.len(),
+                &g.c,
+                &g.tgt,
+                g.scale,
+                signs.as_ref(),
+                self.precise_pivot,
+            ),
+            Some(cw) => solve_rows_weighted(
+                &g.rows,
+                &g.c,
+                &g.tgt,
+                &cw,
+                g.scale,
+                signs.as_ref(),
+                self.precise_pivot,
+            ),
         };
         let (mut pinned, mut given_up) = (0, 0);
         // Beyond the in-house factor a group goes to the supernodal one, and every pin round
@@ -1949,7 +1970,7 @@ fn solve_rows(
     tgt: &[f64],
     scale: f64,
 ) -> dense::Solution {
-    solve_rows_signed(rows, n, c, tgt, scale, None)
+    solve_rows_signed(rows, n, c, tgt, scale, None, None)
 }
 
 /// [`solve_rows_signed`] closest to `tgt` in the weighted norm Σ w_j² (x_j − t_j)² (`cw`: one
@@ -1962,6 +1983,7 @@ fn solve_rows_weighted(
     cw: &[f64],
     scale: f64,
     signs: Option<&cholesky::SignBox>,
+    pivot: Option<f64>,
 ) -> dense::Solution {
     let scaled: Vec<sparse::Row> = rows
         .iter()
@@ -1969,7 +1991,7 @@ fn solve_rows_weighted(
         .collect();
     let ty: Vec<f64> = tgt.iter().zip(cw).map(|(t, w)| t * w).collect();
     let scale = ty.iter().fold(scale, |a, t| a.max(t.abs()));
-    let mut sol = solve_rows_signed(&scaled, tgt.len(), c, &ty, scale, signs);
+    let mut sol = solve_rows_signed(&scaled, tgt.len(), c, &ty, scale, signs, pivot);
     for (x, w) in sol.x.iter_mut().zip(cw) {
         *x /= w;
     }
@@ -1977,7 +1999,8 @@ fn solve_rows_weighted(
 }
 
 /// [`solve_rows`], with Theorem 2.1's `signs` taken by alternating projections where the group
-/// goes to the supernodal factor ([`supernodal::solve_near_signed`]).
+/// goes to the supernodal factor ([`supernodal::solve_near_signed`]), whose double-double
+/// factor drops rows at `pivot` if given.
 fn solve_rows_signed(
     rows: &[sparse::Row],
     n: usize,
@@ -1985,6 +2008,7 @@ fn solve_rows_signed(
     tgt: &[f64],
     scale: f64,
     signs: Option<&cholesky::SignBox>,
+    pivot: Option<f64>,
 ) -> dense::Solution {
     let m = rows.len();
     if n <= DENSE_LIMIT {
@@ -2008,7 +2032,7 @@ fn solve_rows_signed(
             cholesky::MAX_FACTOR_ENTRIES,
             supernodal::MAX_VALUES,
         );
-        let sol = solve_sparse(rows, n, c, tgt, 1e-13 * scale, limits, signs);
+        let sol = solve_sparse(rows, n, c, tgt, 1e-13 * scale, limits, signs, pivot);
         if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
             // Opt-in timing of the large groups on stderr (exploration; results unaffected).
             eprintln!(
@@ -2027,6 +2051,7 @@ fn solve_rows_signed(
 /// supernodal values)`, and left unsolved (its targets, infinite residual) beyond that too,
 /// which the caller reports as too large: a factor that does not fit in memory would end the
 /// process instead of the scene.
+#[allow(clippy::too_many_arguments)]
 fn solve_sparse(
     rows: &[sparse::Row],
     n: usize,
@@ -2035,11 +2060,12 @@ fn solve_sparse(
     tol: f64,
     (max_rows, max_entries, max_values): (usize, usize, usize),
     signs: Option<&cholesky::SignBox>,
+    pivot: Option<f64>,
 ) -> dense::Solution {
     if let Some(o) = cholesky::Ordering::within(rows, n, (max_rows, max_entries)) {
         return cholesky::solve_near_ordered(rows, n, c, tgt, tol, &o);
     }
-    supernodal::solve_near_signed(rows, n, c, tgt, tol, max_values, signs)
+    supernodal::solve_near_signed(rows, n, c, tgt, tol, max_values, signs, pivot)
         .unwrap_or_else(|| dense::Solution::unsolved(tgt))
 }
 
@@ -2271,7 +2297,7 @@ mod tests {
         let t = [0.3, -0.2, 0.1, 0.7];
         let c = [1.5];
         let w = [1.0, 10.0, 3.0, 1.0];
-        let sol = solve_rows_weighted(&rows, &c, &t, &w, 1.0, None);
+        let sol = solve_rows_weighted(&rows, &c, &t, &w, 1.0, None, None);
         let at: f64 = a.iter().zip(&t).map(|(a, t)| a * t).sum();
         let den: f64 = a.iter().zip(&w).map(|(a, w)| a * a / (w * w)).sum();
         for j in 0..4 {
@@ -2286,7 +2312,7 @@ mod tests {
         assert!(sol.residual < 1e-14);
         // Weights all 1: the plain least change.
         let plain = solve_rows(&rows, 4, &c, &t, 1.0);
-        let even = solve_rows_weighted(&rows, &c, &t, &[1.0; 4], 1.0, None);
+        let even = solve_rows_weighted(&rows, &c, &t, &[1.0; 4], 1.0, None, None);
         assert_eq!(plain.x, even.x);
         // The heavy unknown (w = 10, a = 2) moves less than the light one of the same sign
         // (w = 1, a = 1) though its coefficient is larger.
@@ -2317,7 +2343,7 @@ mod tests {
         let c = vec![1.0; n - 1];
         let tgt = vec![0.0; n];
         let big = usize::MAX;
-        let solved = solve_sparse(&rows, n, &c, &tgt, 1e-13, (1000, 1000, big), None);
+        let solved = solve_sparse(&rows, n, &c, &tgt, 1e-13, (1000, 1000, big), None, None);
         // Solved: the chain's rows hold to rounding (unit coefficients, values up to 25).
         assert!(solved.residual < 1e-12, "{}", solved.residual);
         assert!(consistent(&solved, 1.0));
@@ -2325,18 +2351,18 @@ mod tests {
         for limits in [(n - 2, 1000), (1000, entries - 1)] {
             // Beyond the in-house factor: the supernodal one meets the same rows.
             let (r, e) = limits;
-            let other = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, big), None);
+            let other = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, big), None, None);
             assert!(other.residual < 1e-12, "{limits:?}: {}", other.residual);
             for (a, b) in other.x.iter().zip(&solved.x) {
                 // The same closest solution; values up to 25, rounding of 49 unit steps.
                 assert!((a - b).abs() < 1e-12, "{a} vs {b}");
             }
             // Beyond both: left unsolved.
-            let left = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, 10), None);
+            let left = solve_sparse(&rows, n, &c, &tgt, 1e-13, (r, e, 10), None, None);
             assert_eq!(left.residual, f64::INFINITY, "{limits:?}");
             assert!(!consistent(&left, 1.0));
         }
-        let fits = solve_sparse(&rows, n, &c, &tgt, 1e-13, (n - 1, entries, 10), None);
+        let fits = solve_sparse(&rows, n, &c, &tgt, 1e-13, (n - 1, entries, 10), None, None);
         assert!(fits.residual < 1e-12);
     }
 
