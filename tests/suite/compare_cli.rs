@@ -120,6 +120,7 @@ fn json_reports_known_rmse_and_writes_pictures() {
         .filter(|e| e.file_name().to_string_lossy().contains(".partial-"))
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
+    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
@@ -136,6 +137,7 @@ fn identical_files_report_null_psnr_and_text_inf() {
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains(" inf "), "{text}");
     assert!(!text.contains("\nR "), "only G compared: {text}");
+    std::fs::remove_dir_all(&d).unwrap();
 }
 
 fn expect_error(args: &[&str], needle: &str) {
@@ -176,4 +178,5 @@ fn bad_inputs_are_one_line_errors() {
     let diff = d.join("never.png");
     expect_error(&["compare", s(&a), s(&small), "--diff", s(&diff)], "sizes");
     assert!(!diff.exists());
+    std::fs::remove_dir_all(&d).unwrap();
 }

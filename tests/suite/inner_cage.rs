@@ -61,10 +61,10 @@ fn verdict(path: &Path) -> (usize, bool) {
     let complex = apatch::scene::build_complex(&scene).unwrap();
     let hull = apatch::scene::inner_hull(&scene).unwrap().unwrap();
     let violations = inner::verify(&hull).len();
-    (
-        violations,
-        check(&complex, &CheckOptions::default()).passed(),
-    )
+    let passed = check(&complex, &CheckOptions::default()).passed();
+    // The scene's directory is this test's own (`write_scene`).
+    std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    (violations, passed)
 }
 
 /// A crease ring of near-duplicate vertices (1e-3 apart, flat or bent slivers) fails as it is:

@@ -94,21 +94,24 @@ fn twisted_prisms_build_and_verify_after_the_split() {
         }
         assert!(s.faces.iter().all(|f| f.against == 0 && f.triangles == 2));
 
-        let scene = apatch::scene::load(&write_scene(name, &m, "")).unwrap();
+        let path = write_scene(name, &m, "");
+        let scene = apatch::scene::load(&path).unwrap();
         let complex = apatch::scene::build_complex(&scene).unwrap();
         let hull = apatch::scene::inner_hull(&scene).unwrap().unwrap();
         let violations = inner::verify(&hull);
         assert!(violations.is_empty(), "{name}: {violations:?}");
         let report = check(&complex, &CheckOptions::default());
         assert!(report.passed(), "{name}: {report}");
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
 
-        let strict = write_scene(&format!("{name}_nosplit"), &m, "planar_tolerance = false");
-        let strict = apatch::scene::load(&strict).unwrap();
+        let path = write_scene(&format!("{name}_nosplit"), &m, "planar_tolerance = false");
+        let strict = apatch::scene::load(&path).unwrap();
         let hull = apatch::scene::inner_hull(&strict).unwrap().unwrap();
         assert!(
             !inner::verify(&hull).is_empty(),
             "{name}: the unsplit hull verified"
         );
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 }
 
