@@ -916,11 +916,15 @@ pub(super) fn refine_near<F: NormalSolve>(
                         eprintln!("quintic-c2: could not save the sign fit: {e:#}");
                     }
                 }
-                if meet && got > tol {
+                // Exploration (`APATCH_MEET_TOL=t`): the meet after the fit stops once the rows
+                // are met to t instead of the solve's tolerance (what the check's jump bounds
+                // need may be less than what the solve asks, and every row met is a move).
+                let meet_tol = positive_env("APATCH_MEET_TOL").unwrap_or(tol);
+                if meet && got > meet_tol {
                     drop(basis);
                     let weights = meet_weights_override().unwrap_or(MEET_OWN_WEIGHTS.to_vec());
                     let q;
-                    (got, q) = meet_dropped(unit, f, &mut x, tol, &weights);
+                    (got, q) = meet_dropped(unit, f, &mut x, meet_tol, &weights);
                     // Exploration (`APATCH_FIT_CYCLES=n`): the fit and the meet in turns.
                     if let Some(cycles) = positive_env("APATCH_FIT_CYCLES") {
                         got = fit_meet_cycles(

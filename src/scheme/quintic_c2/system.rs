@@ -1512,6 +1512,29 @@ impl System {
                 .zip(&g.c)
                 .map(|(row, c)| (row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c).abs())
                 .fold(0.0, f64::max);
+            if let Some(path) = std::env::var_os("APATCH_ROW_DUMP") {
+                // Opt-in exploration: the group's rows these values miss beyond its solve's
+                // tolerance, one line each: row, residual, |row|, then every term's
+                // tetrahedron (the complex's patch order), multi-index and coefficient.
+                let tol = 1e-13 * g.scale;
+                let mut out = String::new();
+                for (i, (row, c)) in g.rows.iter().zip(&g.c).enumerate().take(g.m) {
+                    let r = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
+                    if r.abs() <= tol {
+                        continue;
+                    }
+                    let norm = row.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt();
+                    out.push_str(&format!("{i} {r:e} {norm:e}"));
+                    for &(j, k) in row {
+                        let (t, l) = self.home[g.unk[j] as usize];
+                        out.push_str(&format!(" {t}:{}{}{}{}:{k:e}", l[0], l[1], l[2], l[3]));
+                    }
+                    out.push('\n');
+                }
+                if let Err(e) = std::fs::write(&path, out) {
+                    eprintln!("quintic-c2: row dump not written: {e}");
+                }
+            }
             let rank = g.m.min(x.len());
             return (dense::Solution { x, rank, residual }, 0, 0);
         }
