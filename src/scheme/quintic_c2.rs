@@ -129,6 +129,15 @@ pub struct QuinticOptions {
     /// weight's miss only loosens Theorem 2.1's certificate; `apatch check --holes` names the
     /// boundary faces' misses (docs/quintic.md, session 55).
     pub joint_sign_boundary: f64,
+    /// With `joint_sign_fit`: the miss, relative to the group's scale, to which the meet
+    /// after the fit meets the rows its factor dropped (0, the default: the solve's own
+    /// tolerance, 1e-13). Those rows lie within ~1e-11 of the kept rows' span, so the meet's
+    /// moves are long (1e-2) and take the fit's weights off their signs, while the check's
+    /// Hessian jump (bound 1e-7) follows the rows' miss at ~5e4 times it: fandisk, met to
+    /// 2e-12 of its scale instead of 1e-13, keeps C2 (gradient 3.0e-10, Hessian 6.8e-8) with
+    /// 494 crossed faces and 59 j-sheet patches instead of 623 and 69 (session 63). At most
+    /// [`MAX_JOINT_MEET_TOLERANCE`].
+    pub joint_meet_tolerance: f64,
     /// β of the shared faces in the C1/C2 rows ([`beta::FaceBeta`]): `"f64"` (the default,
     /// the f64 barycentric map), `"exact"` (double-double from the stored points) or
     /// `"snapped"` (exact, with the construction's zeros and integers restored: the edge
@@ -197,6 +206,7 @@ impl Default for QuinticOptions {
             joint_sign_rounds: 0,
             joint_sign_fit: 0,
             joint_sign_boundary: 1.0,
+            joint_meet_tolerance: 0.0,
             face_beta: beta::FaceBeta::F64,
             precise_pivot: None,
             relax_stars: true,
@@ -237,6 +247,11 @@ pub const MAX_REPAIR_WIDEN: usize = 8;
 /// the row, so 1e-6 drops rows up to 1e-3 of their length from the span of the others, which
 /// are independent rows for the factor to keep, not rounding for the meet to mend.
 pub const MAX_PRECISE_PIVOT: f64 = 1e-6;
+
+/// The largest [`QuinticOptions::joint_meet_tolerance`]: the check's gradient and Hessian
+/// jumps follow the joint group's row misses at ~200 and ~5e4 times them (fandisk), so rows
+/// met to 1e-10 of the scale already break C2's bounds (1e-9, 1e-7) by far.
+pub const MAX_JOINT_MEET_TOLERANCE: f64 = 1e-10;
 
 /// Default [`QuinticOptions::lift`].
 pub const LIFT: f64 = 3.0;
@@ -349,6 +364,18 @@ impl QuinticOptions {
                         scene.display()
                     ),
                 },
+                "joint_meet_tolerance" => match v
+                    .as_float()
+                    .or_else(|| v.as_integer().map(|i| i as f64))
+                {
+                    Some(t) if (0.0..=MAX_JOINT_MEET_TOLERANCE).contains(&t) => {
+                        o.joint_meet_tolerance = t;
+                    }
+                    _ => bail!(
+                        "{}: `scheme.joint_meet_tolerance` must be a number in [0, {MAX_JOINT_MEET_TOLERANCE:e}], got {v}",
+                        scene.display()
+                    ),
+                },
                 "face_beta" => {
                     o.face_beta = match v.as_str().and_then(beta::FaceBeta::named) {
                         Some(m) => m,
@@ -381,7 +408,7 @@ impl QuinticOptions {
                     }
                 }
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -513,6 +540,7 @@ pub fn build_prepared(
     sys.joint_sign_rounds = options.joint_sign_rounds;
     sys.joint_sign_fit = options.joint_sign_fit;
     sys.joint_sign_boundary = options.joint_sign_boundary;
+    sys.joint_meet_tolerance = options.joint_meet_tolerance;
     sys.precise_pivot = options.precise_pivot;
     if let Some(path) = resume::restage_requested() {
         // Exploration: the joint group's values read back, the stages after it solved again.

@@ -261,6 +261,37 @@ fn joint_sign_boundary_key_is_read_and_checked() {
     }
 }
 
+/// `[scheme] joint_meet_tolerance` is the miss (relative to the group's scale) the meet
+/// after the joint sign fit stops at, 0 by default (the solve's own); negative, above 1e-10
+/// or not a number is an error naming the scene and the key.
+#[test]
+fn joint_meet_tolerance_key_is_read_and_checked() {
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert_eq!(read("").unwrap().joint_meet_tolerance, 0.0);
+    assert_eq!(
+        read("joint_meet_tolerance = 2e-12")
+            .unwrap()
+            .joint_meet_tolerance,
+        2e-12
+    );
+    assert_eq!(
+        read("joint_meet_tolerance = 0")
+            .unwrap()
+            .joint_meet_tolerance,
+        0.0
+    );
+    for bad in ["-1e-12", "1e-9", "1", "\"x\""] {
+        let e = read(&format!("joint_meet_tolerance = {bad}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("joint_meet_tolerance"),
+            "{e}"
+        );
+    }
+}
+
 /// `[scheme] precise_pivot` is the double-double factor's one drop threshold, unset by
 /// default (1e-15, then 1e-12); zero, negative, above 1e-6 or not a number is an error naming
 /// the scene and the key.

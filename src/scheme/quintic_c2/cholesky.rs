@@ -893,7 +893,7 @@ pub(super) fn refine_near<F: NormalSolve>(
             let bound = if best.0 <= tol { tol } else { 10.0 * best.0 };
             // Exploration (`APATCH_JOINT_FIT_BOUND`): a fit kept up to another miss, so that
             // `check` can say what a miss beyond the bound does to the jumps.
-            let bound = positive_env("APATCH_JOINT_FIT_BOUND").unwrap_or(bound);
+            let bound = positive_env("APATCH_JOINT_FIT_BOUND").unwrap_or(bound.max(sb.meet_tol));
             let mut x = best.1.clone();
             let loose = if meet { f64::INFINITY } else { bound };
             let was_loaded = loaded.is_some();
@@ -916,10 +916,10 @@ pub(super) fn refine_near<F: NormalSolve>(
                         eprintln!("quintic-c2: could not save the sign fit: {e:#}");
                     }
                 }
-                // Exploration (`APATCH_MEET_TOL=t`): the meet after the fit stops once the rows
-                // are met to t instead of the solve's tolerance (what the check's jump bounds
-                // need may be less than what the solve asks, and every row met is a move).
-                let meet_tol = positive_env("APATCH_MEET_TOL").unwrap_or(tol);
+                // The meet after the fit stops at the scene's `joint_meet_tolerance` (or, for
+                // exploration, `APATCH_MEET_TOL=t`, absolute) where that is looser than the
+                // solve's: every row met is a move, and the last rows cost the most signs.
+                let meet_tol = positive_env("APATCH_MEET_TOL").unwrap_or(tol.max(sb.meet_tol));
                 if meet && got > meet_tol {
                     drop(basis);
                     let weights = meet_weights_override().unwrap_or(MEET_OWN_WEIGHTS.to_vec());
@@ -1108,6 +1108,10 @@ pub struct SignBox {
     /// Rounds of the split sign program after the dropped rows are met
     /// ([`super::signsplit::fit`]; 0 = none).
     pub fit: usize,
+    /// The miss (max |A x − c|, the group's data units) to which the meet after the split
+    /// sign program meets the dropped rows, if above the solve's tolerance (0: that
+    /// tolerance); a fit whose meet reaches it is kept.
+    pub meet_tol: f64,
 }
 
 impl SignBox {

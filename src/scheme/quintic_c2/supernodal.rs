@@ -815,6 +815,7 @@ mod tests {
             margin: 0.1,
             rounds: 300,
             fit: 0,
+            meet_tol: 0.0,
         };
         let plain = solve_near(&rows, n, &c, &target, tol, MAX_VALUES).expect("small");
         let signed_sol = solve_near_signed(&rows, n, &c, &target, tol, MAX_VALUES, Some(&sb), None)
@@ -896,6 +897,7 @@ mod tests {
                 margin: 0.1,
                 rounds,
                 fit,
+                meet_tol: 0.0,
             };
             let solve = |b: Option<cholesky::SignBox>| {
                 let (r, c, t) = (&sys.rows, &sys.c, &sys.target);
@@ -937,6 +939,7 @@ mod tests {
                 margin: 0.1,
                 rounds: 0,
                 fit: 100,
+                meet_tol: 0.0,
             };
             let (r, c, t) = (&sys.rows, &sys.c, &sys.target);
             let x = solve_near_signed(r, n, c, t, tol, MAX_VALUES, Some(&sb), None)
@@ -955,6 +958,58 @@ mod tests {
         let weighed = fit(costly.iter().map(|&k| if k { 10.0 } else { 1.0 }).collect());
         eprintln!("off (costly, the rest): plain {plain:?}, weighed {weighed:?}");
         assert!(weighed.0 < plain.0, "{plain:?} -> {weighed:?}");
+    }
+
+    /// `SignBox::meet_tol` (`joint_meet_tolerance`): the meet after the split sign program
+    /// stops once the rows are met to it, and that fit is kept. The signed system of the tests
+    /// above with 20 rows 1e-9 off others (dropped by the double-double factor, data
+    /// consistent): the fit's move (~1 a weight) makes them missed, so the meet after it has
+    /// rows to meet; with the solve's tolerance it meets them all, with 1e-10 it stops between.
+    #[test]
+    fn the_meet_after_the_fit_stops_at_its_tolerance() {
+        let (tol, n, delta) = (1e-13, 600, 1e-9);
+        let sys = signed_system(500, n, 6, 1, -0.25);
+        let x0 = solve_near(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES)
+            .expect("small")
+            .x;
+        let (mut rows, mut c) = (sys.rows.clone(), sys.c.clone());
+        let mut seed = 43_u64;
+        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
+        for k in 0..20 {
+            let i = 25 * k;
+            let j = ((lcg(&mut seed) + 1.0) * 0.5 * n as f64) as usize % n;
+            let mut row = rows[i].clone();
+            row.push((j, delta));
+            rows.push(row);
+            c.push(c[i] + delta * x0[j]);
+        }
+        let unit = UnitRows::new(&rows, &c);
+        let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
+        let solve = |meet_tol| {
+            let sb = cholesky::SignBox {
+                signed: sys.signed.clone(),
+                cost: Vec::new(),
+                margin: 0.1,
+                rounds: 0,
+                fit: 100,
+                meet_tol,
+            };
+            let drops = [cholesky::PRECISE_PIVOT];
+            let (got, x, dropped) =
+                cholesky::refine_near(&unit, &sys.target, tol, &drops, true, Some(&sb), |d| {
+                    normal.factor::<fx128>(d).map(with_dropped)
+                })
+                .expect("small");
+            assert_eq!(dropped, 20, "the near rows are the ones dropped");
+            (got, sb.off(&x, 1e-12))
+        };
+        let (full, loose) = (solve(0.0), solve(1e-10));
+        eprintln!(
+            "full meet: residual {:e}, {} off; to 1e-10: {:e}, {} off",
+            full.0, full.1, loose.0, loose.1
+        );
+        assert!(full.0 <= tol, "{:e}", full.0);
+        assert!(loose.0 > tol && loose.0 <= 1e-10, "{:e}", loose.0);
     }
 
     /// A long move whose projection onto the rows' null space was rounded (here: 1e-6 of a
@@ -1071,6 +1126,7 @@ mod tests {
             margin: 0.1,
             rounds: 0,
             fit: 100,
+            meet_tol: 0.0,
         };
         let fit = |q: &[Vec<f64>]| {
             let mut y = x.clone();

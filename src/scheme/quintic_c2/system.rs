@@ -202,6 +202,9 @@ pub struct System {
     /// Cost of a boundary slot's sign miss in the split sign program, in units of an inner
     /// one's (`QuinticOptions::joint_sign_boundary`, 1 = all alike).
     pub joint_sign_boundary: f64,
+    /// The miss, relative to a group's scale, to which the meet after its split sign program
+    /// meets the dropped rows (`QuinticOptions::joint_meet_tolerance`; 0 = the solve's).
+    pub joint_meet_tolerance: f64,
     /// The double-double factor's one drop threshold for groups beyond the in-house factor
     /// (`QuinticOptions::precise_pivot`; `None`: [`super::cholesky::PRECISE_PIVOT`], then
     /// [`super::supernodal::PRECISE_RETRY_PIVOT`]).
@@ -334,6 +337,7 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
         joint_sign_rounds: 0,
         joint_sign_fit: 0,
         joint_sign_boundary: 1.0,
+        joint_meet_tolerance: 0.0,
         precise_pivot: None,
         preset: None,
     })
@@ -1661,6 +1665,7 @@ impl System {
             margin: per * median,
             rounds: self.joint_sign_rounds,
             fit: self.joint_sign_fit,
+            meet_tol: self.joint_meet_tolerance * g.scale,
         }
     }
 
