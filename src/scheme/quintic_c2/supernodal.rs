@@ -960,6 +960,30 @@ mod tests {
         assert!(weighed.0 < plain.0, "{plain:?} -> {weighed:?}");
     }
 
+    /// `sys`'s rows and right-hand side with 20 near rows appended: every 25th row with one
+    /// entry of `delta` added (a random column, from `seed`), its datum consistent with `x0`;
+    /// and the seed after those draws.
+    fn with_near_rows(
+        sys: &SignedSystem,
+        x0: &[f64],
+        delta: f64,
+        seed: u64,
+    ) -> (Vec<Row>, Vec<f64>, u64) {
+        let n = x0.len();
+        let (mut rows, mut c) = (sys.rows.clone(), sys.c.clone());
+        let mut seed = seed;
+        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
+        for k in 0..20 {
+            let i = 25 * k;
+            let j = ((lcg(&mut seed) + 1.0) * 0.5 * n as f64) as usize % n;
+            let mut row = rows[i].clone();
+            row.push((j, delta));
+            rows.push(row);
+            c.push(c[i] + delta * x0[j]);
+        }
+        (rows, c, seed)
+    }
+
     /// `SignBox::meet_tol` (`joint_meet_tolerance`): the meet after the split sign program
     /// stops once the rows are met to it, and that fit is kept. The signed system of the tests
     /// above with 20 rows 1e-9 off others (dropped by the double-double factor, data
@@ -972,17 +996,7 @@ mod tests {
         let x0 = solve_near(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES)
             .expect("small")
             .x;
-        let (mut rows, mut c) = (sys.rows.clone(), sys.c.clone());
-        let mut seed = 43_u64;
-        let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
-        for k in 0..20 {
-            let i = 25 * k;
-            let j = ((lcg(&mut seed) + 1.0) * 0.5 * n as f64) as usize % n;
-            let mut row = rows[i].clone();
-            row.push((j, delta));
-            rows.push(row);
-            c.push(c[i] + delta * x0[j]);
-        }
+        let (rows, c, _) = with_near_rows(&sys, &x0, delta, 43);
         let unit = UnitRows::new(&rows, &c);
         let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
         let solve = |meet_tol| {
@@ -1091,18 +1105,8 @@ mod tests {
         )
         .expect("small")
         .x;
-        // The near rows, consistent with x0.
-        let (mut rows, mut c) = (sys.rows.clone(), sys.c.clone());
-        let mut seed = 41_u64;
+        let (rows, c, mut seed) = with_near_rows(&sys, &x0, delta, 41);
         let lcg = crate::scheme::quintic_c2::cholesky::tests::lcg;
-        for k in 0..20 {
-            let i = 25 * k;
-            let j = ((lcg(&mut seed) + 1.0) * 0.5 * n as f64) as usize % n;
-            let mut row = rows[i].clone();
-            row.push((j, delta));
-            rows.push(row);
-            c.push(c[i] + delta * x0[j]);
-        }
         let unit = UnitRows::new(&rows, &c);
         let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
         let (f, dropped) = normal
