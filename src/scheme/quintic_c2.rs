@@ -283,19 +283,20 @@ impl QuinticOptions {
                         )
                     })
             };
+            // Every numeric key: a float or an integer, finite, in the key's range.
+            let number = |in_range: &dyn Fn(f64) -> bool, what: &str| -> anyhow::Result<f64> {
+                match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
+                    Some(x) if x.is_finite() && in_range(x) => Ok(x),
+                    _ => Err(anyhow::anyhow!(
+                        "{}: `scheme.{k}` must be {what}, got {v}",
+                        scene.display()
+                    )),
+                }
+            };
             match k.as_str() {
                 "type" => {}
                 k if crate::hull::inner::InnerOptions::KEYS.contains(&k) => {}
-                "lift" => {
-                    let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
-                    match x {
-                        Some(x) if x.is_finite() && x >= 0.0 => o.lift = x,
-                        _ => bail!(
-                            "{}: `scheme.lift` must be a number ≥ 0, got {v}",
-                            scene.display()
-                        ),
-                    }
-                }
+                "lift" => o.lift = number(&|x| x >= 0.0, "a number ≥ 0")?,
                 "complete_lu_pairs" => o.complete_lu_pairs = flag()?,
                 "joint_stars" => o.joint_stars = flag()?,
                 "relax_stars" => o.relax_stars = flag()?,
@@ -330,52 +331,30 @@ impl QuinticOptions {
                 "zero_groups" => o.zero_groups = flag()?,
                 "tangent_clearance" => {
                     let margin = crate::scheme::cubic_c1::tangent::TANGENT_MARGIN;
-                    match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
-                        Some(c) if (0.0..=margin).contains(&c) => o.tangent_clearance = c,
-                        _ => bail!(
-                            "{}: `scheme.tangent_clearance` must be a number in [0, {margin}] (moved apexes get the slope {margin}), got {v}",
-                            scene.display()
-                        ),
-                    }
+                    o.tangent_clearance = number(
+                        &|c| (0.0..=margin).contains(&c),
+                        &format!("a number in [0, {margin}] (moved apexes get the slope {margin})"),
+                    )?;
                 }
-                "star_tau" => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
-                    Some(t) if (0.0..1.0).contains(&t) => o.star_tau = t,
-                    _ => bail!(
-                        "{}: `scheme.star_tau` must be a number in [0, 1), got {v}",
-                        scene.display()
-                    ),
-                },
-                "sign_targets" => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
-                    Some(t) if (0.0..=100.0).contains(&t) => o.sign_targets = t,
-                    _ => bail!(
-                        "{}: `scheme.sign_targets` must be a number in [0, 100], got {v}",
-                        scene.display()
-                    ),
-                },
+                "star_tau" => {
+                    o.star_tau = number(&|t| (0.0..1.0).contains(&t), "a number in [0, 1)")?;
+                }
+                "sign_targets" => {
+                    o.sign_targets =
+                        number(&|t| (0.0..=100.0).contains(&t), "a number in [0, 100]")?;
+                }
                 "joint_sign_rounds" => o.joint_sign_rounds = count()?,
                 "joint_sign_fit" => o.joint_sign_fit = count()?,
-                "joint_sign_boundary" => match v
-                    .as_float()
-                    .or_else(|| v.as_integer().map(|i| i as f64))
-                {
-                    Some(t) if (1.0..=1e6).contains(&t) => o.joint_sign_boundary = t,
-                    _ => bail!(
-                        "{}: `scheme.joint_sign_boundary` must be a number in [1, 1e6], got {v}",
-                        scene.display()
-                    ),
-                },
-                "joint_meet_tolerance" => match v
-                    .as_float()
-                    .or_else(|| v.as_integer().map(|i| i as f64))
-                {
-                    Some(t) if (0.0..=MAX_JOINT_MEET_TOLERANCE).contains(&t) => {
-                        o.joint_meet_tolerance = t;
-                    }
-                    _ => bail!(
-                        "{}: `scheme.joint_meet_tolerance` must be a number in [0, {MAX_JOINT_MEET_TOLERANCE:e}], got {v}",
-                        scene.display()
-                    ),
-                },
+                "joint_sign_boundary" => {
+                    o.joint_sign_boundary =
+                        number(&|t| (1.0..=1e6).contains(&t), "a number in [1, 1e6]")?;
+                }
+                "joint_meet_tolerance" => {
+                    o.joint_meet_tolerance = number(
+                        &|t| (0.0..=MAX_JOINT_MEET_TOLERANCE).contains(&t),
+                        &format!("a number in [0, {MAX_JOINT_MEET_TOLERANCE:e}]"),
+                    )?;
+                }
                 "face_beta" => {
                     o.face_beta = match v.as_str().and_then(beta::FaceBeta::named) {
                         Some(m) => m,
@@ -386,27 +365,14 @@ impl QuinticOptions {
                         ),
                     }
                 }
-                "precise_pivot" => match v
-                    .as_float()
-                    .or_else(|| v.as_integer().map(|i| i as f64))
-                {
-                    Some(t) if t > 0.0 && t <= MAX_PRECISE_PIVOT => o.precise_pivot = Some(t),
-                    _ => bail!(
-                        "{}: `scheme.precise_pivot` must be a number in (0, {MAX_PRECISE_PIVOT:e}], got {v}",
-                        scene.display()
-                    ),
-                },
-                "signs" => o.signs = flag()?,
-                "curvature" => {
-                    let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
-                    match x {
-                        Some(x) if x.is_finite() && x >= 0.0 => o.curvature = x,
-                        _ => bail!(
-                            "{}: `scheme.curvature` must be a number ≥ 0, got {v}",
-                            scene.display()
-                        ),
-                    }
+                "precise_pivot" => {
+                    o.precise_pivot = Some(number(
+                        &|t| t > 0.0 && t <= MAX_PRECISE_PIVOT,
+                        &format!("a number in (0, {MAX_PRECISE_PIVOT:e}]"),
+                    )?);
                 }
+                "signs" => o.signs = flag()?,
+                "curvature" => o.curvature = number(&|x| x >= 0.0, "a number ≥ 0")?,
                 other => bail!(
                     "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),

@@ -292,6 +292,46 @@ fn joint_meet_tolerance_key_is_read_and_checked() {
     }
 }
 
+/// Every numeric quintic key takes a float or an integer in its range and refuses NaN, the
+/// infinities, text and booleans with one message naming the scene, the key and "must be a
+/// number"; an in-range value is read back as given.
+#[test]
+fn every_number_key_is_read_and_refuses_non_numbers() {
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    type Get = fn(&QuinticOptions) -> f64;
+    let keys: [(&str, &str, f64, Get); 8] = [
+        ("lift", "4", 4.0, |o| o.lift),
+        ("curvature", "0.5", 0.5, |o| o.curvature),
+        ("tangent_clearance", "0.01", 0.01, |o| o.tangent_clearance),
+        ("star_tau", "0.25", 0.25, |o| o.star_tau),
+        ("sign_targets", "2", 2.0, |o| o.sign_targets),
+        ("joint_sign_boundary", "10", 10.0, |o| o.joint_sign_boundary),
+        ("joint_meet_tolerance", "2e-12", 2e-12, |o| {
+            o.joint_meet_tolerance
+        }),
+        ("precise_pivot", "1e-12", 1e-12, |o| {
+            o.precise_pivot.unwrap_or(f64::NAN)
+        }),
+    ];
+    for (key, good, value, get) in keys {
+        assert_eq!(
+            get(&read(&format!("{key} = {good}")).unwrap()),
+            value,
+            "{key}"
+        );
+        for bad in ["nan", "inf", "-inf", "\"x\"", "true", "[1]"] {
+            let e = read(&format!("{key} = {bad}")).unwrap_err().to_string();
+            assert!(
+                e.contains("scenes/x.toml")
+                    && e.contains(&format!("`scheme.{key}` must be a number"))
+                    && e.contains(&format!("got {bad}")),
+                "{key} = {bad}: {e}"
+            );
+        }
+    }
+}
+
 /// `[scheme] precise_pivot` is the double-double factor's one drop threshold, unset by
 /// default (1e-15, then 1e-12); zero, negative, above 1e-6 or not a number is an error naming
 /// the scene and the key.
