@@ -17,6 +17,7 @@ pub mod flat;
 pub mod holes;
 pub mod interior;
 pub mod jets;
+pub mod localmeet;
 pub mod ordering;
 mod pinned;
 pub mod project;
@@ -138,6 +139,14 @@ pub struct QuinticOptions {
     /// 494 crossed faces and 59 j-sheet patches instead of 623 and 69 (session 63). At most
     /// [`MAX_JOINT_MEET_TOLERANCE`].
     pub joint_meet_tolerance: f64,
+    /// With `joint_sign_fit`: the rows the fit leaves missed are met region by region
+    /// ([`localmeet`]: the nearest unknowns free, a dense SVD's least move) instead of by the
+    /// group's factor, whose meet moves the weights by 1e-2 and takes their signs. On fandisk
+    /// the regions' rows have a clean gap between their exact dependencies (σ ~1e-15 of the
+    /// largest) and their constraints (σ above ~1e-9), and their moves are 1e-10 … 1e-6
+    /// (session 64). Off by default. With it `joint_meet_tolerance` has no effect: the factor's
+    /// meet after the fit is not made.
+    pub joint_local_meet: bool,
     /// β of the shared faces in the C1/C2 rows ([`beta::FaceBeta`]): `"f64"` (the default,
     /// the f64 barycentric map), `"exact"` (double-double from the stored points) or
     /// `"snapped"` (exact, with the construction's zeros and integers restored: the edge
@@ -207,6 +216,7 @@ impl Default for QuinticOptions {
             joint_sign_fit: 0,
             joint_sign_boundary: 1.0,
             joint_meet_tolerance: 0.0,
+            joint_local_meet: false,
             face_beta: beta::FaceBeta::F64,
             precise_pivot: None,
             relax_stars: true,
@@ -355,6 +365,7 @@ impl QuinticOptions {
                         &format!("a number in [0, {MAX_JOINT_MEET_TOLERANCE:e}]"),
                     )?;
                 }
+                "joint_local_meet" => o.joint_local_meet = flag()?,
                 "face_beta" => {
                     o.face_beta = match v.as_str().and_then(beta::FaceBeta::named) {
                         Some(m) => m,
@@ -374,7 +385,7 @@ impl QuinticOptions {
                 "signs" => o.signs = flag()?,
                 "curvature" => o.curvature = number(&|x| x >= 0.0, "a number ≥ 0")?,
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -507,6 +518,7 @@ pub fn build_prepared(
     sys.joint_sign_fit = options.joint_sign_fit;
     sys.joint_sign_boundary = options.joint_sign_boundary;
     sys.joint_meet_tolerance = options.joint_meet_tolerance;
+    sys.joint_local_meet = options.joint_local_meet;
     sys.precise_pivot = options.precise_pivot;
     if let Some(path) = resume::restage_requested() {
         // Exploration: the joint group's values read back, the stages after it solved again.

@@ -17,7 +17,8 @@ use std::path::Path;
 /// interior point method), `TANGENT_CLEARANCE` the quintic's `tangent_clearance`,
 /// `SIGN_TARGETS` its `sign_targets`, `JOINT_SIGN_ROUNDS` its `joint_sign_rounds`,
 /// `JOINT_SIGN_FIT` its `joint_sign_fit`, `JOINT_SIGN_BOUNDARY` its
-/// `joint_sign_boundary`, `JOINT_MEET_TOLERANCE` its `joint_meet_tolerance`, `REPAIR_WIDEN` its `repair_widen` (to explore).
+/// `joint_sign_boundary`, `JOINT_MEET_TOLERANCE` its `joint_meet_tolerance`, `JOINT_LOCAL_MEET=1` its
+/// `joint_local_meet`, `REPAIR_WIDEN` its `repair_widen` (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -72,6 +73,7 @@ fn options() -> QuinticOptions {
             .ok()
             .and_then(|x| x.parse().ok())
             .unwrap_or(0.0),
+        joint_local_meet: std::env::var("JOINT_LOCAL_MEET").is_ok_and(|s| s == "1"),
         // The default rows; `APATCH_FACE_BETA` picks others here as in any build.
         face_beta: apatch::scheme::quintic_c2::beta::FaceBeta::default(),
         // The default thresholds; `APATCH_PRECISE_PIVOT` picks another here as in any build.

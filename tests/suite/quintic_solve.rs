@@ -292,6 +292,27 @@ fn joint_meet_tolerance_key_is_read_and_checked() {
     }
 }
 
+/// `[scheme] joint_local_meet` is a flag, off by default; anything but true or false is an
+/// error naming the scene and the key.
+#[test]
+fn joint_local_meet_key_is_read_and_checked() {
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert!(!read("").unwrap().joint_local_meet);
+    assert!(read("joint_local_meet = true").unwrap().joint_local_meet);
+    assert!(!read("joint_local_meet = false").unwrap().joint_local_meet);
+    for bad in ["1", "\"yes\"", "2e-12"] {
+        let e = read(&format!("joint_local_meet = {bad}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("scenes/x.toml")
+                && e.contains("`scheme.joint_local_meet` must be true or false"),
+            "{e}"
+        );
+    }
+}
+
 /// Every numeric quintic key takes a float or an integer in its range and refuses NaN, the
 /// infinities, text and booleans with one message naming the scene, the key and "must be a
 /// number"; an in-range value is read back as given.

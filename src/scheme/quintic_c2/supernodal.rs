@@ -1026,6 +1026,60 @@ mod tests {
         assert!(loose.0 > tol && loose.0 <= 1e-10, "{:e}", loose.0);
     }
 
+    /// `joint_local_meet`: the fit kept without the factor's meet (`SignBox::meet_tol`
+    /// infinite, as the scene key sets it) leaves the near rows missed, and
+    /// [`super::super::localmeet::meet`] meets them to the solve's tolerance afterwards,
+    /// moving only what they ask (the system of the test above, one region of every unknown).
+    #[test]
+    fn the_local_meet_meets_what_a_fit_without_its_meet_leaves() {
+        let (tol, n, delta) = (1e-13, 600, 1e-9);
+        let sys = signed_system(500, n, 6, 1, -0.25);
+        let x0 = solve_near(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES)
+            .expect("small")
+            .x;
+        let (rows, c, _) = with_near_rows(&sys, &x0, delta, 43);
+        let unit = UnitRows::new(&rows, &c);
+        let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
+        let sb = cholesky::SignBox {
+            signed: sys.signed.clone(),
+            cost: Vec::new(),
+            margin: 0.1,
+            rounds: 0,
+            fit: 100,
+            meet_tol: f64::INFINITY,
+        };
+        let drops = [cholesky::PRECISE_PIVOT];
+        let (got, mut x, _) =
+            cholesky::refine_near(&unit, &sys.target, tol, &drops, true, Some(&sb), |d| {
+                normal.factor::<fx128>(d).map(with_dropped)
+            })
+            .expect("small");
+        assert!(
+            got > 1e3 * tol,
+            "the fit's move reached the near rows: {got:e}"
+        );
+        let fitted = x.clone();
+        // Positions play no part when one region holds every unknown.
+        let pos = vec![glam::DVec3::ZERO; n];
+        let out = super::super::localmeet::meet(&rows, &c, &mut x, &pos, tol, n, f64::INFINITY);
+        let miss = rows
+            .iter()
+            .zip(&c)
+            .map(|(row, c)| (row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c).abs())
+            .fold(0.0_f64, f64::max);
+        eprintln!("fit kept at {got:e}; local meet: {out:?}, rows missed by {miss:e}");
+        assert_eq!(out.worst_after, miss, "the miss reported is x's");
+        assert!(miss <= tol, "{miss:e}");
+        assert!(out.missed_before > 0 && out.missed_after == 0, "{out:?}");
+        // The move is the least that meets the rows: the miss over the near rows' distance
+        // (1e-9) from the others, at most ~1e2 times the fit's miss of each.
+        let moved = x
+            .iter()
+            .zip(&fitted)
+            .fold(0.0_f64, |a, (p, q)| a.max((p - q).abs()));
+        assert!(moved > 0.0 && moved <= got / delta * 1e2, "{moved:e}");
+    }
+
     /// A long move whose projection onto the rows' null space was rounded (here: 1e-6 of a
     /// row-space vector added to it) is settled back onto the rows by `signsplit::settle`
     /// (the sign fit's last step), its null-space part kept; a settled move is left as it is.

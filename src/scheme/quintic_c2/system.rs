@@ -178,6 +178,8 @@ pub struct System {
     pub(super) keys: Vec<u128>,
     /// One tetrahedron and multi-index per slot (for targets).
     home: Vec<(u32, [u8; 4])>,
+    /// Domain point of every slot (where [`super::localmeet`] finds a row's neighbours).
+    pos: Vec<DVec3>,
     pub(super) equations: Vec<Equation>,
     /// Number of points of T (global ids below are points of T).
     pub(super) np: u32,
@@ -205,6 +207,9 @@ pub struct System {
     /// The miss, relative to a group's scale, to which the meet after its split sign program
     /// meets the dropped rows (`QuinticOptions::joint_meet_tolerance`; 0 = the solve's).
     pub joint_meet_tolerance: f64,
+    /// Whether the rows a group's sign fit leaves missed are met region by region
+    /// (`QuinticOptions::joint_local_meet`, [`super::localmeet`]) instead of by its factor.
+    pub joint_local_meet: bool,
     /// The double-double factor's one drop threshold for groups beyond the in-house factor
     /// (`QuinticOptions::precise_pivot`; `None`: [`super::cholesky::PRECISE_PIVOT`], then
     /// [`super::supernodal::PRECISE_RETRY_PIVOT`]).
@@ -324,10 +329,18 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
         // Opt-in report on stderr (exploration; results unaffected).
         eprintln!("quintic-c2: {stable_swaps} faces written from the thicker tetrahedron");
     }
+    let pos = home
+        .iter()
+        .map(|&(t, l)| {
+            let p = &tets[t as usize].pts;
+            (0..4).map(|v| p[v] * f64::from(l[v])).sum::<DVec3>() / N as f64
+        })
+        .collect();
     Ok(System {
         slot_of,
         keys,
         home,
+        pos,
         equations,
         np,
         req,
@@ -338,10 +351,21 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
         joint_sign_fit: 0,
         joint_sign_boundary: 1.0,
         joint_meet_tolerance: 0.0,
+        joint_local_meet: false,
         precise_pivot: None,
         preset: None,
     })
 }
+
+/// Unknowns free in one region of the local meet ([`super::localmeet`]): on fandisk
+/// (session 64) ~2000 around a missed row met it to ~1e-14, with a dense SVD of ~2300 rows.
+/// `APATCH_LOCAL_MEET_SIZE` overrides it (exploration).
+pub const LOCAL_MEET_SIZE: usize = 2000;
+
+/// Longest move of one region of the local meet, relative to the group's scale: the fit
+/// leaves its signed weights ~1e-5 inside their signs, and fandisk's regions move by at most
+/// ~3e-7, so a region asking more is not meeting rounding-level misses and is refused.
+pub const LOCAL_MEET_MOVE: f64 = 1e-4;
 
 /// Largest |barycentric| of B's opposite vertex in A above which a face's C1/C2 equations are
 /// written from the other side when that side's is smaller ([`assemble`]). Adjacent thick
@@ -1506,10 +1530,14 @@ impl System {
                     .map_err(|e| eprintln!("quintic-c2: saved sign fit not used: {e}"))
                     .ok()
             });
-            let x: Vec<f64> = match fitted {
+            let mut x: Vec<f64> = match fitted {
                 Some((_, x)) => x,
                 None => g.unk.iter().map(|&s| v[s as usize]).collect(),
             };
+            if self.joint_local_meet && std::env::var_os("APATCH_RESTAGE_FIT").is_some() {
+                // A saved fit taken up: its missed rows met as the run would meet them.
+                self.meet_locally(g, &mut x);
+            }
             let residual = g
                 .rows
                 .iter()
@@ -1537,6 +1565,40 @@ impl System {
                 }
                 if let Err(e) = std::fs::write(&path, out) {
                     eprintln!("quintic-c2: row dump not written: {e}");
+                }
+            }
+            if let Some(path) = std::env::var_os("APATCH_ROW_LOCAL") {
+                // Opt-in exploration: every row of the group with a term in the tetrahedra the
+                // file lists (ids, whitespace-separated), in the dump's format with each term's
+                // column in the group after its coefficient, written to the file's name +
+                // ".rows": a region's rows, to look for their near dependencies.
+                let tets: HashSet<u32> = std::fs::read_to_string(&path)
+                    .unwrap_or_default()
+                    .split_whitespace()
+                    .filter_map(|w| w.parse().ok())
+                    .collect();
+                let mut out = String::new();
+                for (i, (row, c)) in g.rows.iter().zip(&g.c).enumerate().take(g.m) {
+                    if !row
+                        .iter()
+                        .any(|&(j, _)| tets.contains(&self.home[g.unk[j] as usize].0))
+                    {
+                        continue;
+                    }
+                    let r = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
+                    let norm = row.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt();
+                    out.push_str(&format!("{i} {r:e} {norm:e}"));
+                    for &(j, k) in row {
+                        let (t, l) = self.home[g.unk[j] as usize];
+                        let at = format!("{t}:{}{}{}{}", l[0], l[1], l[2], l[3]);
+                        out.push_str(&format!(" {at}:{k:e}:{j}"));
+                    }
+                    out.push('\n');
+                }
+                let mut to = path.clone();
+                to.push(".rows");
+                if let Err(e) = std::fs::write(&to, out) {
+                    eprintln!("quintic-c2: local row dump not written: {e}");
                 }
             }
             let rank = g.m.min(x.len());
@@ -1591,6 +1653,9 @@ impl System {
                 self.precise_pivot,
             ),
         };
+        if signs.is_some() && self.joint_local_meet && sol.x.iter().all(|v| v.is_finite()) {
+            sol.residual = self.meet_locally(g, &mut sol.x);
+        }
         let (mut pinned, mut given_up) = (0, 0);
         // Beyond the in-house factor a group goes to the supernodal one, and every pin round
         // would factor it again (fandisk's joint group: 17 minutes, 16.5 GB each).
@@ -1618,6 +1683,40 @@ impl System {
             }
         }
         (sol, pinned, given_up)
+    }
+
+    /// Meets the rows of `g` that `x` misses beyond the solve's tolerance region by region
+    /// ([`super::localmeet`]); returns the largest miss left.
+    fn meet_locally(&self, g: &Group, x: &mut [f64]) -> f64 {
+        let pos: Vec<DVec3> = g.unk.iter().map(|&s| self.pos[s as usize]).collect();
+        let size = std::env::var("APATCH_LOCAL_MEET_SIZE")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(LOCAL_MEET_SIZE);
+        let out = super::localmeet::meet(
+            &g.rows[..g.m],
+            &g.c[..g.m],
+            x,
+            &pos,
+            1e-13 * g.scale,
+            size,
+            LOCAL_MEET_MOVE * g.scale,
+        );
+        if std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
+            // Opt-in report on stderr (exploration; results unaffected).
+            eprintln!(
+                "quintic-c2 local meet: {} unknowns, rows missed {} -> {} (worst {:.2e} -> {:.2e}), {} regions of {size}, {} kept, largest move {:.2e}",
+                g.unk.len(),
+                out.missed_before,
+                out.missed_after,
+                out.worst_before,
+                out.worst_after,
+                out.regions,
+                out.kept,
+                out.largest_move
+            );
+        }
+        out.worst_after
     }
 
     /// The sign box of `g`'s own weights that Theorem 2.1 asks a sign of, its margin
@@ -1665,7 +1764,13 @@ impl System {
             margin: per * median,
             rounds: self.joint_sign_rounds,
             fit: self.joint_sign_fit,
-            meet_tol: self.joint_meet_tolerance * g.scale,
+            // With the local meet, the factor's meet after the fit is skipped (and the fit
+            // kept): the regions meet what it leaves.
+            meet_tol: if self.joint_local_meet {
+                f64::INFINITY
+            } else {
+                self.joint_meet_tolerance * g.scale
+            },
         }
     }
 

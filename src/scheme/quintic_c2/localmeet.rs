@@ -1,0 +1,317 @@
+//! The rows of a large group that its solve leaves missed, met region by region
+//! (`[scheme] joint_local_meet`).
+//!
+//! A group beyond the dense solves (fandisk's joint group: 1.88M rows) is factored once with a
+//! drop threshold on its pivots, and its exactly dependent rows are told from its independent
+//! ones by that threshold alone. The sign fit then moves the weights in the kept rows' null
+//! space, and the dropped rows it reaches are missed (fandisk: 1013 rows, up to 3.5e-10).
+//! Meeting them with the same factor takes moves of 1e-2, which undo the fit's signs
+//! (docs/quintic.md, sessions 62–63). Around each missed row, though, the group's rows with
+//! the nearby unknowns free and the rest held have a clean gap in their singular values
+//! (session 64: exact dependencies at ~1e-15 of the largest, every other value above ~1e-9),
+//! which a dense SVD of the region resolves where a sparse factor's pivots cannot; its
+//! minimum-norm move meets every row of the region, the missed ones to ~1e-14, by moves of
+//! 1e-10 … 1e-6.
+//!
+//! A region is the `size` unknowns nearest (by their domain points) to the missed row, found
+//! through the rows; its rows are every row with a term in it, so rows outside see no change.
+//! A region's move is kept only if it lowers the region's worst miss and is no longer than
+//! `max_move`. Regions are solved one after another, worst row first, so the result does not
+//! depend on the thread count.
+
+use glam::DVec3;
+
+/// Singular values at or below this share of a region's largest are its rows' exact
+/// dependencies (rounding, ~1e-15 on fandisk); above it (~1e-9 and up) they are constraints.
+const RANK_CUT: f64 = 1e-11;
+/// Passes over the rows still missed: a region's move can leave a row at its edge missed
+/// (the held unknowns bind it) that a region centred on it meets.
+const PASSES: usize = 3;
+/// Unknowns gathered through the rows before the nearest `size` are taken: enough that the
+/// region is the nearest by distance, not the first reached.
+const GATHER: usize = 4;
+
+/// What [`meet`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LocalMeet {
+    /// Rows missed beyond the tolerance before and after.
+    pub missed_before: usize,
+    /// See `missed_before`.
+    pub missed_after: usize,
+    /// Largest |row · x − c| before and after.
+    pub worst_before: f64,
+    /// See `worst_before`.
+    pub worst_after: f64,
+    /// Regions solved, and of those, kept.
+    pub regions: usize,
+    /// See `regions`.
+    pub kept: usize,
+    /// Largest |Δx| of a kept region.
+    pub largest_move: f64,
+}
+
+/// Meets the rows of `rows` · x = `c` that `x` misses by more than `tol`, moving `x` region by
+/// region (module doc). `pos` is each unknown's domain point.
+#[must_use]
+pub fn meet(
+    rows: &[Vec<(usize, f64)>],
+    c: &[f64],
+    x: &mut [f64],
+    pos: &[DVec3],
+    tol: f64,
+    size: usize,
+    max_move: f64,
+) -> LocalMeet {
+    debug_assert_eq!(rows.len(), c.len());
+    debug_assert_eq!(x.len(), pos.len());
+    let n = x.len();
+    let mut rows_of: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (i, row) in rows.iter().enumerate() {
+        for &(j, _) in row {
+            rows_of[j].push(i as u32);
+        }
+    }
+    let miss = |i: usize, x: &[f64]| rows[i].iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c[i];
+    let mut r: Vec<f64> = (0..rows.len()).map(|i| miss(i, x)).collect();
+    let worst = |r: &[f64]| r.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let count = |r: &[f64]| r.iter().filter(|v| v.abs() > tol).count();
+    let mut out = LocalMeet {
+        missed_before: count(&r),
+        worst_before: worst(&r),
+        ..LocalMeet::default()
+    };
+    // Scratch marks, cleared after each region.
+    let mut in_region = vec![false; n];
+    let mut row_seen = vec![false; rows.len()];
+    for _ in 0..PASSES {
+        let mut missed: Vec<usize> = (0..rows.len()).filter(|&i| r[i].abs() > tol).collect();
+        if missed.is_empty() {
+            break;
+        }
+        missed.sort_by(|&a, &b| r[b].abs().total_cmp(&r[a].abs()).then(a.cmp(&b)));
+        let mut progress = false;
+        for i in missed {
+            if r[i].abs() <= tol {
+                continue;
+            }
+            let unknowns = region(i, rows, &rows_of, pos, size, &mut in_region);
+            let region_rows = rows_touching(&unknowns, &rows_of, &mut row_seen);
+            out.regions += 1;
+            let before = region_rows.iter().fold(0.0_f64, |a, &k| a.max(r[k].abs()));
+            let Some(step) = min_norm_step(rows, &region_rows, &unknowns, &r, &mut in_region)
+            else {
+                continue;
+            };
+            let longest = step.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            let saved: Vec<f64> = unknowns.iter().map(|&j| x[j]).collect();
+            for (&j, d) in unknowns.iter().zip(&step) {
+                x[j] += d;
+            }
+            let after: Vec<f64> = region_rows.iter().map(|&k| miss(k, x)).collect();
+            let worst_after = after.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            if worst_after < before && longest <= max_move {
+                for (&k, v) in region_rows.iter().zip(after) {
+                    r[k] = v;
+                }
+                out.kept += 1;
+                out.largest_move = out.largest_move.max(longest);
+                progress = true;
+            } else {
+                for (&j, v) in unknowns.iter().zip(saved) {
+                    x[j] = v;
+                }
+            }
+        }
+        if !progress {
+            break;
+        }
+    }
+    out.missed_after = count(&r);
+    out.worst_after = worst(&r);
+    out
+}
+
+/// The `size` unknowns nearest row `i`'s terms (the mean of their domain points), gathered
+/// through the rows from the row's own unknowns; sorted.
+fn region(
+    i: usize,
+    rows: &[Vec<(usize, f64)>],
+    rows_of: &[Vec<u32>],
+    pos: &[DVec3],
+    size: usize,
+    mark: &mut [bool],
+) -> Vec<usize> {
+    let centre = rows[i].iter().map(|&(j, _)| pos[j]).sum::<DVec3>() / rows[i].len() as f64;
+    let mut found: Vec<usize> = Vec::new();
+    for &(j, _) in &rows[i] {
+        if !mark[j] {
+            mark[j] = true;
+            found.push(j);
+        }
+    }
+    let mut next = 0;
+    while next < found.len() && found.len() < GATHER * size {
+        let j = found[next];
+        next += 1;
+        for &k in &rows_of[j] {
+            for &(l, _) in &rows[k as usize] {
+                if !mark[l] {
+                    mark[l] = true;
+                    found.push(l);
+                }
+            }
+        }
+    }
+    for &j in &found {
+        mark[j] = false;
+    }
+    found.sort_by(|&a, &b| {
+        pos[a]
+            .distance_squared(centre)
+            .total_cmp(&pos[b].distance_squared(centre))
+            .then(a.cmp(&b))
+    });
+    found.truncate(size);
+    found.sort_unstable();
+    found
+}
+
+/// Every row with a term in `unknowns`, sorted.
+fn rows_touching(unknowns: &[usize], rows_of: &[Vec<u32>], seen: &mut [bool]) -> Vec<usize> {
+    let mut out = Vec::new();
+    for &j in unknowns {
+        for &k in &rows_of[j] {
+            if !seen[k as usize] {
+                seen[k as usize] = true;
+                out.push(k as usize);
+            }
+        }
+    }
+    for &k in &out {
+        seen[k] = false;
+    }
+    out.sort_unstable();
+    out
+}
+
+/// The least-norm Δ over `unknowns` with M Δ = −r on `region_rows` (M: those rows' columns
+/// of the unknowns), by SVD with the singular values below [`RANK_CUT`] of the largest left
+/// out; `None` where the SVD fails.
+fn min_norm_step(
+    rows: &[Vec<(usize, f64)>],
+    region_rows: &[usize],
+    unknowns: &[usize],
+    r: &[f64],
+    mark: &mut [bool],
+) -> Option<Vec<f64>> {
+    let (m, n) = (region_rows.len(), unknowns.len());
+    if m == 0 || n == 0 {
+        return None;
+    }
+    // Column of each region unknown, through a scratch map of the group's columns.
+    let col: std::collections::HashMap<usize, usize> =
+        unknowns.iter().enumerate().map(|(a, &j)| (j, a)).collect();
+    for &j in unknowns {
+        mark[j] = true;
+    }
+    let mut a = faer::Mat::<f64>::zeros(m, n);
+    for (ri, &k) in region_rows.iter().enumerate() {
+        for &(j, v) in &rows[k] {
+            if mark[j] {
+                a[(ri, col[&j])] += v;
+            }
+        }
+    }
+    for &j in unknowns {
+        mark[j] = false;
+    }
+    let svd = a.thin_svd().ok()?;
+    let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
+    let top = (0..s.nrows()).fold(0.0_f64, |t, k| t.max(s[k]));
+    if top <= 0.0 {
+        return None;
+    }
+    let mut step = vec![0.0; n];
+    for k in 0..s.nrows() {
+        if s[k] <= RANK_CUT * top {
+            continue;
+        }
+        let coef = -(0..m)
+            .map(|ri| u[(ri, k)] * r[region_rows[ri]])
+            .sum::<f64>()
+            / s[k];
+        for (a, d) in step.iter_mut().enumerate() {
+            *d += coef * v[(a, k)];
+        }
+    }
+    Some(step)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unknowns on a line with rows x_j − x_{j+1} = c_j, each row also given twice over
+    /// (an exact dependency the SVD must leave out), and the exact solution with x_0 = 1.
+    #[allow(clippy::type_complexity)]
+    fn chain(n: usize) -> (Vec<Vec<(usize, f64)>>, Vec<f64>, Vec<DVec3>, Vec<f64>) {
+        let mut rows = Vec::new();
+        let mut c = Vec::new();
+        for j in 0..n - 1 {
+            rows.push(vec![(j, 1.0), (j + 1, -1.0)]);
+            c.push(step(j));
+            rows.push(vec![(j, 2.0), (j + 1, -2.0)]);
+            c.push(2.0 * step(j));
+        }
+        let pos = (0..n).map(|j| DVec3::new(j as f64, 0.0, 0.0)).collect();
+        let mut exact = vec![1.0; n];
+        for j in 0..n - 1 {
+            exact[j + 1] = exact[j] - step(j);
+        }
+        (rows, c, pos, exact)
+    }
+
+    /// Steps of the chain: bounded, so that its values stay near 1 and its rows' rounding
+    /// (~1e-16) far below the tolerances asked.
+    fn step(j: usize) -> f64 {
+        0.01 * ((j % 7) as f64 - 3.0)
+    }
+
+    #[test]
+    fn a_local_miss_is_met_by_a_short_move_near_it() {
+        let n = 400;
+        let (rows, c, pos, exact) = chain(n);
+        let mut x = exact.clone();
+        // A miss of 1e-9 at unknown 200 only.
+        x[200] += 1e-9;
+        let out = meet(&rows, &c, &mut x, &pos, 1e-13, 40, 1e-3);
+        assert_eq!(out.missed_before, 4, "{out:?}");
+        assert!(out.worst_before > 0.9e-9, "{out:?}");
+        // Met to the rounding of values near 1 (a few 1e-16).
+        assert!(out.worst_after < 1e-14, "{out:?}");
+        assert_eq!(out.missed_after, 0, "{out:?}");
+        // Only unknowns near 200 moved (within the region of 40), by at most the miss.
+        for j in 0..n {
+            let d = (x[j] - exact[j]).abs();
+            if (j as i64 - 200).abs() > 20 {
+                assert_eq!(x[j], exact[j], "unknown {j} moved");
+            } else {
+                assert!(d <= 1.1e-9, "unknown {j} moved by {d:e}");
+            }
+        }
+        assert!(out.largest_move > 0.0 && out.largest_move <= 1.1e-9);
+    }
+
+    #[test]
+    fn a_move_beyond_the_bound_is_refused() {
+        let n = 100;
+        let (rows, c, pos, exact) = chain(n);
+        let mut x = exact.clone();
+        x[50] += 1e-3;
+        let before = x.clone();
+        let out = meet(&rows, &c, &mut x, &pos, 1e-13, 20, 1e-6);
+        assert_eq!(out.kept, 0, "{out:?}");
+        assert_eq!(x, before);
+        assert_eq!(out.missed_after, out.missed_before);
+    }
+}
