@@ -140,7 +140,7 @@ pub struct QuinticOptions {
     /// [`MAX_JOINT_MEET_TOLERANCE`].
     pub joint_meet_tolerance: f64,
     /// With `joint_sign_fit`: the rows the fit leaves missed are met region by region
-    /// ([`localmeet`]: the nearest unknowns free, a dense SVD's least move) instead of by the
+    /// ([`localmeet`]: the nearest unknowns free, a dense pivoted QR's least move) instead of by the
     /// group's factor, whose meet moves the weights by 1e-2 and takes their signs. On fandisk
     /// the regions' rows have a clean gap between their exact dependencies (σ ~1e-15 of the
     /// largest) and their constraints (σ above ~1e-9), and their moves are 1e-10 … 1e-6

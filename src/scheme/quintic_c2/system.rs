@@ -358,7 +358,7 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
 }
 
 /// Unknowns free in one region of the local meet ([`super::localmeet`]): on fandisk
-/// (session 64) ~2000 around a missed row met it to ~1e-14, with a dense SVD of ~2300 rows.
+/// (session 64) ~2000 around a missed row met it to ~1e-14, with a dense factor of ~2300 rows.
 /// `APATCH_LOCAL_MEET_SIZE` overrides it (exploration).
 pub const LOCAL_MEET_SIZE: usize = 2000;
 
