@@ -330,12 +330,8 @@ mod tests {
     fn the_step_is_the_least_move_that_meets_the_rows() {
         let (n, m) = (60, 50);
         let mut seed = 7_u64;
-        let mut lcg = || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1_u64 << 53) as f64 - 0.5
-        };
+        // Uniform in [−0.5, 0.5).
+        let mut lcg = || 0.5 * crate::scheme::quintic_c2::cholesky::tests::lcg(&mut seed);
         let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
         for _ in 0..2 * m / 3 {
             let mut row = Vec::new();

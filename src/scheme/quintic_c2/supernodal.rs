@@ -984,6 +984,24 @@ mod tests {
         (rows, c, seed)
     }
 
+    /// The signed system of the tests above with 20 rows `delta` off others
+    /// ([`with_near_rows`] from its solution): the rows, their right-hand sides, the rows as
+    /// unit rows and their normal matrix.
+    fn near_fixture(
+        tol: f64,
+        n: usize,
+        delta: f64,
+    ) -> (SignedSystem, Vec<Row>, Vec<f64>, UnitRows, Normal) {
+        let sys = signed_system(500, n, 6, 1, -0.25);
+        let x0 = solve_near(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES)
+            .expect("small")
+            .x;
+        let (rows, c, _) = with_near_rows(&sys, &x0, delta, 43);
+        let unit = UnitRows::new(&rows, &c);
+        let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
+        (sys, rows, c, unit, normal)
+    }
+
     /// `SignBox::meet_tol` (`joint_meet_tolerance`): the meet after the split sign program
     /// stops once the rows are met to it, and that fit is kept. The signed system of the tests
     /// above with 20 rows 1e-9 off others (dropped by the double-double factor, data
@@ -992,13 +1010,7 @@ mod tests {
     #[test]
     fn the_meet_after_the_fit_stops_at_its_tolerance() {
         let (tol, n, delta) = (1e-13, 600, 1e-9);
-        let sys = signed_system(500, n, 6, 1, -0.25);
-        let x0 = solve_near(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES)
-            .expect("small")
-            .x;
-        let (rows, c, _) = with_near_rows(&sys, &x0, delta, 43);
-        let unit = UnitRows::new(&rows, &c);
-        let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
+        let (sys, _, _, unit, normal) = near_fixture(tol, n, delta);
         let solve = |meet_tol| {
             let sb = cholesky::SignBox {
                 signed: sys.signed.clone(),
@@ -1033,13 +1045,7 @@ mod tests {
     #[test]
     fn the_local_meet_meets_what_a_fit_without_its_meet_leaves() {
         let (tol, n, delta) = (1e-13, 600, 1e-9);
-        let sys = signed_system(500, n, 6, 1, -0.25);
-        let x0 = solve_near(&sys.rows, n, &sys.c, &sys.target, tol, MAX_VALUES)
-            .expect("small")
-            .x;
-        let (rows, c, _) = with_near_rows(&sys, &x0, delta, 43);
-        let unit = UnitRows::new(&rows, &c);
-        let normal = Normal::of(&unit.rows, n, MAX_VALUES).expect("small");
+        let (sys, rows, c, unit, normal) = near_fixture(tol, n, delta);
         let sb = cholesky::SignBox {
             signed: sys.signed.clone(),
             cost: Vec::new(),
