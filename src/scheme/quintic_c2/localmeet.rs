@@ -99,17 +99,16 @@ pub fn meet(
             let region_rows = rows_touching(&unknowns, &rows_of, &mut row_seen);
             out.regions += 1;
             let before = region_rows.iter().fold(0.0_f64, |a, &k| a.max(r[k].abs()));
-            let Some(step) = min_norm_step(rows, &region_rows, &unknowns, &r, &mut in_region)
-            else {
+            let Some(step) = min_norm_step(rows, &region_rows, &unknowns, &r) else {
                 continue;
             };
-            let longest = step.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            let longest = worst(&step);
             let saved: Vec<f64> = unknowns.iter().map(|&j| x[j]).collect();
             for (&j, d) in unknowns.iter().zip(&step) {
                 x[j] += d;
             }
             let after: Vec<f64> = region_rows.iter().map(|&k| miss(k, x)).collect();
-            let worst_after = after.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            let worst_after = worst(&after);
             if worst_after < before && longest <= max_move {
                 for (&k, v) in region_rows.iter().zip(after) {
                     r[k] = v;
@@ -207,7 +206,6 @@ fn min_norm_step(
     region_rows: &[usize],
     unknowns: &[usize],
     r: &[f64],
-    mark: &mut [bool],
 ) -> Option<Vec<f64>> {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::linalg::householder;
@@ -215,23 +213,17 @@ fn min_norm_step(
     if m == 0 || n == 0 {
         return None;
     }
-    // Column of each region unknown; `mark` tells the region's unknowns from held ones.
+    // Column of each region unknown (held unknowns have none).
     let col: std::collections::HashMap<usize, usize> =
         unknowns.iter().enumerate().map(|(a, &j)| (j, a)).collect();
-    for &j in unknowns {
-        mark[j] = true;
-    }
     // Mᵀ: column ri is region row ri over the unknowns.
     let mut mt = faer::Mat::<f64>::zeros(n, m);
     for (ri, &k) in region_rows.iter().enumerate() {
         for &(j, v) in &rows[k] {
-            if mark[j] {
-                mt[(col[&j], ri)] += v;
+            if let Some(&a) = col.get(&j) {
+                mt[(a, ri)] += v;
             }
         }
-    }
-    for &j in unknowns {
-        mark[j] = false;
     }
     let qr = mt.col_piv_qr();
     let rr = qr.thin_R();
@@ -365,8 +357,7 @@ mod tests {
         }
         let region_rows: Vec<usize> = (0..rows.len()).collect();
         let unknowns: Vec<usize> = (0..n).collect();
-        let mut mark = vec![false; n];
-        let step = min_norm_step(&rows, &region_rows, &unknowns, &r, &mut mark).unwrap();
+        let step = min_norm_step(&rows, &region_rows, &unknowns, &r).unwrap();
         // The SVD's minimum-norm solution of M Δ = −r.
         let a = faer::Mat::<f64>::from_fn(rows.len(), n, |i, j| {
             rows[i].iter().filter(|p| p.0 == j).map(|p| p.1).sum()

@@ -1002,6 +1002,32 @@ mod tests {
         (sys, rows, c, unit, normal)
     }
 
+    /// 100 rounds of the split sign program (margin 0.1) on `near_fixture`'s system, factored
+    /// by the double-double factor at its default threshold, the meet after the fit stopped at
+    /// `meet_tol`: the sign box and `refine_near`'s (miss, x, rows dropped).
+    fn fit_near(
+        sys: &SignedSystem,
+        unit: &UnitRows,
+        normal: &Normal,
+        tol: f64,
+        meet_tol: f64,
+    ) -> (cholesky::SignBox, (f64, Vec<f64>, usize)) {
+        let sb = cholesky::SignBox {
+            signed: sys.signed.clone(),
+            cost: Vec::new(),
+            margin: 0.1,
+            rounds: 0,
+            fit: 100,
+            meet_tol,
+        };
+        let drops = [cholesky::PRECISE_PIVOT];
+        let got = cholesky::refine_near(unit, &sys.target, tol, &drops, true, Some(&sb), |d| {
+            normal.factor::<fx128>(d).map(with_dropped)
+        })
+        .expect("small");
+        (sb, got)
+    }
+
     /// `SignBox::meet_tol` (`joint_meet_tolerance`): the meet after the split sign program
     /// stops once the rows are met to it, and that fit is kept. The signed system of the tests
     /// above with 20 rows 1e-9 off others (dropped by the double-double factor, data
@@ -1012,20 +1038,7 @@ mod tests {
         let (tol, n, delta) = (1e-13, 600, 1e-9);
         let (sys, _, _, unit, normal) = near_fixture(tol, n, delta);
         let solve = |meet_tol| {
-            let sb = cholesky::SignBox {
-                signed: sys.signed.clone(),
-                cost: Vec::new(),
-                margin: 0.1,
-                rounds: 0,
-                fit: 100,
-                meet_tol,
-            };
-            let drops = [cholesky::PRECISE_PIVOT];
-            let (got, x, dropped) =
-                cholesky::refine_near(&unit, &sys.target, tol, &drops, true, Some(&sb), |d| {
-                    normal.factor::<fx128>(d).map(with_dropped)
-                })
-                .expect("small");
+            let (sb, (got, x, dropped)) = fit_near(&sys, &unit, &normal, tol, meet_tol);
             assert_eq!(dropped, 20, "the near rows are the ones dropped");
             (got, sb.off(&x, 1e-12))
         };
@@ -1046,20 +1059,7 @@ mod tests {
     fn the_local_meet_meets_what_a_fit_without_its_meet_leaves() {
         let (tol, n, delta) = (1e-13, 600, 1e-9);
         let (sys, rows, c, unit, normal) = near_fixture(tol, n, delta);
-        let sb = cholesky::SignBox {
-            signed: sys.signed.clone(),
-            cost: Vec::new(),
-            margin: 0.1,
-            rounds: 0,
-            fit: 100,
-            meet_tol: f64::INFINITY,
-        };
-        let drops = [cholesky::PRECISE_PIVOT];
-        let (got, mut x, _) =
-            cholesky::refine_near(&unit, &sys.target, tol, &drops, true, Some(&sb), |d| {
-                normal.factor::<fx128>(d).map(with_dropped)
-            })
-            .expect("small");
+        let (_, (got, mut x, _)) = fit_near(&sys, &unit, &normal, tol, f64::INFINITY);
         assert!(
             got > 1e3 * tol,
             "the fit's move reached the near rows: {got:e}"

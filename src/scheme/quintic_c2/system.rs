@@ -1552,16 +1552,9 @@ impl System {
                 let mut out = String::new();
                 for (i, (row, c)) in g.rows.iter().zip(&g.c).enumerate().take(g.m) {
                     let r = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
-                    if r.abs() <= tol {
-                        continue;
+                    if r.abs() > tol {
+                        out.push_str(&self.row_line(g, i, r, false));
                     }
-                    let norm = row.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt();
-                    out.push_str(&format!("{i} {r:e} {norm:e}"));
-                    for &(j, k) in row {
-                        let (t, l) = self.home[g.unk[j] as usize];
-                        out.push_str(&format!(" {t}:{}{}{}{}:{k:e}", l[0], l[1], l[2], l[3]));
-                    }
-                    out.push('\n');
                 }
                 if let Err(e) = std::fs::write(&path, out) {
                     eprintln!("quintic-c2: row dump not written: {e}");
@@ -1579,21 +1572,13 @@ impl System {
                     .collect();
                 let mut out = String::new();
                 for (i, (row, c)) in g.rows.iter().zip(&g.c).enumerate().take(g.m) {
-                    if !row
+                    if row
                         .iter()
                         .any(|&(j, _)| tets.contains(&self.home[g.unk[j] as usize].0))
                     {
-                        continue;
+                        let r = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
+                        out.push_str(&self.row_line(g, i, r, true));
                     }
-                    let r = row.iter().map(|&(j, k)| k * x[j]).sum::<f64>() - c;
-                    let norm = row.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt();
-                    out.push_str(&format!("{i} {r:e} {norm:e}"));
-                    for &(j, k) in row {
-                        let (t, l) = self.home[g.unk[j] as usize];
-                        let at = format!("{t}:{}{}{}{}", l[0], l[1], l[2], l[3]);
-                        out.push_str(&format!(" {at}:{k:e}:{j}"));
-                    }
-                    out.push('\n');
                 }
                 let mut to = path.clone();
                 to.push(".rows");
@@ -1683,6 +1668,24 @@ impl System {
             }
         }
         (sol, pinned, given_up)
+    }
+
+    /// Exploration dumps (`APATCH_ROW_DUMP`, `APATCH_ROW_LOCAL`): row `i` of `g` with its
+    /// residual `r` and norm, then every term's tetrahedron, multi-index and coefficient (and,
+    /// with `columns`, its column in the group); one line.
+    fn row_line(&self, g: &Group, i: usize, r: f64, columns: bool) -> String {
+        let row = &g.rows[i];
+        let norm = row.iter().map(|t| t.1 * t.1).sum::<f64>().sqrt();
+        let mut line = format!("{i} {r:e} {norm:e}");
+        for &(j, k) in row {
+            let (t, l) = self.home[g.unk[j] as usize];
+            line.push_str(&format!(" {t}:{}{}{}{}:{k:e}", l[0], l[1], l[2], l[3]));
+            if columns {
+                line.push_str(&format!(":{j}"));
+            }
+        }
+        line.push('\n');
+        line
     }
 
     /// Meets the rows of `g` that `x` misses beyond the solve's tolerance region by region
