@@ -180,6 +180,19 @@ pub struct QuinticOptions {
     /// only as weighted targets are held back by weights beyond its reach; a wider pass frees
     /// them (fandisk, docs/quintic.md). A repair taken up from its checkpoint may ask for more.
     pub repair_widen: usize,
+    /// With `repair_holes`: a crossed face's sign conditions asked of its polynomial's
+    /// coefficients elevated by this many degrees instead of its weights ([`holes`]; 0, the
+    /// default, keeps the weights'). Elevated coefficients of one sign are a weaker condition
+    /// than the weights' (the face stays uncrossed), which a crease point whose sides ask
+    /// opposite curvature signs can still meet: letter_P_poly without `hessian_signs` passes
+    /// `check` with 2, not without (docs/quintic.md, session 52–53). At most
+    /// [`MAX_REPAIR_ELEVATE`].
+    pub repair_elevate: usize,
+    /// With `repair_elevate`: the pins a crossed face is tried with, in turn, until one
+    /// mends it: `None` the weights' own pins, `Some(m)` the elevated coefficients' with the
+    /// margin m (a share of the weights' margin). Default: the weights', then 1, 1e-2, 0 (on
+    /// fandisk each margin mends faces the others do not).
+    pub repair_margins: Vec<Option<f64>>,
     /// Move apart the apexes of edge tetrahedra that are slivers (relative volume below
     /// [`slivers::EDGE_MIN_VOLUME`]) before building: their world Hessians carry the weights'
     /// rounding times (L / h)², which no solve can remove ([`slivers`]). On by default; hulls
@@ -228,6 +241,8 @@ impl Default for QuinticOptions {
             repair_holes: false,
             repair_hessians: HessianRepair::Last,
             repair_widen: holes::WIDEN,
+            repair_elevate: 0,
+            repair_margins: REPAIR_MARGINS.to_vec(),
             thicken_edges: true,
             balance_edges: false,
             sign_rounds: 0,
@@ -252,6 +267,18 @@ pub enum HessianRepair {
 /// The largest [`QuinticOptions::repair_widen`]: 2 + 8 = 10 rings of points round a defect
 /// already reach across most of a model's features, and every ring grows the local group.
 pub const MAX_REPAIR_WIDEN: usize = 8;
+
+/// The largest [`QuinticOptions::repair_elevate`]: a face of degree 5 elevated by r has
+/// (r + 6)(r + 7)/2 coefficients, each an unknown and a row of the repair's group.
+pub const MAX_REPAIR_ELEVATE: usize = 5;
+
+/// Default [`QuinticOptions::repair_margins`]: the weights' pins, then the elevated ones with
+/// margins 1, 1e-2 and 0.
+pub const REPAIR_MARGINS: [Option<f64>; 4] = [None, Some(1.0), Some(1e-2), Some(0.0)];
+
+/// The largest elevated margin [`QuinticOptions::repair_margins`] takes: 100 times the
+/// weights' own margin is already a tenth of the face's largest weight.
+pub const MAX_REPAIR_MARGIN: f64 = 100.0;
 
 /// The largest [`QuinticOptions::precise_pivot`]: pivots are squared distances relative to
 /// the row, so 1e-6 drops rows up to 1e-3 of their length from the span of the others, which
@@ -334,6 +361,32 @@ impl QuinticOptions {
                         ),
                     }
                 }
+                "repair_elevate" => {
+                    o.repair_elevate = match v.as_integer() {
+                        Some(n) if (0..=MAX_REPAIR_ELEVATE as i64).contains(&n) => n as usize,
+                        _ => bail!(
+                            "{}: `scheme.repair_elevate` must be an integer in [0, {MAX_REPAIR_ELEVATE}], got {v}",
+                            scene.display()
+                        ),
+                    }
+                }
+                "repair_margins" => {
+                    let bad = || {
+                        anyhow::anyhow!(
+                            "{}: `scheme.repair_margins` must be a non-empty array of \"weights\" and numbers in [0, {MAX_REPAIR_MARGIN}], got {v}",
+                            scene.display()
+                        )
+                    };
+                    let items = v.as_array().filter(|a| !a.is_empty()).ok_or_else(bad)?;
+                    o.repair_margins = items
+                        .iter()
+                        .map(|m| match (m.as_str(), m.as_float().or_else(|| m.as_integer().map(|i| i as f64))) {
+                            (Some("weights"), _) => Ok(None),
+                            (_, Some(x)) if (0.0..=MAX_REPAIR_MARGIN).contains(&x) => Ok(Some(x)),
+                            _ => Err(bad()),
+                        })
+                        .collect::<anyhow::Result<_>>()?;
+                }
                 "thicken_edges" => o.thicken_edges = flag()?,
                 "balance_edges" => o.balance_edges = flag()?,
                 "sign_program" => o.sign_program = flag()?,
@@ -385,11 +438,17 @@ impl QuinticOptions {
                 "signs" => o.signs = flag()?,
                 "curvature" => o.curvature = number(&|x| x >= 0.0, "a number ≥ 0")?,
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
             }
+        }
+        if table.contains_key("repair_margins") && o.repair_elevate == 0 {
+            bail!(
+                "{}: `scheme.repair_margins` needs `repair_elevate` ≥ 1 (the margins are the elevated pins')",
+                scene.display()
+            );
         }
         Ok(o)
     }
@@ -568,13 +627,17 @@ pub fn build_prepared(
                 || std::env::var("APATCH_HOLE_HESSIANS").is_ok_and(|v| v != "0"),
         };
         let last = options.repair_hessians != HessianRepair::Off;
+        let plan = holes::Plan {
+            reach,
+            widen: options.repair_widen,
+            hessian_passes: last,
+            pins: holes::pin_modes(options.repair_elevate, &options.repair_margins),
+        };
         stats.hole_repair = holes::repair(
             &sys,
             &tets,
             &mut value,
-            reach,
-            options.repair_widen,
-            last,
+            &plan,
             checkpoint::requested().as_deref(),
         )?;
         if std::env::var_os("APATCH_SIGN_TRACE").is_some() {

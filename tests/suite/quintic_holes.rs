@@ -244,7 +244,8 @@ fn repair_hessian_passes_mend_letter_p_base_faces() {
 /// the weights (at its crease points the sides ask opposite signs of the curvature along one
 /// line: no margin is feasible); with the signs asked of the faces' coefficients elevated by
 /// 2 degrees instead, those faces are mended and C1/C2 stay within `check`'s bounds, with the
-/// margins tried in turn: the whole `check` passes.
+/// margins tried in turn: the whole `check` passes; the scene keys `repair_elevate` and
+/// `repair_margins` ask the same.
 #[test]
 fn elevated_face_pins_mend_what_weight_pins_cannot() {
     use std::process::Command;
@@ -262,14 +263,21 @@ fn elevated_face_pins_mend_what_weight_pins_cannot() {
     assert!(text.contains("repair_holes = true"), "the scene changed");
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
     let scene = dir.join("letter_p_elevate.toml");
+    // The same cascade asked by the scene keys instead of the environment.
+    let keyed = dir.join("letter_p_elevate_keys.toml");
+    std::fs::write(
+        &keyed,
+        text.replace(
+            "repair_holes = true",
+            "repair_holes = true\nrepair_elevate = 2\nrepair_margins = [\"weights\", 1, 1e-2, 0]",
+        ),
+    )
+    .unwrap();
     std::fs::write(&scene, text).unwrap();
-    let run = |out: &str, elevate: Option<(&str, &str)>| {
+    let export = |scene: &std::path::Path, out: &str, elevate: Option<(&str, &str)>| {
         let out = dir.join(out);
         let mut c = Command::new(env!("CARGO_BIN_EXE_apatch"));
-        c.args(["export", "patches"])
-            .arg(&scene)
-            .arg("-o")
-            .arg(&out);
+        c.args(["export", "patches"]).arg(scene).arg("-o").arg(&out);
         for v in [
             "APATCH_HOLE_ELEVATE",
             "APATCH_HOLE_ELEVATE_MARGIN",
@@ -284,6 +292,10 @@ fn elevated_face_pins_mend_what_weight_pins_cannot() {
         }
         let o = c.output().expect("run apatch");
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        out
+    };
+    let run = |out: &str, elevate: Option<(&str, &str)>| {
+        let out = export(&scene, out, elevate);
         let complex = apatch::complex_io::read_json_file(&out).unwrap();
         apatch::check::check(&complex, &apatch::check::CheckOptions::default())
     };
@@ -307,5 +319,13 @@ fn elevated_face_pins_mend_what_weight_pins_cannot() {
         elevated.hessian_jump.worst <= 1e-7,
         "{}",
         elevated.hessian_jump.worst
+    );
+    // `repair_elevate = 2`, `repair_margins = ["weights", 1, 1e-2, 0]`: the same repair, bit
+    // for bit.
+    let by_keys = export(&keyed, "letter_p_elevated_keys.json", None);
+    assert!(
+        std::fs::read(by_keys).unwrap()
+            == std::fs::read(dir.join("letter_p_elevated.json")).unwrap(),
+        "the scene keys' cascade differs from the environment's"
     );
 }

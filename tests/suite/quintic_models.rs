@@ -18,7 +18,8 @@ use std::path::Path;
 /// `SIGN_TARGETS` its `sign_targets`, `JOINT_SIGN_ROUNDS` its `joint_sign_rounds`,
 /// `JOINT_SIGN_FIT` its `joint_sign_fit`, `JOINT_SIGN_BOUNDARY` its
 /// `joint_sign_boundary`, `JOINT_MEET_TOLERANCE` its `joint_meet_tolerance`, `JOINT_LOCAL_MEET=1` its
-/// `joint_local_meet`, `REPAIR_WIDEN` its `repair_widen` (to explore).
+/// `joint_local_meet`, `REPAIR_WIDEN` its `repair_widen`, `REPAIR_ELEVATE` its
+/// `repair_elevate` (with the default margins) (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -55,6 +56,11 @@ fn options() -> QuinticOptions {
             .ok()
             .and_then(|x| x.parse().ok())
             .unwrap_or(apatch::scheme::quintic_c2::holes::WIDEN),
+        repair_elevate: std::env::var("REPAIR_ELEVATE")
+            .ok()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or(0),
+        repair_margins: apatch::scheme::quintic_c2::REPAIR_MARGINS.to_vec(),
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
         balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
         joint_sign_rounds: std::env::var("JOINT_SIGN_ROUNDS")

@@ -117,6 +117,25 @@ fn a_repair_taken_up_from_its_checkpoint_equals_the_whole_build() {
     assert!(ckpt.exists(), "the stopped repair saved its checkpoint");
     // Stopped part way: the whole repair mends more than its first wave.
     assert!(holes(&stopped) > holes(&direct));
+    // Taken up with no wave to run (`APATCH_HOLE_STOP_AFTER=0`): the checkpoint's values as
+    // they are, the stopped run's complex bit for bit, and the checkpoint left as it was.
+    let saved = std::fs::read(&ckpt).unwrap();
+    let as_saved = tmp("ckpt_as_saved.json");
+    let o = export_with(
+        &repairing,
+        &as_saved,
+        None,
+        &[
+            ("APATCH_HOLE_CHECKPOINT", ckpt_s),
+            ("APATCH_HOLE_STOP_AFTER", "0"),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        std::fs::read(&as_saved).unwrap() == std::fs::read(&stopped).unwrap(),
+        "the checkpoint's values differ from the stopped repair's"
+    );
+    assert!(std::fs::read(&ckpt).unwrap() == saved);
     let taken_up = tmp("ckpt_taken_up.json");
     let o = export_with(
         &repairing,

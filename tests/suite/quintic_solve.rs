@@ -313,6 +313,50 @@ fn joint_local_meet_key_is_read_and_checked() {
     }
 }
 
+/// `repair_elevate` (0–5, default 0) and `repair_margins` (the pins tried in turn: "weights"
+/// and margins in [0, 100], default weights, 1, 1e-2, 0) are read as given, and refused
+/// otherwise with the scene and the key named; margins without an elevation are refused
+/// (they would be silently unused).
+#[test]
+fn repair_elevate_and_margins_are_read_and_checked() {
+    use apatch::scheme::quintic_c2::{MAX_REPAIR_ELEVATE, REPAIR_MARGINS};
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    let d = read("").unwrap();
+    assert_eq!(d.repair_elevate, 0);
+    assert_eq!(d.repair_margins, REPAIR_MARGINS.to_vec());
+    let o = read("repair_elevate = 2").unwrap();
+    assert_eq!(
+        (o.repair_elevate, o.repair_margins),
+        (2, REPAIR_MARGINS.to_vec())
+    );
+    let o = read("repair_elevate = 3\nrepair_margins = [0.5, \"weights\", 0]").unwrap();
+    assert_eq!(o.repair_elevate, 3);
+    assert_eq!(o.repair_margins, vec![Some(0.5), None, Some(0.0)]);
+    let fails = |text: &str, key: &str| {
+        let e = read(text).unwrap_err().to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains(&format!("`scheme.{key}`")),
+            "{text}: {e}"
+        );
+        e
+    };
+    for bad in ["-1", "6", "1.5", "true", "\"2\""] {
+        let e = fails(&format!("repair_elevate = {bad}"), "repair_elevate");
+        assert!(e.contains(&format!("[0, {MAX_REPAIR_ELEVATE}]")), "{e}");
+    }
+    for bad in [
+        "[]", "1", "[\"w\"]", "[-1]", "[101]", "[nan]", "[inf]", "[true]", "[[1]]",
+    ] {
+        fails(
+            &format!("repair_elevate = 2\nrepair_margins = {bad}"),
+            "repair_margins",
+        );
+    }
+    let e = fails("repair_margins = [1]", "repair_margins");
+    assert!(e.contains("repair_elevate"), "{e}");
+}
+
 /// Every numeric quintic key takes a float or an integer in its range and refuses NaN, the
 /// infinities, text and booleans with one message naming the scene, the key and "must be a
 /// number"; an in-range value is read back as given.

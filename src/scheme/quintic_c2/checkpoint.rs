@@ -36,7 +36,9 @@ pub fn requested() -> Option<PathBuf> {
 }
 
 /// Exploration and tests: with `APATCH_HOLE_STOP_AFTER=n` the repair stops after `n` waves
-/// of repairs (saving its checkpoint), as if its process had ended there.
+/// of repairs (saving its checkpoint), as if its process had ended there; `n = 0` runs none,
+/// so that a checkpoint taken up with it gives its values as a complex (to `check` a long
+/// repair's progress without stopping it).
 #[must_use]
 pub fn stop_after() -> Option<usize> {
     std::env::var("APATCH_HOLE_STOP_AFTER").ok()?.parse().ok()

@@ -108,6 +108,19 @@ pub struct Reach {
     pub hessians: bool,
 }
 
+/// What a [`repair`] is asked to do.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    /// The first pass's reach.
+    pub reach: Reach,
+    /// Passes with one more ring each after the first ([`WIDEN`]).
+    pub widen: usize,
+    /// Two last passes with the Hessians free, unless `reach` frees them already.
+    pub hessian_passes: bool,
+    /// The pins a crossed face is tried with, in turn ([`pin_modes`]).
+    pub pins: Vec<Option<(usize, f64)>>,
+}
+
 /// |F| at or below this share of the patch's largest weight is zero (the checker's threshold).
 const ZERO: f64 = 1e-12;
 /// Pinned weights are set to this share of the largest weight on their face, with their sign:
@@ -151,32 +164,42 @@ fn only_tets() -> Option<HashSet<u32>> {
     Some(v.split(',').filter_map(|x| x.trim().parse().ok()).collect())
 }
 
-/// Exploration (`APATCH_HOLE_ELEVATE=r`): a crossed face's sign conditions on the coefficients
-/// of its polynomial elevated by `r` degrees instead of on its weights ([`elevation`]), with
-/// the margins `APATCH_HOLE_ELEVATE_MARGIN` (a share of the weights' [`MARGIN`]; 0 by
-/// default) tried in turn until one repairs the defect, `w` in that list standing for the
-/// weights' own pins: `w,1,1e-2,0` tries the weight pins first, then the elevated ones with
-/// decreasing margins. Without the variable, the weights' pins alone (`None`).
-fn elevated_modes() -> Vec<Option<(usize, f64)>> {
+/// The pins a crossed face is tried with, in turn, until one mends it
+/// (`QuinticOptions::repair_elevate`, `repair_margins`): `None` the weights' own pins,
+/// `Some((r, m))` the coefficients of its polynomial elevated by `r` degrees, signed with the
+/// margin `m` (a share of the weights' [`MARGIN`]). Elevation 0: the weights' pins alone.
+#[must_use]
+pub fn pin_modes(elevate: usize, margins: &[Option<f64>]) -> Vec<Option<(usize, f64)>> {
+    if elevate == 0 || margins.is_empty() {
+        return vec![None];
+    }
+    margins.iter().map(|m| m.map(|m| (elevate, m))).collect()
+}
+
+/// Exploration overrides of the scene's pins (`asked`, [`pin_modes`]):
+/// `APATCH_HOLE_ELEVATE=r` with the margins `APATCH_HOLE_ELEVATE_MARGIN` (a comma list, `w`
+/// standing for the weights' own pins: `w,1,1e-2,0`; 0 alone by default), as before the scene
+/// keys existed.
+fn elevated_modes(asked: &[Option<(usize, f64)>]) -> Vec<Option<(usize, f64)>> {
     let Some(r) = std::env::var("APATCH_HOLE_ELEVATE")
         .ok()
         .and_then(|v| v.parse::<usize>().ok())
         .filter(|&r| r > 0)
     else {
-        return vec![None];
+        return asked.to_vec();
     };
     let list = std::env::var("APATCH_HOLE_ELEVATE_MARGIN").unwrap_or_else(|_| "0".into());
-    let modes: Vec<Option<(usize, f64)>> = list
+    let modes: Vec<Option<f64>> = list
         .split(',')
         .filter_map(|m| match m.trim() {
             "w" => Some(None),
-            m => m.parse::<f64>().ok().map(|m| Some((r, m))),
+            m => m.parse::<f64>().ok().map(Some),
         })
         .collect();
     if modes.is_empty() {
-        vec![Some((r, 0.0))]
+        pin_modes(r, &[Some(0.0)])
     } else {
-        modes
+        pin_modes(r, &modes)
     }
 }
 
@@ -350,11 +373,15 @@ pub fn repair(
     sys: &System,
     tets: &[HullTet],
     value: &mut [f64],
-    reach: Reach,
-    widen: usize,
-    hessian_passes_asked: bool,
+    plan: &Plan,
     checkpoint: Option<&Path>,
 ) -> Result<HoleRepair> {
+    let Plan {
+        reach,
+        widen,
+        hessian_passes: hessian_passes_asked,
+        ref pins,
+    } = *plan;
     let np = sys.np;
     let boundary = boundary_faces(tets);
     let weights = |t: u32, value: &[f64]| -> Vec<f64> { sys.weights(t as usize, value) };
@@ -456,11 +483,15 @@ pub fn repair(
     }
     let mi = multi_indices(5);
     let only = only_tets();
-    let modes = elevated_modes();
+    let modes = elevated_modes(pins);
     let stop_after = checkpoint::stop_after();
     let (every, exit_after) = checkpoint::midway_hooks(CHECKPOINT_EVERY);
     let mut waves_run = 0usize;
     'passes: for (pass_no, &reach) in passes.iter().enumerate() {
+        if stop_after == Some(0) {
+            trace(|| "stopped before the first wave".to_string());
+            break;
+        }
         if pass_no < start_pass {
             continue;
         }
