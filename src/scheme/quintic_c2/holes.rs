@@ -876,6 +876,7 @@ fn repair_defect(
     // such weight b at p, a, b' the equation b − (a − p)ᵀ δH (b' − p)/20 = its value now.
     let mut hess_rows: Vec<(Vec<(usize, f64)>, f64)> = Vec::new();
     let mut hess_col: HashMap<u32, usize> = HashMap::new();
+    let mut hess_unit: Vec<f64> = Vec::new();
     if reach.hessians {
         let mut pos: HashMap<u32, glam::DVec3> = HashMap::new();
         for &k in near {
@@ -929,6 +930,7 @@ fn repair_defect(
                 }
             }
         }
+        hess_unit = unit;
     }
     let n = unk.len() + 6 * hess_col.len();
     let mut rows: Vec<Vec<(usize, f64)>> = Vec::with_capacity(eqs.len());
@@ -954,6 +956,38 @@ fn repair_defect(
     }
     let mut x0: Vec<f64> = unk.iter().map(|&s| value[s as usize]).collect();
     x0.resize(n, 0.0);
+    if normal_bend_target() {
+        // Exploration (`APATCH_HOLE_NORMAL_BEND=1`): each freed Hessian's change aims at
+        // taking its normal part n·H·n back to the jets' 0 (`scripts/normal_curvature.py`).
+        for (&p, &base) in &hess_col {
+            let Some(k) = near
+                .iter()
+                .copied()
+                .find(|&k| tets[k as usize].gid.contains(&p))
+            else {
+                continue;
+            };
+            let tet = &tets[k as usize];
+            let at = tet.gid.iter().position(|&g| g == p).unwrap_or(0);
+            let Some((g, h)) = jet_at(&sys.weights(k as usize, value), &tet.pts, at) else {
+                continue;
+            };
+            let nn = g.normalize_or_zero();
+            let bend = nn.dot(h * nn);
+            let u = hess_unit[(base - unk.len()) / 6];
+            let d = [
+                nn.x * nn.x,
+                nn.x * nn.y,
+                nn.x * nn.z,
+                nn.y * nn.y,
+                nn.y * nn.z,
+                nn.z * nn.z,
+            ];
+            for (e, v) in d.iter().enumerate() {
+                x0[base + e] = -u * bend * v;
+            }
+        }
+    }
     // Exploration (`APATCH_HOLE_ELEVATE`): the crossed face (or every boundary face of the
     // re-solved tetrahedra) gets one more unknown per elevated coefficient that a re-solved
     // weight enters, tied to the weights by a row; those carry the face's sign conditions
@@ -1442,6 +1476,54 @@ fn repair_defect(
 /// The point of T whose number 2 weight the slot with key `parts` is (multiplicity 3 there,
 /// the other two indices elsewhere) when that point is in `inner`: the weights whose jet a
 /// repair with [`Reach::hessians`] re-solves.
+/// Exploration (`APATCH_HOLE_NORMAL_BEND=1`): the freed Hessians' changes aim at n·H·n = 0.
+fn normal_bend_target() -> bool {
+    std::env::var("APATCH_HOLE_NORMAL_BEND").is_ok_and(|v| v != "0")
+}
+
+/// ∇F and ∇²F of the quintic with `weights` (in [`multi_indices`] order) over the
+/// tetrahedron `pts` at its corner `at`: 5 Σ (w_{4a+i} − w_{5a}) ∇λ_i and 20 Σ (w_{3a+i+j} −
+/// w_{4a+i} − w_{4a+j} + w_{5a}) ∇λ_i ∇λ_jᵀ over the other corners i, j. `None` for a flat
+/// tetrahedron.
+fn jet_at(
+    weights: &[f64],
+    pts: &[glam::DVec3; 4],
+    at: usize,
+) -> Option<(glam::DVec3, glam::DMat3)> {
+    let m = glam::DMat4::from_cols(
+        pts[0].extend(1.0),
+        pts[1].extend(1.0),
+        pts[2].extend(1.0),
+        pts[3].extend(1.0),
+    );
+    if m.determinant().abs() <= f64::MIN_POSITIVE {
+        return None;
+    }
+    // λ = M⁻¹ (x, 1): ∇λ_i is row i of M⁻¹ without its last entry.
+    let inv = m.inverse().transpose();
+    let grad = |i: usize| inv.col(i).truncate();
+    let w = |extra: &[usize]| {
+        let mut l = [0u8; 4];
+        l[at] = 5 - extra.len() as u8;
+        for &i in extra {
+            l[i] += 1;
+        }
+        weights[crate::bb::index_of(l)]
+    };
+    let others: Vec<usize> = (0..4).filter(|&i| i != at).collect();
+    let mut g = glam::DVec3::ZERO;
+    let mut h = glam::DMat3::ZERO;
+    for &i in &others {
+        g += 5.0 * (w(&[i]) - w(&[])) * grad(i);
+        for &j in &others {
+            let d2 = w(&[i, j]) - w(&[i]) - w(&[j]) + w(&[]);
+            let (a, b) = (grad(i), grad(j));
+            h += 20.0 * d2 * glam::DMat3::from_cols(a * b.x, a * b.y, a * b.z);
+        }
+    }
+    Some((g, h))
+}
+
 fn hessian_point(parts: &[(u32, u8)], np: u32, inner: &HashSet<u32>) -> Option<u32> {
     let p = parts.iter().find(|q| q.1 == 3)?;
     (p.0 < np && inner.contains(&p.0)).then_some(p.0)
@@ -1595,6 +1677,50 @@ fn trace(msg: impl FnOnce() -> String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The quintic whose weights are the blossom of a 2-jet's Taylor polynomial at one corner
+    /// ([`super::super::jets::Jet::blossom5`]) has that jet there: `jet_at` gives back its
+    /// gradient and Hessian, at every corner of a skewed tetrahedron.
+    #[test]
+    fn jet_at_recovers_the_taylor_polynomial_it_was_made_from() {
+        use glam::{DMat3, DVec3};
+        let pts = [
+            DVec3::new(0.1, -0.2, 0.05),
+            DVec3::new(1.3, 0.1, -0.2),
+            DVec3::new(0.2, 0.9, 0.3),
+            DVec3::new(0.4, 0.3, 0.02),
+        ];
+        let g = DVec3::new(0.3, -0.8, 0.5);
+        let h = DMat3::from_cols(
+            DVec3::new(2.0, -0.7, 0.4),
+            DVec3::new(-0.7, -1.5, 3.0),
+            DVec3::new(0.4, 3.0, 0.25),
+        );
+        for at in 0..4 {
+            let jet = super::super::jets::Jet { p: pts[at], g, h };
+            let weights: Vec<f64> = multi_indices(5)
+                .iter()
+                .map(|l| {
+                    let mut args = [DVec3::ZERO; 5];
+                    let mut n = 0;
+                    for (i, &m) in l.iter().enumerate() {
+                        for _ in 0..m {
+                            args[n] = pts[i];
+                            n += 1;
+                        }
+                    }
+                    jet.blossom5(&args)
+                })
+                .collect();
+            let (g2, h2) = jet_at(&weights, &pts, at).unwrap();
+            // Rounding only: the tetrahedron's edges are ~1 and its λ-gradients ~5, so the
+            // differences of weights ~1 lose a few digits of 1e-16.
+            assert!((g2 - g).length() < 1e-12, "{at}: {g2} vs {g}");
+            for c in 0..3 {
+                assert!((h2.col(c) - h.col(c)).length() < 1e-11, "{at}: {h2} vs {h}");
+            }
+        }
+    }
 
     /// Weights that depend only on the level (λ_3 for a face tetrahedron, λ_2 + λ_3 for an
     /// edge tetrahedron) make F a univariate Bernstein polynomial in the level with those
