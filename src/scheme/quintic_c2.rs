@@ -320,6 +320,16 @@ impl QuinticOptions {
                         )
                     })
             };
+            // An integer key in [0, max].
+            let integer_to = |max: usize| -> anyhow::Result<usize> {
+                match v.as_integer() {
+                    Some(n) if (0..=max as i64).contains(&n) => Ok(n as usize),
+                    _ => Err(anyhow::anyhow!(
+                        "{}: `scheme.{k}` must be an integer in [0, {max}], got {v}",
+                        scene.display()
+                    )),
+                }
+            };
             // Every numeric key: a float or an integer, finite, in the key's range.
             let number = |in_range: &dyn Fn(f64) -> bool, what: &str| -> anyhow::Result<f64> {
                 match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
@@ -352,24 +362,8 @@ impl QuinticOptions {
                         ),
                     }
                 }
-                "repair_widen" => {
-                    o.repair_widen = match v.as_integer() {
-                        Some(n) if (0..=MAX_REPAIR_WIDEN as i64).contains(&n) => n as usize,
-                        _ => bail!(
-                            "{}: `scheme.repair_widen` must be an integer in [0, {MAX_REPAIR_WIDEN}], got {v}",
-                            scene.display()
-                        ),
-                    }
-                }
-                "repair_elevate" => {
-                    o.repair_elevate = match v.as_integer() {
-                        Some(n) if (0..=MAX_REPAIR_ELEVATE as i64).contains(&n) => n as usize,
-                        _ => bail!(
-                            "{}: `scheme.repair_elevate` must be an integer in [0, {MAX_REPAIR_ELEVATE}], got {v}",
-                            scene.display()
-                        ),
-                    }
-                }
+                "repair_widen" => o.repair_widen = integer_to(MAX_REPAIR_WIDEN)?,
+                "repair_elevate" => o.repair_elevate = integer_to(MAX_REPAIR_ELEVATE)?,
                 "repair_margins" => {
                     let bad = || {
                         anyhow::anyhow!(
@@ -682,14 +676,7 @@ pub fn build_prepared(
 /// of the tetrahedron's points of T, each weighted by its multiplicity + ½, evaluated as the
 /// degree-5 blossom at the weight's domain point.
 fn target_weight(tet: &system::HullTet, l: [u8; 4], jets: &[jets::Jet], np: u32, lift: f64) -> f64 {
-    let mut args = [DVec3::ZERO; 5];
-    let mut c = 0;
-    for (i, &m) in l.iter().enumerate() {
-        for _ in 0..m {
-            args[c] = tet.pts[i];
-            c += 1;
-        }
-    }
+    let args = jets::domain_args(&tet.pts, l);
     let mut sum = 0.0;
     let mut wsum = 0.0;
     for k in 0..4 {

@@ -1700,17 +1700,7 @@ mod tests {
             let jet = super::super::jets::Jet { p: pts[at], g, h };
             let weights: Vec<f64> = multi_indices(5)
                 .iter()
-                .map(|l| {
-                    let mut args = [DVec3::ZERO; 5];
-                    let mut n = 0;
-                    for (i, &m) in l.iter().enumerate() {
-                        for _ in 0..m {
-                            args[n] = pts[i];
-                            n += 1;
-                        }
-                    }
-                    jet.blossom5(&args)
-                })
+                .map(|&l| jet.blossom5(&super::super::jets::domain_args(&pts, l)))
                 .collect();
             let (g2, h2) = jet_at(&weights, &pts, at).unwrap();
             // Rounding only: the tetrahedron's edges are ~1 and its λ-gradients ~5, so the

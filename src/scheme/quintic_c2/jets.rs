@@ -38,6 +38,21 @@ impl Jet {
     }
 }
 
+/// The five points whose blossom is the BB weight at multi-index `l` (|l| = 5) of the
+/// tetrahedron `pts`: each corner as often as `l` names it ([`Jet::blossom5`]'s arguments).
+#[must_use]
+pub fn domain_args(pts: &[DVec3; 4], l: [u8; 4]) -> [DVec3; 5] {
+    let mut args = [DVec3::ZERO; 5];
+    let mut c = 0;
+    for (i, &m) in l.iter().enumerate() {
+        for _ in 0..m {
+            args[c] = pts[i];
+            c += 1;
+        }
+    }
+    args
+}
+
 /// The jets at every point of `hull`, the Hessian scaled by `curvature` (1 = the estimated
 /// shape operator, 0 = planar data).
 ///

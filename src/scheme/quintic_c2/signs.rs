@@ -465,14 +465,7 @@ mod tests {
                 .into_iter()
                 .filter(|l| l[0] == 3)
                 .all(|l| {
-                    let mut args = [DVec3::ZERO; 5];
-                    let mut c = 0;
-                    for (i, &m) in l.iter().enumerate() {
-                        for _ in 0..m {
-                            args[c] = pts[i];
-                            c += 1;
-                        }
-                    }
+                    let args = crate::scheme::quintic_c2::jets::domain_args(&pts, l);
                     // Rounding of the fit (1e-13 of the conditions' scale).
                     f64::from(required(&t, l, false)) * jet.blossom5(&args) >= -1e-12
                 })

@@ -1110,15 +1110,7 @@ impl System {
                 let tet = &tets[t as usize];
                 let k = (0..4).find(|&k| l[k] >= 3).expect("jet slot");
                 let jet = &jets[tet.gid[k] as usize];
-                let mut args = [DVec3::ZERO; 5];
-                let mut c = 0;
-                for (i, &m) in l.iter().enumerate() {
-                    for _ in 0..m {
-                        args[c] = tet.pts[i];
-                        c += 1;
-                    }
-                }
-                value[s] = jet.blossom5(&args);
+                value[s] = jet.blossom5(&super::jets::domain_args(&tet.pts, l));
                 if l[k] == 3 && lv(tet.gid[k]) >= 2 {
                     st = 2;
                     relaxed_jet[s] = true;
