@@ -1002,6 +1002,19 @@ mod tests {
         (sys, rows, c, unit, normal)
     }
 
+    /// The sign box of 100 rounds of the split sign program (margin 0.1, no boundary cost) on
+    /// `sys`, the meet after the fit stopped at `meet_tol`.
+    fn fit_box(sys: &SignedSystem, meet_tol: f64) -> cholesky::SignBox {
+        cholesky::SignBox {
+            signed: sys.signed.clone(),
+            cost: Vec::new(),
+            margin: 0.1,
+            rounds: 0,
+            fit: 100,
+            meet_tol,
+        }
+    }
+
     /// 100 rounds of the split sign program (margin 0.1) on `near_fixture`'s system, factored
     /// by the double-double factor at its default threshold, the meet after the fit stopped at
     /// `meet_tol`: the sign box and `refine_near`'s (miss, x, rows dropped).
@@ -1012,14 +1025,7 @@ mod tests {
         tol: f64,
         meet_tol: f64,
     ) -> (cholesky::SignBox, (f64, Vec<f64>, usize)) {
-        let sb = cholesky::SignBox {
-            signed: sys.signed.clone(),
-            cost: Vec::new(),
-            margin: 0.1,
-            rounds: 0,
-            fit: 100,
-            meet_tol,
-        };
+        let sb = fit_box(sys, meet_tol);
         let drops = [cholesky::PRECISE_PIVOT];
         let got = cholesky::refine_near(unit, &sys.target, tol, &drops, true, Some(&sb), |d| {
             normal.factor::<fx128>(d).map(with_dropped)
@@ -1184,14 +1190,7 @@ mod tests {
         let (met, q) = cholesky::meet_dropped(&unit, &f, &mut x, tol, &cholesky::MEET_OWN_WEIGHTS);
         assert!(met <= tol, "{moved:e} -> {met:e}");
         assert!(!q.is_empty());
-        let sb = cholesky::SignBox {
-            signed: sys.signed.clone(),
-            cost: Vec::new(),
-            margin: 0.1,
-            rounds: 0,
-            fit: 100,
-            meet_tol: 0.0,
-        };
+        let sb = fit_box(&sys, 0.0);
         let fit = |q: &[Vec<f64>]| {
             let mut y = x.clone();
             let got =
