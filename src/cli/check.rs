@@ -327,6 +327,11 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
         )
     };
     let p = &s.sign_projection;
+    let held = if s.normal_rows > 0 {
+        format!(", {} rows holding the Hessians' normal part", s.normal_rows)
+    } else {
+        String::new()
+    };
     let projection = if p.too_large {
         "; sign projection skipped: too large to factor".to_string()
     } else if p.rounds == 0 && !p.program {
@@ -366,8 +371,8 @@ fn solve_line(s: &apatch::scheme::quintic_c2::BuildStats) -> String {
     };
     format!(
         "solve            {} unknowns, {} equations, largest group {} ({} sparse), residual \
-         {:.1e}; {} points of T relaxed, {} consistency conditions{}; {} weights off Theorem \
-         2.1's sufficient signs, in {} patches{slivers}{projection}{repair}  info",
+         {:.1e}; {} points of T relaxed, {} consistency conditions{}{held}; {} weights off \
+         Theorem 2.1's sufficient signs, in {} patches{slivers}{projection}{repair}  info",
         s.unknowns,
         s.equations,
         s.largest_group,

@@ -18,6 +18,7 @@ pub mod holes;
 pub mod interior;
 pub mod jets;
 pub mod localmeet;
+pub mod normalpart;
 pub mod ordering;
 mod pinned;
 pub mod project;
@@ -154,6 +155,12 @@ pub struct QuinticOptions {
     /// group's sign fit 421 weights off instead of 1020 and the holes 623 instead of 723
     /// (docs/quintic.md, sessions 60–61); the small scenes pass with any of the three.
     pub face_beta: beta::FaceBeta,
+    /// The part of each relaxed point's Hessian held at the signed distance's
+    /// ([`normalpart::HessianNormal`]): `"free"` (the default: every relaxed Hessian weight
+    /// closest to its estimate), `"bend"` (nᵀ∇²F n = 0, a row per point) or `"column"`
+    /// (∇²F n = 0, three rows per point). Only points whose Hessian is relaxed (`joint_stars`,
+    /// failing stars) are affected: elsewhere the estimate meets the rows.
+    pub hessian_normal: normalpart::HessianNormal,
     /// The double-double factor's drop threshold (a pivot is a row's squared distance from
     /// the rows before it, relative) for the groups beyond the in-house factor (fandisk's
     /// joint group), instead of [`cholesky::PRECISE_PIVOT`] (1e-15) and, when that factor's
@@ -231,6 +238,7 @@ impl Default for QuinticOptions {
             joint_meet_tolerance: 0.0,
             joint_local_meet: false,
             face_beta: beta::FaceBeta::F64,
+            hessian_normal: normalpart::HessianNormal::Free,
             precise_pivot: None,
             relax_stars: true,
             consistent_stars: false,
@@ -423,6 +431,19 @@ impl QuinticOptions {
                         ),
                     }
                 }
+                "hessian_normal" => {
+                    o.hessian_normal = match v.as_str().and_then(normalpart::HessianNormal::named)
+                    {
+                        Some(m) => m,
+                        None => bail!(
+                            "{}: `scheme.hessian_normal` must be one of {}, got {v}",
+                            scene.display(),
+                            normalpart::HessianNormal::NAMES
+                                .map(|n| format!("\"{n}\""))
+                                .join(", ")
+                        ),
+                    }
+                }
                 "precise_pivot" => {
                     o.precise_pivot = Some(number(
                         &|t| t > 0.0 && t <= MAX_PRECISE_PIVOT,
@@ -432,7 +453,7 @@ impl QuinticOptions {
                 "signs" => o.signs = flag()?,
                 "curvature" => o.curvature = number(&|x| x >= 0.0, "a number ≥ 0")?,
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `hessian_normal`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -585,6 +606,8 @@ pub fn build_prepared(
     } else {
         signs::HessianFit::default()
     };
+    sys.held = normalpart::rows(&sys, &tets, &jets, options.hessian_normal);
+    sys.hessian_normal = options.hessian_normal;
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
     let (mut value, mut stats) = match resume::requested() {
         // Exploration: the solve's result read back from an exported complex.
@@ -604,6 +627,7 @@ pub fn build_prepared(
             options.hessian_signs,
         )?,
     };
+    stats.normal_rows = sys.held.len();
     if options.sign_rounds > 0 || options.sign_program {
         stats.sign_projection =
             project::project_signs(&sys, &mut value, options.sign_rounds, options.sign_program);

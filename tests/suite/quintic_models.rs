@@ -19,7 +19,8 @@ use std::path::Path;
 /// `JOINT_SIGN_FIT` its `joint_sign_fit`, `JOINT_SIGN_BOUNDARY` its
 /// `joint_sign_boundary`, `JOINT_MEET_TOLERANCE` its `joint_meet_tolerance`, `JOINT_LOCAL_MEET=1` its
 /// `joint_local_meet`, `REPAIR_WIDEN` its `repair_widen`, `REPAIR_ELEVATE` its
-/// `repair_elevate` (with the default margins) (to explore).
+/// `repair_elevate` (with the default margins), `HESSIAN_NORMAL` its `hessian_normal` (to
+/// explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -61,6 +62,10 @@ fn options() -> QuinticOptions {
             .and_then(|x| x.parse().ok())
             .unwrap_or(0),
         repair_margins: apatch::scheme::quintic_c2::REPAIR_MARGINS.to_vec(),
+        hessian_normal: std::env::var("HESSIAN_NORMAL")
+            .ok()
+            .and_then(|x| apatch::scheme::quintic_c2::normalpart::HessianNormal::named(&x))
+            .unwrap_or_default(),
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
         balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
         joint_sign_rounds: std::env::var("JOINT_SIGN_ROUNDS")

@@ -519,3 +519,128 @@ fn repair_widen_key_is_read_and_checked() {
         );
     }
 }
+
+/// `hessian_normal` reads its three names, defaults to `"free"` and refuses anything else with a
+/// message naming the scene, the key and the names it takes.
+#[test]
+fn hessian_normal_is_read_and_checked() {
+    use apatch::scheme::quintic_c2::normalpart::HessianNormal;
+    let scene = Path::new("scenes/x.toml");
+    let read = |text: &str| QuinticOptions::from_toml(&text.parse::<toml::Table>().unwrap(), scene);
+    assert_eq!(read("").unwrap().hessian_normal, HessianNormal::Free);
+    for (name, mode) in [
+        ("free", HessianNormal::Free),
+        ("bend", HessianNormal::Bend),
+        ("column", HessianNormal::Column),
+    ] {
+        let o = read(&format!("hessian_normal = \"{name}\"")).unwrap();
+        assert_eq!(o.hessian_normal, mode, "{name}");
+    }
+    for bad in ["\"Bend\"", "\"\"", "true", "1", "[\"bend\"]"] {
+        let e = read(&format!("hessian_normal = {bad}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("scenes/x.toml")
+                && e.contains("`scheme.hessian_normal`")
+                && e.contains("\"free\", \"bend\", \"column\""),
+            "{bad}: {e}"
+        );
+    }
+}
+
+/// nᵀ∇²F n / |∇F| at every vertex of `c`, from one patch with a corner there (the patch's own
+/// Hessian, `Patch::hessian`, and the complex's normals).
+fn normal_bends(c: &apatch::complex::PatchComplex) -> Vec<f64> {
+    c.vertices
+        .iter()
+        .zip(&c.normals)
+        .map(|(v, n)| {
+            let (v, n) = (glam::DVec3::from(*v), glam::DVec3::from(*n));
+            let patch = c
+                .patches
+                .iter()
+                .find(|p| p.tet.iter().any(|q| glam::DVec3::from(*q) == v))
+                .expect("a patch at every vertex");
+            n.dot(patch.hessian(v) * n) / patch.gradient(v).length()
+        })
+        .collect()
+}
+
+/// The rounded cylinder's scene (joint stars: every point's Hessian relaxed) bends F along the
+/// normal at every point of T (~2.9 / unit length: the solve used that freedom, which the
+/// estimated jets do not have); with `hessian_normal = "bend"` the bend is gone at every point
+/// while the scene still passes `check`, and with `"column"` (∇²F n = 0) too, though that
+/// scene no longer passes (boundary faces crossed: the tangent part alone is too little freedom
+/// for the signs there).
+#[test]
+fn held_normal_bend_takes_the_joint_stars_bend_away() {
+    let path = Path::new("scenes/paper1994/cylinder_rounded_quintic.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains("joint_stars = true"), "the scene changed");
+    let build = |mode: &str| {
+        let text = text.replace(
+            "joint_stars = true",
+            &format!("joint_stars = true\nhessian_normal = \"{mode}\""),
+        );
+        let scene = apatch::scene::parse(&text, path).unwrap();
+        apatch::scene::build_complex(&scene).unwrap()
+    };
+    let largest = |b: &[f64]| b.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    let free = build("free");
+    let bends = normal_bends(&free);
+    // The cylinder's radius is 0.5: a bend of a tenth of its curvature (2) would already be
+    // far from the signed distance's 0; the free solve puts ~2.9 at the points (measured).
+    // Every point but the two caps' centres (flat, −5e-4 there) is bent by ~−2.9.
+    let bent = bends.iter().filter(|b| b.abs() > 0.2).count();
+    assert!(bent + 2 >= bends.len(), "{bends:?}");
+    let held = build("bend");
+    // The rows are met to the solve's rounding (~1e-13 of the weights, which are O(1) here),
+    // multiplied by the row's coefficients ~20/h² with h ~ 0.05, and the patch's Hessian is
+    // evaluated from weights of size ~1: 1e-13 × 1e4 = 1e-9, with room.
+    assert!(
+        largest(&normal_bends(&held)) < 1e-7,
+        "{:?}",
+        normal_bends(&held)
+    );
+    let report = check(&held, &CheckOptions::default());
+    assert!(report.passed(), "{:?}", report.failures());
+    let column = build("column");
+    assert!(largest(&normal_bends(&column)) < 1e-7);
+    assert!(report_c2(&check(&column, &CheckOptions::default())));
+}
+
+/// C1 and C2 within issue 8's bounds in a check report.
+fn report_c2(r: &apatch::check::CheckReport) -> bool {
+    r.failures().iter().all(|f| !f.contains("jump"))
+}
+
+/// The hole repair's freed Hessians keep a held normal bend: letter_P_poly without
+/// `hessian_signs`, repaired with the Hessians free in every pass (`repair_hessians = "all"`),
+/// bends F along the normal at some points when nothing is held, and at none with
+/// `hessian_normal = "bend"`, whose rows the solve and then every repair meet.
+#[test]
+fn the_repair_keeps_a_held_normal_bend() {
+    let path = Path::new("scenes/paper1994/letter_P_poly_quintic.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains("hessian_signs = true"), "the scene changed");
+    let build = |mode: &str| {
+        let text = text.replace(
+            "hessian_signs = true",
+            &format!(
+                "hessian_signs = false\nrepair_holes = true\nrepair_hessians = \"all\"\n\
+                 hessian_normal = \"{mode}\""
+            ),
+        );
+        let scene = apatch::scene::parse(&text, path).unwrap();
+        apatch::scene::build_complex(&scene).unwrap()
+    };
+    let largest = |b: &[f64]| b.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    // Free: up to ~7.5 (measured), where the estimated jets have 0.
+    let free = normal_bends(&build("free"));
+    assert!(largest(&free) > 1.0, "{free:?}");
+    // Held: ~5e-12 (measured; the rows met to the solves' rounding, 1e-13 of weights of
+    // size ~1, through coefficients up to ~1e2), with room.
+    let held = normal_bends(&build("bend"));
+    assert!(largest(&held) < 1e-9, "{held:?}");
+}

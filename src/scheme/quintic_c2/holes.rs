@@ -954,6 +954,15 @@ fn repair_defect(
         rows.push(row);
         c.push(rhs);
     }
+    // The scene's held normal part of the Hessians (`hessian_normal`, [`super::normalpart`]):
+    // each freed Hessian's change keeps it, so the repair cannot put back the normal bend the
+    // solve was kept from.
+    for (&p, &base) in &hess_col {
+        for row in held_hessian_rows(sys, tets, near, value, p, base) {
+            rows.push(row);
+            c.push(0.0);
+        }
+    }
     let mut x0: Vec<f64> = unk.iter().map(|&s| value[s as usize]).collect();
     x0.resize(n, 0.0);
     if normal_bend_target() {
@@ -1522,6 +1531,66 @@ fn jet_at(
         }
     }
     Some((g, h))
+}
+
+/// Rows on point `p`'s six Hessian unknowns (columns `base..base + 6`, the change δH in the
+/// entries xx, xy, xz, yy, yz, zz, each in its point's unit) that keep uᵀδH n = 0 for the
+/// directions u that [`System::hessian_normal`] holds, n the unit gradient at `p` read from a
+/// near tetrahedron's weights. A uniform scale of δH (the point's unit) leaves the rows true.
+fn held_hessian_rows(
+    sys: &System,
+    tets: &[HullTet],
+    near: &[u32],
+    value: &[f64],
+    p: u32,
+    base: usize,
+) -> Vec<Vec<(usize, f64)>> {
+    use super::normalpart::HessianNormal;
+    if sys.hessian_normal == HessianNormal::Free {
+        return Vec::new();
+    }
+    let Some(k) = near
+        .iter()
+        .copied()
+        .find(|&k| tets[k as usize].gid.contains(&p))
+    else {
+        return Vec::new();
+    };
+    let tet = &tets[k as usize];
+    let at = tet.gid.iter().position(|&g| g == p).unwrap_or(0);
+    let Some((g, _)) = jet_at(&sys.weights(k as usize, value), &tet.pts, at) else {
+        return Vec::new();
+    };
+    let n = g.normalize_or_zero();
+    if n == glam::DVec3::ZERO {
+        return Vec::new();
+    }
+    let along = match sys.hessian_normal {
+        HessianNormal::Free => Vec::new(),
+        HessianNormal::Bend => vec![n],
+        HessianNormal::Column => {
+            let (t1, t2) = n.any_orthonormal_pair();
+            vec![n, t1, t2]
+        }
+    };
+    along
+        .into_iter()
+        .map(|u| {
+            let c = [
+                u.x * n.x,
+                u.x * n.y + u.y * n.x,
+                u.x * n.z + u.z * n.x,
+                u.y * n.y,
+                u.y * n.z + u.z * n.y,
+                u.z * n.z,
+            ];
+            c.iter()
+                .enumerate()
+                .filter(|(_, v)| **v != 0.0)
+                .map(|(e, v)| (base + e, *v))
+                .collect()
+        })
+        .collect()
 }
 
 fn hessian_point(parts: &[(u32, u8)], np: u32, inner: &HashSet<u32>) -> Option<u32> {

@@ -210,6 +210,12 @@ pub struct System {
     /// Whether the rows a group's sign fit leaves missed are met region by region
     /// (`QuinticOptions::joint_local_meet`, [`super::localmeet`]) instead of by its factor.
     pub joint_local_meet: bool,
+    /// Rows holding the normal part of the relaxed points' Hessians
+    /// (`QuinticOptions::hessian_normal`, [`super::normalpart`]): solved with the scheme's
+    /// equations, in the group of their last unknowns.
+    pub(super) held: Vec<Equation>,
+    /// What [`Self::held`] holds, so that the hole repair's freed Hessians keep it too.
+    pub hessian_normal: super::normalpart::HessianNormal,
     /// The double-double factor's one drop threshold for groups beyond the in-house factor
     /// (`QuinticOptions::precise_pivot`; `None`: [`super::cholesky::PRECISE_PIVOT`], then
     /// [`super::supernodal::PRECISE_RETRY_PIVOT`]).
@@ -354,6 +360,8 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
         joint_local_meet: false,
         precise_pivot: None,
         preset: None,
+        held: Vec::new(),
+        hessian_normal: super::normalpart::HessianNormal::Free,
     })
 }
 
@@ -521,6 +529,9 @@ pub struct SolveStats {
     pub hole_repair: super::holes::HoleRepair,
     /// What [`super::project::project_signs`] did (`QuinticOptions::sign_rounds`).
     pub sign_projection: super::project::SignProjection,
+    /// Rows holding the normal part of the points' Hessians
+    /// (`QuinticOptions::hessian_normal`).
+    pub normal_rows: usize,
 }
 
 /// One point's vertex-star system ([`System::star_systems`]).
@@ -685,6 +696,15 @@ impl System {
             pin,
             (consistent_stars, consistent_faces),
         )?;
+        if std::env::var_os("APATCH_HELD_TRACE").is_some() {
+            // Opt-in exploration on stderr (results unaffected): how closely the scheme's rows
+            // and the held normal rows (`hessian_normal`) are met.
+            eprintln!(
+                "quintic-c2 held: scheme residual {:.2e}, held rows {:.2e}",
+                self.scheme_residual(&value),
+                self.held_residual(&value)
+            );
+        }
         if !relax_stars {
             return Ok((value, stats));
         }
@@ -800,6 +820,21 @@ impl System {
         let wmax = value.iter().fold(1e-300_f64, |a, v| a.max(v.abs()));
         (0..self.equations.len())
             .map(|e| self.relative_residual(e, value, wmax))
+            .fold(0.0, f64::max)
+    }
+
+    /// The largest residual of the held normal rows ([`Self::held`]) in `value`, each relative
+    /// to the size of its terms.
+    fn held_residual(&self, value: &[f64]) -> f64 {
+        self.held
+            .iter()
+            .map(|eq| {
+                let (r, size) = eq.terms.iter().fold((0.0_f64, 0.0_f64), |(r, z), (s, c)| {
+                    let t = c * value[*s as usize];
+                    (r + t, z + t.abs())
+                });
+                r.abs() / size.max(1e-300)
+            })
             .fold(0.0, f64::max)
     }
 
@@ -1073,7 +1108,12 @@ impl System {
     ) -> (Vec<f64>, SolveStats, Vec<Failure>) {
         // The scheme's equations, then the consistency conditions of singular stars
         // (`QuinticOptions::consistent_stars`).
-        let all: Vec<&Equation> = self.equations.iter().chain(extra).collect();
+        let all: Vec<&Equation> = self
+            .equations
+            .iter()
+            .chain(&self.held)
+            .chain(extra)
+            .collect();
         let ns = self.keys.len();
         let np = self.np;
         let first_mid = np + 2 * nt;
