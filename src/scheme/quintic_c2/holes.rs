@@ -897,15 +897,7 @@ fn repair_defect(
                 .filter(|q| q.0 != p)
                 .flat_map(|q| std::iter::repeat_n(pos[&q.0] - at, usize::from(q.1)))
                 .collect();
-            let (u, v) = (others[0], others[1]);
-            let coef = [
-                u.x * v.x,
-                u.x * v.y + u.y * v.x,
-                u.x * v.z + u.z * v.x,
-                u.y * v.y,
-                u.y * v.z + u.z * v.y,
-                u.z * v.z,
-            ];
+            let coef = symmetric_pair(others[0], others[1]);
             let mut row = vec![(j, 1.0)];
             row.extend(coef.iter().enumerate().map(|(e, c)| (base + e, -c / 20.0)));
             hess_rows.push((row, value[s as usize]));
@@ -1499,18 +1491,8 @@ fn jet_at(
     pts: &[glam::DVec3; 4],
     at: usize,
 ) -> Option<(glam::DVec3, glam::DMat3)> {
-    let m = glam::DMat4::from_cols(
-        pts[0].extend(1.0),
-        pts[1].extend(1.0),
-        pts[2].extend(1.0),
-        pts[3].extend(1.0),
-    );
-    if m.determinant().abs() <= f64::MIN_POSITIVE {
-        return None;
-    }
-    // λ = M⁻¹ (x, 1): ∇λ_i is row i of M⁻¹ without its last entry.
-    let inv = m.inverse().transpose();
-    let grad = |i: usize| inv.col(i).truncate();
+    let grads = super::normalpart::barycentric_gradients(pts)?;
+    let grad = |i: usize| grads[i];
     let w = |extra: &[usize]| {
         let mut l = [0u8; 4];
         l[at] = 5 - extra.len() as u8;
@@ -1576,21 +1558,26 @@ fn held_hessian_rows(
     along
         .into_iter()
         .map(|u| {
-            let c = [
-                u.x * n.x,
-                u.x * n.y + u.y * n.x,
-                u.x * n.z + u.z * n.x,
-                u.y * n.y,
-                u.y * n.z + u.z * n.y,
-                u.z * n.z,
-            ];
-            c.iter()
+            symmetric_pair(u, n)
+                .iter()
                 .enumerate()
                 .filter(|(_, v)| **v != 0.0)
                 .map(|(e, v)| (base + e, *v))
                 .collect()
         })
         .collect()
+}
+
+/// uᵀH v as coefficients of the symmetric H's entries xx, xy, xz, yy, yz, zz.
+fn symmetric_pair(u: glam::DVec3, v: glam::DVec3) -> [f64; 6] {
+    [
+        u.x * v.x,
+        u.x * v.y + u.y * v.x,
+        u.x * v.z + u.z * v.x,
+        u.y * v.y,
+        u.y * v.z + u.z * v.y,
+        u.z * v.z,
+    ]
 }
 
 fn hessian_point(parts: &[(u32, u8)], np: u32, inner: &HashSet<u32>) -> Option<u32> {
@@ -1752,19 +1739,7 @@ mod tests {
     /// gradient and Hessian, at every corner of a skewed tetrahedron.
     #[test]
     fn jet_at_recovers_the_taylor_polynomial_it_was_made_from() {
-        use glam::{DMat3, DVec3};
-        let pts = [
-            DVec3::new(0.1, -0.2, 0.05),
-            DVec3::new(1.3, 0.1, -0.2),
-            DVec3::new(0.2, 0.9, 0.3),
-            DVec3::new(0.4, 0.3, 0.02),
-        ];
-        let g = DVec3::new(0.3, -0.8, 0.5);
-        let h = DMat3::from_cols(
-            DVec3::new(2.0, -0.7, 0.4),
-            DVec3::new(-0.7, -1.5, 3.0),
-            DVec3::new(0.4, 3.0, 0.25),
-        );
+        let (pts, g, h) = super::super::normalpart::tests::skewed_jet();
         for at in 0..4 {
             let jet = super::super::jets::Jet { p: pts[at], g, h };
             let weights: Vec<f64> = multi_indices(5)

@@ -47,15 +47,9 @@ impl HessianNormal {
     }
 }
 
-/// The coefficients of uᵀ∇²F v at corner `at` of the tetrahedron `pts`, by multi-index of its
-/// quintic's weights; `None` for a flat tetrahedron.
+/// ∇λ_i of the tetrahedron's barycentric coordinates; `None` for a flat tetrahedron.
 #[must_use]
-pub fn second_derivative_row(
-    pts: &[DVec3; 4],
-    at: usize,
-    u: DVec3,
-    v: DVec3,
-) -> Option<Vec<([u8; 4], f64)>> {
+pub fn barycentric_gradients(pts: &[DVec3; 4]) -> Option<[DVec3; 4]> {
     let m = DMat4::from_cols(
         pts[0].extend(1.0),
         pts[1].extend(1.0),
@@ -67,7 +61,20 @@ pub fn second_derivative_row(
     }
     // λ = M⁻¹ (x, 1): ∇λ_i is row i of M⁻¹ without its last entry.
     let inv = m.inverse().transpose();
-    let grad = |i: usize| inv.col(i).truncate();
+    Some([0, 1, 2, 3].map(|i| inv.col(i).truncate()))
+}
+
+/// The coefficients of uᵀ∇²F v at corner `at` of the tetrahedron `pts`, by multi-index of its
+/// quintic's weights; `None` for a flat tetrahedron.
+#[must_use]
+pub fn second_derivative_row(
+    pts: &[DVec3; 4],
+    at: usize,
+    u: DVec3,
+    v: DVec3,
+) -> Option<Vec<([u8; 4], f64)>> {
+    let grads = barycentric_gradients(pts)?;
+    let grad = |i: usize| grads[i];
     let index = |extra: &[usize]| {
         let mut l = [0u8; 4];
         l[at] = 5 - extra.len() as u8;
@@ -160,15 +167,14 @@ pub(super) fn rows(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::bb::multi_indices;
     use glam::DMat3;
 
-    /// The row gives uᵀ∇²F v of the quintic made from a 2-jet's Taylor polynomial
-    /// ([`Jet::blossom5`]), at every corner of a skewed tetrahedron, for three pairs (u, v).
-    #[test]
-    fn the_row_gives_the_second_derivative_of_a_taylor_quintic() {
+    /// A skewed tetrahedron (edges ~1) and a 2-jet (gradient, symmetric Hessian) of no special
+    /// form, for the corner formulas' tests here and in [`super::super::holes`].
+    pub(in crate::scheme::quintic_c2) fn skewed_jet() -> ([DVec3; 4], DVec3, DMat3) {
         let pts = [
             DVec3::new(0.1, -0.2, 0.05),
             DVec3::new(1.3, 0.1, -0.2),
@@ -181,6 +187,14 @@ mod tests {
             DVec3::new(-0.7, -1.5, 3.0),
             DVec3::new(0.4, 3.0, 0.25),
         );
+        (pts, g, h)
+    }
+
+    /// The row gives uᵀ∇²F v of the quintic made from a 2-jet's Taylor polynomial
+    /// ([`Jet::blossom5`]), at every corner of a skewed tetrahedron, for three pairs (u, v).
+    #[test]
+    fn the_row_gives_the_second_derivative_of_a_taylor_quintic() {
+        let (pts, g, h) = skewed_jet();
         let pairs = [
             (DVec3::X, DVec3::X),
             (DVec3::new(0.6, 0.0, 0.8), DVec3::new(0.0, 1.0, 0.0)),
