@@ -1547,15 +1547,8 @@ fn held_hessian_rows(
     if n == glam::DVec3::ZERO {
         return Vec::new();
     }
-    let along = match sys.hessian_normal {
-        HessianNormal::Free => Vec::new(),
-        HessianNormal::Bend => vec![n],
-        HessianNormal::Column => {
-            let (t1, t2) = n.any_orthonormal_pair();
-            vec![n, t1, t2]
-        }
-    };
-    along
+    sys.hessian_normal
+        .directions(n)
         .into_iter()
         .map(|u| {
             symmetric_pair(u, n)

@@ -45,6 +45,20 @@ impl HessianNormal {
             .position(|&n| n == name)
             .map(|at| modes[at])
     }
+
+    /// The directions u whose uᵀH n this mode holds at 0, for the unit normal `n`: none,
+    /// n alone, or n and two tangents.
+    #[must_use]
+    pub fn directions(self, n: DVec3) -> Vec<DVec3> {
+        match self {
+            Self::Free => Vec::new(),
+            Self::Bend => vec![n],
+            Self::Column => {
+                let (t1, t2) = n.any_orthonormal_pair();
+                vec![n, t1, t2]
+            }
+        }
+    }
 }
 
 /// ∇λ_i of the tetrahedron's barycentric coordinates; `None` for a flat tetrahedron.
@@ -116,7 +130,7 @@ pub(super) fn rows(
         return Vec::new();
     }
     let np = sys.np as usize;
-    // Per point: (largest |n·∇λ_i| over the other corners, tetrahedron, corner).
+    // Per point: (largest |coefficient| of its nᵀ∇²F n row there, tetrahedron, corner).
     let mut best: Vec<Option<(f64, usize, usize)>> = vec![None; np];
     for (t, tet) in tets.iter().enumerate() {
         for at in 0..4 {
@@ -140,16 +154,8 @@ pub(super) fn rows(
         if n == DVec3::ZERO {
             continue;
         }
-        let along: Vec<DVec3> = match mode {
-            HessianNormal::Free => Vec::new(),
-            HessianNormal::Bend => vec![n],
-            HessianNormal::Column => {
-                let (t1, t2) = n.any_orthonormal_pair();
-                vec![n, t1, t2]
-            }
-        };
         let tet = &tets[t];
-        for u in along {
+        for u in mode.directions(n) {
             let Some(row) = second_derivative_row(&tet.pts, at, u, n) else {
                 continue;
             };
