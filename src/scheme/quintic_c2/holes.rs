@@ -957,9 +957,9 @@ fn repair_defect(
     }
     let mut x0: Vec<f64> = unk.iter().map(|&s| value[s as usize]).collect();
     x0.resize(n, 0.0);
-    if normal_bend_target() {
-        // Exploration (`APATCH_HOLE_NORMAL_BEND=1`): each freed Hessian's change aims at
-        // taking its normal part n·H·n back to the jets' 0 (`scripts/normal_curvature.py`).
+    if let Some(column) = normal_bend_target() {
+        // Exploration (`APATCH_HOLE_NORMAL_BEND`): each freed Hessian's change aims at
+        // taking its normal part back to the jets' 0 (`scripts/normal_curvature.py`).
         for (&p, &base) in &hess_col {
             let Some(k) = near
                 .iter()
@@ -976,16 +976,24 @@ fn repair_defect(
             let nn = g.normalize_or_zero();
             let bend = nn.dot(h * nn);
             let u = hess_unit[(base - unk.len()) / 6];
+            // The part taken out, as the entries xx, xy, xz, yy, yz, zz.
+            let nnt = glam::DMat3::from_cols(nn * nn.x, nn * nn.y, nn * nn.z);
+            let out = if column {
+                let p = glam::DMat3::IDENTITY - nnt;
+                h - p * h * p
+            } else {
+                bend * nnt
+            };
             let d = [
-                nn.x * nn.x,
-                nn.x * nn.y,
-                nn.x * nn.z,
-                nn.y * nn.y,
-                nn.y * nn.z,
-                nn.z * nn.z,
+                out.x_axis.x,
+                out.y_axis.x,
+                out.z_axis.x,
+                out.y_axis.y,
+                out.z_axis.y,
+                out.z_axis.z,
             ];
             for (e, v) in d.iter().enumerate() {
-                x0[base + e] = -u * bend * v;
+                x0[base + e] = -u * v;
             }
         }
     }
@@ -1478,8 +1486,16 @@ fn repair_defect(
 /// the other two indices elsewhere) when that point is in `inner`: the weights whose jet a
 /// repair with [`Reach::hessians`] re-solves.
 /// Exploration (`APATCH_HOLE_NORMAL_BEND=1`): the freed Hessians' changes aim at n·H·n = 0.
-fn normal_bend_target() -> bool {
-    std::env::var("APATCH_HOLE_NORMAL_BEND").is_ok_and(|v| v != "0")
+/// Exploration (`APATCH_HOLE_NORMAL_BEND`): what the freed Hessians' changes aim to take out
+/// of the point's Hessian H. `1`: the normal bend n·H·n (`Some(false)`); `column`: the whole
+/// H − P H P (P = I − n nᵀ), the bend and the mixed part P H n, which the joint stars put at
+/// fandisk's deepest crossed faces (session 67) (`Some(true)`).
+fn normal_bend_target() -> Option<bool> {
+    match std::env::var("APATCH_HOLE_NORMAL_BEND").ok()?.as_str() {
+        "0" => None,
+        "column" => Some(true),
+        _ => Some(false),
+    }
 }
 
 /// ∇F and ∇²F of the quintic with `weights` (in [`multi_indices`] order) over the
