@@ -301,6 +301,28 @@ pub const MAX_JOINT_MEET_TOLERANCE: f64 = 1e-10;
 /// Default [`QuinticOptions::lift`].
 pub const LIFT: f64 = 3.0;
 
+/// The value of `scheme.{key}` as one of `names` (read by `named`), else an error naming
+/// `scene`, the key and the names.
+fn one_of<T>(
+    v: &toml::Value,
+    key: &str,
+    scene: &Path,
+    names: &[&str],
+    named: impl Fn(&str) -> Option<T>,
+) -> anyhow::Result<T> {
+    v.as_str().and_then(named).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: `scheme.{key}` must be one of {}, got {v}",
+            scene.display(),
+            names
+                .iter()
+                .map(|n| format!("\"{n}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    })
+}
+
 impl QuinticOptions {
     /// Reads the `[scheme]` table: `type`, the optional `curvature` (a number ≥ 0) and the inner
     /// hull's keys ([`crate::hull::inner::InnerOptions::KEYS`], read by the hull).
@@ -422,27 +444,16 @@ impl QuinticOptions {
                 }
                 "joint_local_meet" => o.joint_local_meet = flag()?,
                 "face_beta" => {
-                    o.face_beta = match v.as_str().and_then(beta::FaceBeta::named) {
-                        Some(m) => m,
-                        None => bail!(
-                            "{}: `scheme.face_beta` must be one of {}, got {v}",
-                            scene.display(),
-                            beta::FaceBeta::NAMES.map(|n| format!("\"{n}\"")).join(", ")
-                        ),
-                    }
+                    o.face_beta = one_of(v, k, scene, &beta::FaceBeta::NAMES, beta::FaceBeta::named)?
                 }
                 "hessian_normal" => {
-                    o.hessian_normal = match v.as_str().and_then(normalpart::HessianNormal::named)
-                    {
-                        Some(m) => m,
-                        None => bail!(
-                            "{}: `scheme.hessian_normal` must be one of {}, got {v}",
-                            scene.display(),
-                            normalpart::HessianNormal::NAMES
-                                .map(|n| format!("\"{n}\""))
-                                .join(", ")
-                        ),
-                    }
+                    o.hessian_normal = one_of(
+                        v,
+                        k,
+                        scene,
+                        &normalpart::HessianNormal::NAMES,
+                        normalpart::HessianNormal::named,
+                    )?
                 }
                 "precise_pivot" => {
                     o.precise_pivot = Some(number(
