@@ -1482,10 +1482,6 @@ fn repair_defect(
     Some((x, pins.len(), soft))
 }
 
-/// The point of T whose number 2 weight the slot with key `parts` is (multiplicity 3 there,
-/// the other two indices elsewhere) when that point is in `inner`: the weights whose jet a
-/// repair with [`Reach::hessians`] re-solves.
-/// Exploration (`APATCH_HOLE_NORMAL_BEND=1`): the freed Hessians' changes aim at n·H·n = 0.
 /// Exploration (`APATCH_HOLE_NORMAL_BEND`): what the freed Hessians' changes aim to take out
 /// of the point's Hessian H. `1`: the normal bend n·H·n (`Some(false)`); `column`: the whole
 /// H − P H P (P = I − n nᵀ), the bend and the mixed part P H n, which the joint stars put at
@@ -1589,6 +1585,9 @@ fn symmetric_pair(u: glam::DVec3, v: glam::DVec3) -> [f64; 6] {
     ]
 }
 
+/// The point of T whose number 2 weight the slot with key `parts` is (multiplicity 3 there,
+/// the other two indices elsewhere) when that point is in `inner`: the weights whose jet a
+/// repair with [`Reach::hessians`] re-solves.
 fn hessian_point(parts: &[(u32, u8)], np: u32, inner: &HashSet<u32>) -> Option<u32> {
     let p = parts.iter().find(|q| q.1 == 3)?;
     (p.0 < np && inner.contains(&p.0)).then_some(p.0)
