@@ -974,7 +974,6 @@ fn repair_defect(
                 continue;
             };
             let nn = g.normalize_or_zero();
-            let bend = nn.dot(h * nn);
             let u = hess_unit[(base - unk.len()) / 6];
             // The part taken out, as the entries xx, xy, xz, yy, yz, zz.
             let nnt = glam::DMat3::from_cols(nn * nn.x, nn * nn.y, nn * nn.z);
@@ -982,7 +981,7 @@ fn repair_defect(
                 let p = glam::DMat3::IDENTITY - nnt;
                 h - p * h * p
             } else {
-                bend * nnt
+                nn.dot(h * nn) * nnt
             };
             let d = [
                 out.x_axis.x,
