@@ -161,6 +161,14 @@ pub struct QuinticOptions {
     /// (∇²F n = 0, three rows per point). Only points whose Hessian is relaxed (`joint_stars`,
     /// failing stars) are affected: elsewhere the estimate meets the rows.
     pub hessian_normal: normalpart::HessianNormal,
+    /// What a relaxed Hessian weight's distance from its estimate costs in a group's least
+    /// change, against the other weights' 1 (1, the default: weight by weight alike). In a
+    /// tetrahedron of height h a change of the Hessian moves its number 2 weights by only
+    /// ~h²/20 of it, so at 1 the joint stars' solve and sign pins bend the Hessians freely
+    /// (the rounded cylinder's curve 4× the cylinder's at its vertices); at 100 the cylinder,
+    /// both quad tori and the octahedron keep their estimated Hessians to a few per cent and
+    /// still pass (session 68). Both the group's solve and its sign pins use it.
+    pub hessian_cost: f64,
     /// The double-double factor's drop threshold (a pivot is a row's squared distance from
     /// the rows before it, relative) for the groups beyond the in-house factor (fandisk's
     /// joint group), instead of [`cholesky::PRECISE_PIVOT`] (1e-15) and, when that factor's
@@ -239,6 +247,7 @@ impl Default for QuinticOptions {
             joint_local_meet: false,
             face_beta: beta::FaceBeta::F64,
             hessian_normal: normalpart::HessianNormal::Free,
+            hessian_cost: 1.0,
             precise_pivot: None,
             relax_stars: true,
             consistent_stars: false,
@@ -292,6 +301,11 @@ pub const MAX_REPAIR_MARGIN: f64 = 100.0;
 /// the row, so 1e-6 drops rows up to 1e-3 of their length from the span of the others, which
 /// are independent rows for the factor to keep, not rounding for the meet to mend.
 pub const MAX_PRECISE_PIVOT: f64 = 1e-6;
+
+/// The largest [`QuinticOptions::hessian_cost`]: the weighted solve divides the Hessian
+/// weights' columns by it, so beyond ~1e6 those columns fall toward the factor's drop
+/// threshold relative to the others and the group's rank would change, not only its norm.
+pub const MAX_HESSIAN_COST: f64 = 1e6;
 
 /// The largest [`QuinticOptions::joint_meet_tolerance`]: the check's gradient and Hessian
 /// jumps follow the joint group's row misses at ~200 and ~5e4 times them (fandisk), so rows
@@ -455,6 +469,12 @@ impl QuinticOptions {
                         normalpart::HessianNormal::named,
                     )?
                 }
+                "hessian_cost" => {
+                    o.hessian_cost = number(
+                        &|t| t > 0.0 && t <= MAX_HESSIAN_COST,
+                        &format!("a number in (0, {MAX_HESSIAN_COST:e}]"),
+                    )?;
+                }
                 "precise_pivot" => {
                     o.precise_pivot = Some(number(
                         &|t| t > 0.0 && t <= MAX_PRECISE_PIVOT,
@@ -464,7 +484,7 @@ impl QuinticOptions {
                 "signs" => o.signs = flag()?,
                 "curvature" => o.curvature = number(&|x| x >= 0.0, "a number ≥ 0")?,
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `hessian_normal`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `hessian_normal`, `hessian_cost`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -598,6 +618,7 @@ pub fn build_prepared(
     let (tets, _pos) = system::tetrahedra_with(hull, rule)?;
     let mut sys = system::assemble_with(&tets, np, options.face_beta.or_env())?;
     sys.star_tau = options.star_tau;
+    sys.hessian_cost = options.hessian_cost;
     sys.sign_targets = options.sign_targets;
     sys.joint_sign_rounds = options.joint_sign_rounds;
     sys.joint_sign_fit = options.joint_sign_fit;
@@ -617,8 +638,9 @@ pub fn build_prepared(
     } else {
         signs::HessianFit::default()
     };
-    sys.held = normalpart::rows(&sys, &tets, &jets, options.hessian_normal);
     sys.hessian_normal = options.hessian_normal;
+    sys.column_points = normalpart::column_points_from_env(np);
+    sys.held = normalpart::rows(&sys, &tets, &jets);
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
     let (mut value, mut stats) = match resume::requested() {
         // Exploration: the solve's result read back from an exported complex.

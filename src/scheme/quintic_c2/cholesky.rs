@@ -1299,10 +1299,15 @@ pub(super) fn meet_dropped<F: NormalSolve>(
     let mut q: Vec<Vec<f64>> = Vec::new();
     let mut used = vec![false; m];
     let mut seen: Vec<Vec<(usize, f64)>> = Vec::new();
+    // Exploration (`APATCH_MEET_STALL=k`): stop after k rounds in a row that did not lower the
+    // residual (fandisk's meet before the fit: four refused rounds of ~6 min, session 66).
+    let stall = positive_env("APATCH_MEET_STALL").map_or(usize::MAX, |k| k as usize);
+    let mut stalled = 0;
     for round in 0..MEET_ROUNDS {
-        if res <= tol || q.len() >= MEET_BASIS {
+        if res <= tol || q.len() >= MEET_BASIS || stalled >= stall {
             break;
         }
+        stalled += 1;
         let t = std::time::Instant::now();
         // The worst rows not used yet: those missed by more than a fraction of the largest miss.
         let bar = tol.max(MEET_FRACTION * res);
@@ -1474,6 +1479,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
         }
         if got < res {
             (*x, r, res) = (y, ry, got);
+            stalled = 0;
         }
     }
     (res, q)

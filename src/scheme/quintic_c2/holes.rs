@@ -1528,7 +1528,7 @@ fn jet_at(
 
 /// Rows on point `p`'s six Hessian unknowns (columns `base..base + 6`, the change δH in the
 /// entries xx, xy, xz, yy, yz, zz, each in its point's unit) that keep uᵀδH n = 0 for the
-/// directions u that [`System::hessian_normal`] holds, n the unit gradient at `p` read from a
+/// directions u that [`System::hessian_normal_at`] holds, n the unit gradient at `p` read from a
 /// near tetrahedron's weights. A uniform scale of δH (the point's unit) leaves the rows true.
 fn held_hessian_rows(
     sys: &System,
@@ -1539,7 +1539,8 @@ fn held_hessian_rows(
     base: usize,
 ) -> Vec<Vec<(usize, f64)>> {
     use super::normalpart::HessianNormal;
-    if sys.hessian_normal == HessianNormal::Free {
+    let mode = sys.hessian_normal_at(p);
+    if mode == HessianNormal::Free {
         return Vec::new();
     }
     let Some(k) = near
@@ -1558,8 +1559,7 @@ fn held_hessian_rows(
     if n == glam::DVec3::ZERO {
         return Vec::new();
     }
-    sys.hessian_normal
-        .directions(n)
+    mode.directions(n)
         .into_iter()
         .map(|u| {
             symmetric_pair(u, n)

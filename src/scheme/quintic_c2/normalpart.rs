@@ -61,6 +61,32 @@ impl HessianNormal {
     }
 }
 
+/// The points of T whose whole column H n is held (exploration, `APATCH_HESSIAN_COLUMN_AT`:
+/// comma-separated indices of the complex's vertices, e.g. those `scripts/normal_curvature.py`
+/// ranks first by the mixed part), sorted; indices past the `np` points are reported and
+/// skipped.
+#[must_use]
+pub fn column_points_from_env(np: u32) -> Vec<u32> {
+    let Ok(list) = std::env::var("APATCH_HESSIAN_COLUMN_AT") else {
+        return Vec::new();
+    };
+    let mut points: Vec<u32> = list
+        .split(',')
+        .map(str::trim)
+        .filter(|v| !v.is_empty())
+        .filter_map(|v| match v.parse::<u32>() {
+            Ok(p) if p < np => Some(p),
+            _ => {
+                eprintln!("APATCH_HESSIAN_COLUMN_AT: `{v}` is not a point of T (0..{np}); skipped");
+                None
+            }
+        })
+        .collect();
+    points.sort_unstable();
+    points.dedup();
+    points
+}
+
 /// ∇λ_i of the tetrahedron's barycentric coordinates; `None` for a flat tetrahedron.
 #[must_use]
 pub fn barycentric_gradients(pts: &[DVec3; 4]) -> Option<[DVec3; 4]> {
@@ -115,18 +141,13 @@ pub fn second_derivative_row(
     Some(terms)
 }
 
-/// The rows `mode` asks at every point of T (none for [`HessianNormal::Free`]), each over the
-/// slots of the tetrahedron at the point that reaches farthest along its normal (the smallest
-/// coefficients). A point whose Hessian is not relaxed has every slot of its rows known, and
-/// the estimate meets them.
+/// The rows [`System::hessian_normal_at`] asks at every point of T (none where it is
+/// [`HessianNormal::Free`]), each over the slots of the tetrahedron at the point that reaches
+/// farthest along its normal (the smallest coefficients). A point whose Hessian is not relaxed
+/// has every slot of its rows known, and the estimate meets them.
 #[must_use]
-pub(super) fn rows(
-    sys: &System,
-    tets: &[HullTet],
-    jets: &[Jet],
-    mode: HessianNormal,
-) -> Vec<Equation> {
-    if mode == HessianNormal::Free {
+pub(super) fn rows(sys: &System, tets: &[HullTet], jets: &[Jet]) -> Vec<Equation> {
+    if sys.hessian_normal == HessianNormal::Free && sys.column_points.is_empty() {
         return Vec::new();
     }
     let np = sys.np as usize;
@@ -155,7 +176,7 @@ pub(super) fn rows(
             continue;
         }
         let tet = &tets[t];
-        for u in mode.directions(n) {
+        for u in sys.hessian_normal_at(p as u32).directions(n) {
             let Some(row) = second_derivative_row(&tet.pts, at, u, n) else {
                 continue;
             };

@@ -214,8 +214,15 @@ pub struct System {
     /// (`QuinticOptions::hessian_normal`, [`super::normalpart`]): solved with the scheme's
     /// equations, in the group of their last unknowns.
     pub(super) held: Vec<Equation>,
+    /// What a relaxed Hessian weight's change costs in a group's least change, the others'
+    /// being 1 (`QuinticOptions::hessian_cost`).
+    pub hessian_cost: f64,
     /// What [`Self::held`] holds, so that the hole repair's freed Hessians keep it too.
     pub hessian_normal: super::normalpart::HessianNormal,
+    /// Points of T (sorted) whose whole normal column H n is held whatever
+    /// [`Self::hessian_normal`] says (exploration, `APATCH_HESSIAN_COLUMN_AT`): the points
+    /// where a first solve put an extreme mixed part.
+    pub column_points: Vec<u32>,
     /// The double-double factor's one drop threshold for groups beyond the in-house factor
     /// (`QuinticOptions::precise_pivot`; `None`: [`super::cholesky::PRECISE_PIVOT`], then
     /// [`super::supernodal::PRECISE_RETRY_PIVOT`]).
@@ -362,6 +369,8 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
         preset: None,
         held: Vec::new(),
         hessian_normal: super::normalpart::HessianNormal::Free,
+        column_points: Vec::new(),
+        hessian_cost: 1.0,
     })
 }
 
@@ -637,6 +646,17 @@ struct Group {
 type GroupSolution = (dense::Solution, usize, usize);
 
 impl System {
+    /// What is held of point `p`'s Hessian: the whole column at [`Self::column_points`], the
+    /// scene's [`Self::hessian_normal`] elsewhere.
+    #[must_use]
+    pub fn hessian_normal_at(&self, p: u32) -> super::normalpart::HessianNormal {
+        if self.column_points.binary_search(&p).is_ok() {
+            super::normalpart::HessianNormal::Column
+        } else {
+            self.hessian_normal
+        }
+    }
+
     /// Solves every slot: jets, then the stages, each group closest to its target
     /// (`target(slot's tetrahedron, multi-index)`).
     ///
@@ -1630,10 +1650,11 @@ impl System {
             && (self.joint_sign_rounds > 0 || self.joint_sign_fit > 0)
             && g.unk.len() > PIN_MAX_UNKNOWNS)
             .then(|| self.sign_box(g));
-        // Exploration (`APATCH_HESSIAN_WEIGHT`): the group's Hessian weights weighted, if it has
-        // any.
+        // The group's relaxed Hessian weights priced by `hessian_cost` (or, for exploration,
+        // `APATCH_HESSIAN_WEIGHT`), if it has any and the price is not 1.
         let np = self.np;
-        let weights = hessian_weight().and_then(|w| {
+        let cost = hessian_weight().unwrap_or(self.hessian_cost);
+        let weights = (cost != 1.0).then_some(cost).and_then(|w| {
             let cw: Vec<f64> = g
                 .unk
                 .iter()
@@ -1650,7 +1671,7 @@ impl System {
                 .collect();
             cw.iter().any(|&x| x != 1.0).then_some(cw)
         });
-        let mut sol = match weights {
+        let mut sol = match weights.as_ref() {
             None => solve_rows_signed(
                 &g.rows,
                 g.unk.len(),
@@ -1664,7 +1685,7 @@ impl System {
                 &g.rows,
                 &g.c,
                 &g.tgt,
-                &cw,
+                cw,
                 g.scale,
                 signs.as_ref(),
                 self.precise_pivot,
@@ -1685,7 +1706,7 @@ impl System {
             let missed = |x: &[f64]| conds.iter().filter(|k| k.value(x) < -tiny).count();
             let before = if trace { missed(&sol.x) } else { 0 };
             (pinned, given_up) =
-                pin_signs(&mut sol, &mut g.rows, &mut g.c, &conds, &g.tgt, g.scale);
+                pin_signs(&mut sol, &mut g.rows, &mut g.c, &conds, &g.tgt, weights.as_deref(), g.scale);
             if trace {
                 let own = conds
                     .iter()
@@ -2042,7 +2063,8 @@ fn unmet_row(g: &Group, x: &[f64], i: usize) -> Option<f64> {
 /// each relaxed Hessian weight's distance from its estimate counts w times the others', so the
 /// solve moves the jets (fitted into Theorem 2.1's signs by `hessian_signs`) only as far as the
 /// stars' equations need: between the Hessians free (w = 1) and fixed (`APATCH_JOINT_LEVEL=1`).
-/// Only the first solve is weighted: the sign pins of a small group re-solve it unweighted.
+/// Overrides the scene's `hessian_cost`; the sign pins of a small group re-solve it in the same
+/// norm (since session 68; before, unweighted, which undid the weight wherever pins were taken).
 fn hessian_weight() -> Option<f64> {
     std::env::var("APATCH_HESSIAN_WEIGHT")
         .ok()
@@ -2311,9 +2333,15 @@ fn pin_signs(
     c: &mut Vec<f64>,
     conds: &[SignCondition],
     tgt: &[f64],
+    cw: Option<&[f64]>,
     scale: f64,
 ) -> (usize, usize) {
     let n = tgt.len();
+    // Each re-solve in the norm the group's first solve used.
+    let solve_rows = |rows: &[sparse::Row], n: usize, c: &[f64], tgt: &[f64], scale: f64| match cw {
+        None => solve_rows(rows, n, c, tgt, scale),
+        Some(cw) => solve_rows_weighted(rows, c, tgt, cw, scale, None, None),
+    };
     let margin = 1e-6 * scale;
     // Rounding of the solves (residual ≤ 1e-9 scale is accepted as consistent).
     let tiny = 1e-9 * scale;
