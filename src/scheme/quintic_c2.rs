@@ -162,12 +162,14 @@ pub struct QuinticOptions {
     /// failing stars) are affected: elsewhere the estimate meets the rows.
     pub hessian_normal: normalpart::HessianNormal,
     /// What a relaxed Hessian weight's distance from its estimate costs in a group's least
-    /// change, against the other weights' 1 (1, the default: weight by weight alike). In a
-    /// tetrahedron of height h a change of the Hessian moves its number 2 weights by only
-    /// ~h²/20 of it, so at 1 the joint stars' solve and sign pins bend the Hessians freely
-    /// (the rounded cylinder's curve 4× the cylinder's at its vertices); at 100 the cylinder,
-    /// both quad tori and the octahedron keep their estimated Hessians to a few per cent and
-    /// still pass (session 68). Both the group's solve and its sign pins use it.
+    /// change, against the other weights' 1 (1, the default: weight by weight alike), in the
+    /// group's solve and in its sign pins. In a tetrahedron of height h a change of the
+    /// Hessian moves its number 2 weights by only ~h²/20 of it, so at 1 the joint stars bend
+    /// the Hessians where that is cheap (the rounded cylinder's level set curves 4× the
+    /// cylinder at its points); at 100 the rounded cylinder, both quad tori and the
+    /// octahedron keep their estimated Hessians to a few per cent and still pass, but the
+    /// curvature moves between the points instead (the cylinder's mean curvature varies 2×
+    /// more over its sides; docs/quintic.md, session 68), so no shipped scene sets it.
     pub hessian_cost: f64,
     /// The double-double factor's drop threshold (a pivot is a row's squared distance from
     /// the rows before it, relative) for the groups beyond the in-house factor (fandisk's

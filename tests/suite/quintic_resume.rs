@@ -35,8 +35,7 @@ fn export_with(scene: &Path, out: &Path, resume: Option<&Path>, env: &[(&str, &s
 }
 
 /// The shipped scene `name` (paper1994) copied with an absolute model path, `repair_holes`
-/// set as asked, Theorem 2.1's pins off and the Hessians priced weight by weight (so the
-/// torus has holes to repair: with its `hessian_cost = 100` the plain solve has none).
+/// set as asked and Theorem 2.1's pins off (so the torus has holes to repair).
 fn scene(name: &str, repair: bool) -> PathBuf {
     scene_with(
         name,
@@ -55,7 +54,6 @@ fn scene_with(name: &str, keys: &str, tag: &str) -> PathBuf {
             &format!("\"{}/", root.join("scenes/models").display()),
         )
         .replace("\nsigns = true", "\n")
-        .replace("\nhessian_cost = 100", "\n")
         .replace(
             "type = \"quintic-c2\"",
             &format!("type = \"quintic-c2\"\n{keys}"),
