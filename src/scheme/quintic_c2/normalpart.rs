@@ -67,9 +67,12 @@ impl HessianNormal {
 /// skipped.
 #[must_use]
 pub fn column_points_from_env(np: u32) -> Vec<u32> {
-    let Ok(list) = std::env::var("APATCH_HESSIAN_COLUMN_AT") else {
-        return Vec::new();
-    };
+    std::env::var("APATCH_HESSIAN_COLUMN_AT").map_or_else(|_| Vec::new(), |v| column_points(&v, np))
+}
+
+/// The points of T a comma-separated list names, sorted and without repeats; an entry that
+/// is not an index below `np` is reported on stderr and skipped.
+fn column_points(list: &str, np: u32) -> Vec<u32> {
     let mut points: Vec<u32> = list
         .split(',')
         .map(str::trim)
@@ -248,6 +251,13 @@ pub(super) mod tests {
     }
 
     /// A flat tetrahedron has no row.
+    #[test]
+    fn column_points_are_read_sorted_and_checked() {
+        assert_eq!(column_points("9, 3,9,,12", 10), vec![3, 9]);
+        assert_eq!(column_points("x,-1,2", 10), vec![2]);
+        assert!(column_points("", 10).is_empty());
+    }
+
     #[test]
     fn a_flat_tetrahedron_has_no_row() {
         let pts = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)];

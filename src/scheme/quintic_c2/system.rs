@@ -1705,8 +1705,15 @@ impl System {
             let tiny = 1e-9 * g.scale;
             let missed = |x: &[f64]| conds.iter().filter(|k| k.value(x) < -tiny).count();
             let before = if trace { missed(&sol.x) } else { 0 };
-            (pinned, given_up) =
-                pin_signs(&mut sol, &mut g.rows, &mut g.c, &conds, &g.tgt, weights.as_deref(), g.scale);
+            (pinned, given_up) = pin_signs(
+                &mut sol,
+                &mut g.rows,
+                &mut g.c,
+                &conds,
+                &g.tgt,
+                weights.as_deref(),
+                g.scale,
+            );
             if trace {
                 let own = conds
                     .iter()
