@@ -304,9 +304,10 @@ pub const MAX_REPAIR_MARGIN: f64 = 100.0;
 /// are independent rows for the factor to keep, not rounding for the meet to mend.
 pub const MAX_PRECISE_PIVOT: f64 = 1e-6;
 
-/// The largest [`QuinticOptions::hessian_cost`]: the weighted solve divides the Hessian
-/// weights' columns by it, so beyond ~1e6 those columns fall toward the factor's drop
-/// threshold relative to the others and the group's rank would change, not only its norm.
+/// The largest [`QuinticOptions::hessian_cost`]: costs up to 1e4 were measured (sessions 59,
+/// 68); the weighted solve divides the Hessian weights' columns by the cost, and far beyond
+/// that they would shrink toward the rows' rounding, changing what the factor drops and not
+/// only the norm.
 pub const MAX_HESSIAN_COST: f64 = 1e6;
 
 /// The largest [`QuinticOptions::joint_meet_tolerance`]: the check's gradient and Hessian

@@ -250,7 +250,8 @@ pub(super) mod tests {
         }
     }
 
-    /// A flat tetrahedron has no row.
+    /// `APATCH_HESSIAN_COLUMN_AT`'s list: sorted, repeats and entries that are not points of T
+    /// dropped.
     #[test]
     fn column_points_are_read_sorted_and_checked() {
         assert_eq!(column_points("9, 3,9,,12", 10), vec![3, 9]);
@@ -258,6 +259,7 @@ pub(super) mod tests {
         assert!(column_points("", 10).is_empty());
     }
 
+    /// A flat tetrahedron has no row.
     #[test]
     fn a_flat_tetrahedron_has_no_row() {
         let pts = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)];
