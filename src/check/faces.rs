@@ -3,6 +3,7 @@
 
 use super::eval::PatchEval;
 use super::{CheckOptions, FaceStats, Location, Measure};
+use crate::complex::Patch;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -132,6 +133,33 @@ pub(super) fn measure(evals: &[PatchEval<'_>], opts: &CheckOptions) -> FaceMeasu
         hessian: jumps.hessian,
         boundary,
     }
+}
+
+/// The worst jumps across the face that patches `a` and `b` share, measured as `apatch check`
+/// measures them (the same lattice points, the same scales): value over g·l, gradient over g,
+/// Hessian times l over g (g the face's largest gradient, l its longest edge). `None` when the
+/// two share no face. For builders that must not make what `check` refuses: the quintic's hole
+/// repair asks it of every face its re-solve touches.
+#[must_use]
+pub fn pair_jumps(a: &Patch, b: &Patch, opts: &CheckOptions) -> Option<[f64; 3]> {
+    let (ka, kb) = (a.tet.map(point_key), b.tet.map(point_key));
+    let entry = |keys: &[PointKey; 4], opp: u8, patch: u32| {
+        let mut local: Vec<u8> = (0..4u8).filter(|&k| k != opp).collect();
+        local.sort_by_key(|&k| keys[usize::from(k)]);
+        let local = [local[0], local[1], local[2]];
+        FaceEntry {
+            key: local.map(|k| keys[usize::from(k)]),
+            patch,
+            local,
+        }
+    };
+    let (fa, fb) = (0..4u8)
+        .flat_map(|oa| (0..4u8).map(move |ob| (oa, ob)))
+        .map(|(oa, ob)| (entry(&ka, oa, 0), entry(&kb, ob, 1)))
+        .find(|(fa, fb)| fa.key == fb.key)?;
+    let evals = [PatchEval::new(a, 0), PatchEval::new(b, 1)];
+    let j = face_jumps(&evals, &fa, &fb, opts);
+    Some([j.value.worst, j.gradient.worst, j.hessian.worst])
 }
 
 fn face_points(evals: &[PatchEval<'_>], f: &FaceEntry) -> [DVec3; 3] {

@@ -38,6 +38,7 @@ pub mod anatomy;
 pub mod distance;
 pub mod eval;
 mod faces;
+pub use faces::pair_jumps;
 pub mod holes;
 mod interp;
 mod report;

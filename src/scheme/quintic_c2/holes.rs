@@ -481,6 +481,7 @@ pub fn repair(
             eqs_of[s as usize].push(e as u32);
         }
     }
+    let across = neighbours(tets);
     let mi = multi_indices(5);
     let only = only_tets();
     let modes = elevated_modes(pins);
@@ -530,6 +531,7 @@ pub fn repair(
             eqs_of: &eqs_of,
             mi: &mi,
             wmax,
+            across: &across,
         };
         // The defects still open (earlier passes repaired some), with their neighbourhoods.
         let (ids, open): (Vec<u32>, Vec<Local>) = defects
@@ -716,6 +718,100 @@ struct Index<'a> {
     mi: &'a [[u8; 4]],
     /// Largest weight of the solve.
     wmax: f64,
+    /// The tetrahedron across each face (by local opposite vertex), [`NONE`] on the boundary.
+    across: &'a [[u32; 4]],
+}
+
+/// No tetrahedron across a face: a boundary face of the hull.
+const NONE: u32 = u32::MAX;
+
+/// The tetrahedron across each face of each of `tets` (by local opposite vertex), [`NONE`]
+/// where the face is on the hull's boundary.
+fn neighbours(tets: &[HullTet]) -> Vec<[u32; 4]> {
+    let face = |t: &HullTet, opp: usize| {
+        let mut f = [0u32; 3];
+        for (c, k) in (0..4).filter(|&k| k != opp).enumerate() {
+            f[c] = t.gid[k];
+        }
+        f.sort_unstable();
+        f
+    };
+    let mut users: HashMap<[u32; 3], Vec<u32>> = HashMap::new();
+    for (k, t) in tets.iter().enumerate() {
+        for opp in 0..4 {
+            users.entry(face(t, opp)).or_default().push(k as u32);
+        }
+    }
+    tets.iter()
+        .enumerate()
+        .map(|(k, t)| {
+            std::array::from_fn(|opp| match users[&face(t, opp)].as_slice() {
+                [a, b] => {
+                    if *a == k as u32 {
+                        *b
+                    } else {
+                        *a
+                    }
+                }
+                _ => NONE,
+            })
+        })
+        .collect()
+}
+
+/// The first face of the `near` tetrahedra (with the tetrahedron across it) whose gradient or
+/// Hessian jump, as `apatch check` measures it ([`crate::check::pair_jumps`]), is over the
+/// checker's bound in `after` and larger than it was in `before`: the jump and the bound.
+///
+/// The repair's residual guard bounds each C1/C2 equation relative to its terms, which does
+/// not bound the checker's jumps in thin tetrahedra: a residual r in a row of number 2 weights
+/// of a tetrahedron of height h under a face of size l is a Hessian jump of ~4 r l/h (fandisk,
+/// session 68: a Sheet repair with residual 3.4e-12 of the data's 1.9e-2 left a Hessian jump of
+/// 2.78e-7, over C2's 1e-7). A face neither side of which changed is skipped.
+fn continuity_broken(
+    tets: &[HullTet],
+    near: &[u32],
+    across: &[[u32; 4]],
+    weights: impl Fn(u32, &[f64]) -> Vec<f64>,
+    before: &[f64],
+    after: &[f64],
+) -> Option<((u32, u32), [f64; 2], [f64; 2])> {
+    let opts = crate::check::CheckOptions::default();
+    let bound = [opts.jump_tolerance, opts.hessian_tolerance];
+    let patch = |k: u32, w: Vec<f64>| {
+        let t = &tets[k as usize];
+        crate::complex::Patch {
+            tet: t.pts.map(|p| p.to_array()),
+            degree: super::system::N as u8,
+            weights: w,
+            rational: Vec::new(),
+            sheet: crate::complex::SheetRule::Any,
+            role: t.role,
+            element: t.element,
+            jvertex: None,
+            jedge: None,
+        }
+    };
+    let in_near: HashSet<u32> = near.iter().copied().collect();
+    let jumps = |k: u32, j: u32, value: &[f64]| {
+        let (a, b) = (patch(k, weights(k, value)), patch(j, weights(j, value)));
+        crate::check::pair_jumps(&a, &b, &opts).map(|d| [d[1], d[2]])
+    };
+    near.iter()
+        .flat_map(|&k| across[k as usize].iter().map(move |&j| (k, j)))
+        .filter(|&(k, j)| j != NONE && (k < j || !in_near.contains(&j)))
+        .filter(|&(k, j)| {
+            weights(k, before) != weights(k, after) || weights(j, before) != weights(j, after)
+        })
+        .find_map(|(k, j)| {
+            let now = jumps(k, j, after)?;
+            if now.iter().zip(&bound).all(|(d, b)| d <= b) {
+                return None;
+            }
+            let was = jumps(k, j, before)?;
+            let grew = (0..2).any(|i| !(now[i] <= bound[i].max(was[i])));
+            grew.then_some(((k, j), now, was))
+        })
 }
 
 /// The neighbourhood a defect's repair re-solves: which weights it may write and which it
@@ -858,7 +954,11 @@ fn repair_defect(
 ) -> Option<Repaired> {
     let Attempt { mode, sparse } = attempt;
     let Index {
-        faces_of, mi, wmax, ..
+        faces_of,
+        mi,
+        wmax,
+        across,
+        ..
     } = *index;
     let np = sys.np;
     let Local {
@@ -1470,6 +1570,19 @@ fn repair_defect(
         });
         return None;
     }
+    // And C1/C2 as `apatch check` measures them, on every face the re-solve touched.
+    let weights_in = |k: u32, v: &[f64]| sys.weights(k as usize, v);
+    if let Some(((k, j), now, was)) =
+        continuity_broken(tets, near, across, weights_in, value, &trial)
+    {
+        trace(|| {
+            format!(
+                "{defect:?}: jumps across the face of {k} and {j} (gradient, Hessian) {:.2e}, {:.2e} over the bound (were {:.2e}, {:.2e})",
+                now[0], now[1], was[0], was[1]
+            )
+        });
+        return None;
+    }
     x.truncate(unk.len());
     trace(|| {
         format!(
@@ -1761,6 +1874,85 @@ mod tests {
                 assert!((h2.col(c) - h.col(c)).length() < 1e-11, "{at}: {h2} vs {h}");
             }
         }
+    }
+
+    /// Two tetrahedra glued on a face, B's weights the continuation of A's quintic
+    /// (`poly::blossom` at B's domain points in A's coordinates), so F is one polynomial and
+    /// every jump is rounding. BB theory says which of B's weights reach across the face: with
+    /// λ_opp = 1 the gradient, = 2 the Hessian, ≥ 3 neither. The guard must name the face for
+    /// the first two changes, not for the third, and not when a jump only stays what it was.
+    #[test]
+    fn continuity_broken_sees_the_jumps_check_would_see() {
+        use crate::hull::simplicial::Side;
+        let a_pts = [
+            glam::DVec3::new(0.0, 0.0, 0.0),
+            glam::DVec3::new(1.0, 0.1, 0.0),
+            glam::DVec3::new(0.2, 0.9, 0.1),
+            glam::DVec3::new(0.3, 0.3, 0.8),
+        ];
+        let b_pts = [
+            a_pts[0],
+            a_pts[1],
+            a_pts[2],
+            glam::DVec3::new(0.4, 0.2, -0.6),
+        ];
+        let tet = |gid: [u32; 4], pts: [glam::DVec3; 4]| HullTet {
+            gid,
+            pts,
+            role: Role::Face,
+            element: 0,
+            triangle: 0,
+            side: Side::Outer,
+        };
+        let tets = [tet([0, 1, 2, 3], a_pts), tet([0, 1, 2, 4], b_pts)];
+        let across = neighbours(&tets);
+        assert_eq!(across, vec![[NONE, NONE, NONE, 1], [NONE, NONE, NONE, 0]]);
+        // A's weights: a fixed pseudo-random sequence in [-1, 1].
+        let mut seed = 12345_u64;
+        let wa: Vec<f64> = (0..56)
+            .map(|_| {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+            })
+            .collect();
+        let ta = crate::bb::tet::Tet::new(a_pts).unwrap();
+        let in_a: Vec<[f64; 4]> = b_pts.iter().map(|&p| ta.bary(p)).collect();
+        let mi = multi_indices(5);
+        let wb: Vec<f64> = mi
+            .iter()
+            .map(|l| {
+                let args: Vec<[f64; 4]> = (0..4)
+                    .flat_map(|v| std::iter::repeat_n(in_a[v], usize::from(l[v])))
+                    .collect();
+                poly::blossom(5, &wa, &args)
+            })
+            .collect();
+        let before: Vec<f64> = wa.iter().chain(&wb).copied().collect();
+        let weights = |k: u32, v: &[f64]| v[56 * k as usize..56 * (k as usize + 1)].to_vec();
+        let near = [0, 1];
+        let changed = |level: u8| {
+            let i = mi.iter().position(|l| l[3] == level).unwrap();
+            let mut v = before.clone();
+            v[56 + i] += 1e-3;
+            v
+        };
+        let broken = |after: &[f64], before: &[f64]| {
+            continuity_broken(&tets, &near, &across, weights, before, after)
+        };
+        assert_eq!(broken(&before, &before), None);
+        let (face, now, _) = broken(&changed(1), &before).expect("a gradient jump");
+        assert_eq!(face, (0, 1));
+        assert!(now[0] > 1e-6, "{now:?}");
+        let (_, now, was) = broken(&changed(2), &before).expect("a Hessian jump");
+        // The continuation's rounding: weights ~1 through a blossom of 5 arguments.
+        assert!(
+            now[0] < 1e-12 && now[1] > 1e-6 && was[1] < 1e-12,
+            "{now:?} {was:?}"
+        );
+        assert_eq!(broken(&changed(3), &before), None);
+        assert_eq!(broken(&changed(2), &changed(2)), None);
     }
 
     /// Weights that depend only on the level (λ_3 for a face tetrahedron, λ_2 + λ_3 for an
