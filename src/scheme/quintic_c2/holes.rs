@@ -759,6 +759,16 @@ fn neighbours(tets: &[HullTet]) -> Vec<[u32; 4]> {
         .collect()
 }
 
+/// A face whose C1/C2 a re-solve broke ([`continuity_broken`]).
+#[derive(Debug, PartialEq)]
+struct Broken {
+    /// The two tetrahedra that share it.
+    face: (u32, u32),
+    /// Its gradient and Hessian jumps after the re-solve, and before.
+    now: [f64; 2],
+    was: [f64; 2],
+}
+
 /// The first face of the `near` tetrahedra (with the tetrahedron across it) whose gradient or
 /// Hessian jump, as `apatch check` measures it ([`crate::check::pair_jumps`]), is over the
 /// checker's bound in `after` and larger than it was in `before`: the jump and the bound.
@@ -775,7 +785,7 @@ fn continuity_broken(
     weights: impl Fn(u32, &[f64]) -> Vec<f64>,
     before: &[f64],
     after: &[f64],
-) -> Option<((u32, u32), [f64; 2], [f64; 2])> {
+) -> Option<Broken> {
     let opts = crate::check::CheckOptions::default();
     let bound = [opts.jump_tolerance, opts.hessian_tolerance];
     let patch = |k: u32, w: Vec<f64>| {
@@ -809,8 +819,12 @@ fn continuity_broken(
                 return None;
             }
             let was = jumps(k, j, before)?;
-            let grew = (0..2).any(|i| !(now[i] <= bound[i].max(was[i])));
-            grew.then_some(((k, j), now, was))
+            let grew = (0..2).any(|i| now[i].is_nan() || now[i] > bound[i].max(was[i]));
+            grew.then_some(Broken {
+                face: (k, j),
+                now,
+                was,
+            })
         })
 }
 
@@ -1572,8 +1586,11 @@ fn repair_defect(
     }
     // And C1/C2 as `apatch check` measures them, on every face the re-solve touched.
     let weights_in = |k: u32, v: &[f64]| sys.weights(k as usize, v);
-    if let Some(((k, j), now, was)) =
-        continuity_broken(tets, near, across, weights_in, value, &trial)
+    if let Some(Broken {
+        face: (k, j),
+        now,
+        was,
+    }) = continuity_broken(tets, near, across, weights_in, value, &trial)
     {
         trace(|| {
             format!(
@@ -1942,10 +1959,10 @@ mod tests {
             continuity_broken(&tets, &near, &across, weights, before, after)
         };
         assert_eq!(broken(&before, &before), None);
-        let (face, now, _) = broken(&changed(1), &before).expect("a gradient jump");
+        let Broken { face, now, .. } = broken(&changed(1), &before).expect("a gradient jump");
         assert_eq!(face, (0, 1));
         assert!(now[0] > 1e-6, "{now:?}");
-        let (_, now, was) = broken(&changed(2), &before).expect("a Hessian jump");
+        let Broken { now, was, .. } = broken(&changed(2), &before).expect("a Hessian jump");
         // The continuation's rounding: weights ~1 through a blossom of 5 arguments.
         assert!(
             now[0] < 1e-12 && now[1] > 1e-6 && was[1] < 1e-12,
