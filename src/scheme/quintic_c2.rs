@@ -171,6 +171,18 @@ pub struct QuinticOptions {
     /// curvature moves between the points instead (the cylinder's mean curvature varies 2×
     /// more over its sides; docs/quintic.md, session 68), so no shipped scene sets it.
     pub hessian_cost: f64,
+    /// Hold the whole column ∇²F n = 0 (as `hessian_normal = "column"`) at every point of T
+    /// flat to this many degrees: the normals of the points of T it shares a tetrahedron with
+    /// all within that angle of its own ([`normalpart::flat_points`]); the scene's
+    /// `hessian_normal` elsewhere. There F should be the plane's signed distance. Held
+    /// everywhere the column leaves fandisk's joint group unmet (session 67); at its points
+    /// flat to 0.5° the sign fit and the repair do better than with `"bend"` alone (session
+    /// 69). `None` (the default): no point.
+    pub hessian_column_flat: Option<f64>,
+    /// More points of T (indices of the complex's vertices) whose whole column is held, as
+    /// for [`Self::hessian_column_flat`]: a point `scripts/normal_curvature.py` ranks first by
+    /// its mixed part P H n. Empty by default.
+    pub hessian_column_points: Vec<u32>,
     /// The double-double factor's drop threshold (a pivot is a row's squared distance from
     /// the rows before it, relative) for the groups beyond the in-house factor (fandisk's
     /// joint group), instead of [`cholesky::PRECISE_PIVOT`] (1e-15) and, when that factor's
@@ -250,6 +262,8 @@ impl Default for QuinticOptions {
             face_beta: beta::FaceBeta::F64,
             hessian_normal: normalpart::HessianNormal::Free,
             hessian_cost: 1.0,
+            hessian_column_flat: None,
+            hessian_column_points: Vec::new(),
             precise_pivot: None,
             relax_stars: true,
             consistent_stars: false,
@@ -478,6 +492,29 @@ impl QuinticOptions {
                         &format!("a number in (0, {MAX_HESSIAN_COST:e}]"),
                     )?;
                 }
+                "hessian_column_flat" => {
+                    o.hessian_column_flat = Some(number(
+                        &|t| t > 0.0 && t <= 90.0,
+                        "an angle in degrees in (0, 90]",
+                    )?);
+                }
+                "hessian_column_points" => {
+                    let bad = || {
+                        anyhow::anyhow!(
+                            "{}: `scheme.hessian_column_points` must be an array of indices of points of T (integers ≥ 0), got {v}",
+                            scene.display()
+                        )
+                    };
+                    let items = v.as_array().ok_or_else(bad)?;
+                    o.hessian_column_points = items
+                        .iter()
+                        .map(|p| {
+                            p.as_integer()
+                                .and_then(|i| u32::try_from(i).ok())
+                                .ok_or_else(bad)
+                        })
+                        .collect::<anyhow::Result<_>>()?;
+                }
                 "precise_pivot" => {
                     o.precise_pivot = Some(number(
                         &|t| t > 0.0 && t <= MAX_PRECISE_PIVOT,
@@ -487,7 +524,7 @@ impl QuinticOptions {
                 "signs" => o.signs = flag()?,
                 "curvature" => o.curvature = number(&|x| x >= 0.0, "a number ≥ 0")?,
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `hessian_normal`, `hessian_cost`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `hessian_normal`, `hessian_cost`, `hessian_column_flat`, `hessian_column_points`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -642,7 +679,7 @@ pub fn build_prepared(
         signs::HessianFit::default()
     };
     sys.hessian_normal = options.hessian_normal;
-    sys.column_points = normalpart::column_points_from_env(np);
+    sys.column_points = column_points(options, hull, &tets)?;
     sys.held = normalpart::rows(&sys, &tets, &jets);
     let target = |t: usize, l: [u8; 4]| target_weight(&tets[t], l, &jets, np, options.lift);
     let (mut value, mut stats) = match resume::requested() {
@@ -730,6 +767,37 @@ pub fn build_prepared(
         });
     }
     Ok((complex, stats))
+}
+
+/// The points of T whose whole column H n is held: those flat to
+/// [`QuinticOptions::hessian_column_flat`], [`QuinticOptions::hessian_column_points`] and the
+/// exploration list `APATCH_HESSIAN_COLUMN_AT`, sorted.
+///
+/// # Errors
+/// A listed point that is not a point of T.
+fn column_points(
+    options: &QuinticOptions,
+    hull: &SimplicialHull,
+    tets: &[system::HullTet],
+) -> Result<Vec<u32>> {
+    let np = hull.points.len() as u32;
+    if let Some(&p) = options.hessian_column_points.iter().find(|&&p| p >= np) {
+        return Err(Error::Invalid(format!(
+            "`scheme.hessian_column_points`: {p} is not a point of T (the hull has {np}: 0..{})",
+            np.saturating_sub(1)
+        )));
+    }
+    let mut points = normalpart::column_points_from_env(np);
+    points.extend(&options.hessian_column_points);
+    if let Some(degrees) = options.hessian_column_flat {
+        points.extend(normalpart::flat_points(tets, &hull.normals, degrees));
+    }
+    points.sort_unstable();
+    points.dedup();
+    if !points.is_empty() && std::env::var_os("APATCH_SOLVE_TRACE").is_some() {
+        eprintln!("quintic-c2 column H n held at {} points of T", points.len());
+    }
+    Ok(points)
 }
 
 /// The target of the weight at multi-index `l` of `tet`: the blend of the Taylor polynomials

@@ -20,7 +20,7 @@ use std::path::Path;
 /// `joint_sign_boundary`, `JOINT_MEET_TOLERANCE` its `joint_meet_tolerance`, `JOINT_LOCAL_MEET=1` its
 /// `joint_local_meet`, `REPAIR_WIDEN` its `repair_widen`, `REPAIR_ELEVATE` its
 /// `repair_elevate` (with the default margins), `HESSIAN_NORMAL` its `hessian_normal`, `HESSIAN_COST` its
-/// `hessian_cost` (to explore).
+/// `hessian_cost`, `HESSIAN_COLUMN_FLAT` its `hessian_column_flat` (to explore).
 fn options() -> QuinticOptions {
     QuinticOptions {
         lift: std::env::var("LIFT")
@@ -70,6 +70,10 @@ fn options() -> QuinticOptions {
             .ok()
             .and_then(|x| x.parse().ok())
             .unwrap_or(1.0),
+        hessian_column_flat: std::env::var("HESSIAN_COLUMN_FLAT")
+            .ok()
+            .and_then(|x| x.parse().ok()),
+        hessian_column_points: Vec::new(),
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
         balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
         joint_sign_rounds: std::env::var("JOINT_SIGN_ROUNDS")
