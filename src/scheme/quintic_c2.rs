@@ -179,6 +179,12 @@ pub struct QuinticOptions {
     /// flat to 0.5° the sign fit and the repair do better than with `"bend"` alone (session
     /// 69). `None` (the default): no point.
     pub hessian_column_flat: Option<f64>,
+    /// The joint group's meet before the sign fit (its dropped rows met by moves in the kept
+    /// rows' null space) stops after this many rounds in a row that did not lower its
+    /// residual, instead of running every round (each ~6 min on fandisk). `None` (the
+    /// default): every round. With `hessian_column_flat` fandisk's first two rounds ask a move
+    /// of 1.37 and are refused; its scene stops there (session 69).
+    pub joint_meet_stall: Option<usize>,
     /// More points of T (indices of the complex's vertices) whose whole column is held, as
     /// for [`Self::hessian_column_flat`]: a point `scripts/normal_curvature.py` ranks first by
     /// its mixed part P H n. Empty by default.
@@ -263,6 +269,7 @@ impl Default for QuinticOptions {
             hessian_normal: normalpart::HessianNormal::Free,
             hessian_cost: 1.0,
             hessian_column_flat: None,
+            joint_meet_stall: None,
             hessian_column_points: Vec::new(),
             precise_pivot: None,
             relax_stars: true,
@@ -463,6 +470,15 @@ impl QuinticOptions {
                 }
                 "joint_sign_rounds" => o.joint_sign_rounds = count()?,
                 "joint_sign_fit" => o.joint_sign_fit = count()?,
+                "joint_meet_stall" => {
+                    o.joint_meet_stall = Some(count()?).filter(|&k| k > 0);
+                    if o.joint_meet_stall.is_none() {
+                        bail!(
+                            "{}: `scheme.joint_meet_stall` must be a whole number ≥ 1, got {v}",
+                            scene.display()
+                        );
+                    }
+                }
                 "joint_sign_boundary" => {
                     o.joint_sign_boundary =
                         number(&|t| (1.0..=1e6).contains(&t), "a number in [1, 1e6]")?;
@@ -524,7 +540,7 @@ impl QuinticOptions {
                 "signs" => o.signs = flag()?,
                 "curvature" => o.curvature = number(&|x| x >= 0.0, "a number ≥ 0")?,
                 other => bail!(
-                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_local_meet`, `face_beta`, `hessian_normal`, `hessian_cost`, `hessian_column_flat`, `hessian_column_points`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
+                    "{}: `scheme.{other}`: unknown key for quintic-c2 (expected `curvature`, `lift`, `signs`, `joint_stars`, `relax_stars`, `consistent_stars`, `hessian_signs`, `complete_lu_pairs`, `contain_tangents`, `tangent_clearance`, `zero_groups`, `star_tau`, `sign_targets`, `joint_sign_rounds`, `joint_sign_fit`, `joint_sign_boundary`, `joint_meet_tolerance`, `joint_meet_stall`, `joint_local_meet`, `face_beta`, `hessian_normal`, `hessian_cost`, `hessian_column_flat`, `hessian_column_points`, `precise_pivot`, `repair_holes`, `repair_hessians`, `repair_widen`, `repair_elevate`, `repair_margins`, `thicken_edges`, `balance_edges`, `sign_rounds`, `sign_program`, {})",
                     scene.display(),
                     crate::hull::inner::InnerOptions::KEYS.map(|k| format!("`{k}`")).join(", ")
                 ),
@@ -664,6 +680,7 @@ pub fn build_prepared(
     sys.joint_sign_fit = options.joint_sign_fit;
     sys.joint_sign_boundary = options.joint_sign_boundary;
     sys.joint_meet_tolerance = options.joint_meet_tolerance;
+    sys.joint_meet_stall = options.joint_meet_stall;
     sys.joint_local_meet = options.joint_local_meet;
     sys.precise_pivot = options.precise_pivot;
     if let Some(path) = resume::restage_requested() {

@@ -74,6 +74,7 @@ fn options() -> QuinticOptions {
             .ok()
             .and_then(|x| x.parse().ok()),
         hessian_column_points: Vec::new(),
+        joint_meet_stall: None,
         thicken_edges: std::env::var("THICKEN").map_or(true, |s| s != "0"),
         balance_edges: std::env::var("BALANCE").is_ok_and(|s| s == "1"),
         joint_sign_rounds: std::env::var("JOINT_SIGN_ROUNDS")

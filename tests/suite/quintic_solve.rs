@@ -549,9 +549,10 @@ fn hessian_normal_is_read_and_checked() {
     }
 }
 
-/// `hessian_column_flat` takes an angle in degrees in (0, 90] and `hessian_column_points` an
-/// array of point indices; anything else is refused naming the scene and the key, and a point
-/// past the hull's points is refused when the scene is built.
+/// `hessian_column_flat` takes an angle in degrees in (0, 90], `hessian_column_points` an
+/// array of point indices and `joint_meet_stall` a whole number ≥ 1; anything else is refused
+/// naming the scene and the key, and a point past the hull's points is refused when the scene
+/// is built.
 #[test]
 fn hessian_column_keys_are_read_and_checked() {
     let scene = Path::new("scenes/x.toml");
@@ -594,6 +595,20 @@ fn hessian_column_keys_are_read_and_checked() {
         assert!(
             e.contains("scenes/x.toml") && e.contains(&format!("`scheme.{key}`")),
             "{key} = {bad}: {e}"
+        );
+    }
+    assert_eq!(read("").unwrap().joint_meet_stall, None);
+    assert_eq!(
+        read("joint_meet_stall = 2").unwrap().joint_meet_stall,
+        Some(2)
+    );
+    for bad in ["0", "-1", "1.5", "true", "\"2\""] {
+        let e = read(&format!("joint_meet_stall = {bad}"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("scenes/x.toml") && e.contains("`scheme.joint_meet_stall`"),
+            "{bad}: {e}"
         );
     }
     let path = Path::new("scenes/paper1994/cylinder_rounded_quintic.toml");

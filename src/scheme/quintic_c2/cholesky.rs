@@ -877,7 +877,8 @@ pub(super) fn refine_near<F: NormalSolve>(
         if let Some((f, _)) = factors.iter().find(|(_, d)| *d == best.2) {
             let mut x = best.1.clone();
             let got;
-            (got, basis) = meet_dropped(unit, f, &mut x, tol, &MEET_OWN_WEIGHTS);
+            let stall = signs.and_then(|sb| sb.meet_stall);
+            (got, basis) = meet_dropped(unit, f, &mut x, tol, &MEET_OWN_WEIGHTS, stall);
             if got < best.0 {
                 best = (got, x, best.2);
             }
@@ -924,7 +925,7 @@ pub(super) fn refine_near<F: NormalSolve>(
                     drop(basis);
                     let weights = meet_weights_override().unwrap_or(MEET_OWN_WEIGHTS.to_vec());
                     let q;
-                    (got, q) = meet_dropped(unit, f, &mut x, meet_tol, &weights);
+                    (got, q) = meet_dropped(unit, f, &mut x, meet_tol, &weights, None);
                     // Exploration (`APATCH_FIT_CYCLES=n`): the fit and the meet in turns.
                     if let Some(cycles) = positive_env("APATCH_FIT_CYCLES") {
                         got = fit_meet_cycles(
@@ -989,7 +990,7 @@ fn fit_meet_cycles<F: NormalSolve>(
     for cycle in 0..cycles {
         let fitted = super::signsplit::fit(unit, f, x, &q, &refit, f64::INFINITY);
         drop(std::mem::take(&mut q));
-        (got, q) = meet_dropped(unit, f, x, tol, weights);
+        (got, q) = meet_dropped(unit, f, x, tol, weights, None);
         let cost = sb.off_cost(x, zero_up_to_rounding(x));
         eprintln!(
             "quintic-c2 fit/meet cycle {cycle}: fit {}, {} off their sign (cost {cost}), residual after the meet {got:.2e} (bound {bound:.2e})",
@@ -1112,6 +1113,9 @@ pub struct SignBox {
     /// sign program meets the dropped rows, if above the solve's tolerance (0: that
     /// tolerance); a fit whose meet reaches it is kept.
     pub meet_tol: f64,
+    /// The meet before the fit stops after this many rounds in a row that did not lower its
+    /// residual ([`meet_dropped`]; `None`: it runs its rounds out).
+    pub meet_stall: Option<usize>,
 }
 
 impl SignBox {
@@ -1286,6 +1290,7 @@ pub(super) fn meet_dropped<F: NormalSolve>(
     x: &mut Vec<f64>,
     tol: f64,
     own_weights: &[f64],
+    stall: Option<usize>,
 ) -> (f64, Vec<Vec<f64>>) {
     let arows = &unit.rows;
     let (m, n) = (arows.len(), x.len());
@@ -1299,9 +1304,13 @@ pub(super) fn meet_dropped<F: NormalSolve>(
     let mut q: Vec<Vec<f64>> = Vec::new();
     let mut used = vec![false; m];
     let mut seen: Vec<Vec<(usize, f64)>> = Vec::new();
-    // Exploration (`APATCH_MEET_STALL=k`): stop after k rounds in a row that did not lower the
-    // residual (fandisk's meet before the fit: four refused rounds of ~6 min, session 66).
-    let stall = positive_env("APATCH_MEET_STALL").map_or(usize::MAX, |k| k as usize);
+    // Stop after `stall` rounds in a row that did not lower the residual (fandisk's meet
+    // before the fit: four refused rounds of ~6 min, session 66), or as many as
+    // `APATCH_MEET_STALL=k` says (exploration, every meet).
+    let stall = positive_env("APATCH_MEET_STALL")
+        .map(|k| k as usize)
+        .or(stall)
+        .unwrap_or(usize::MAX);
     let mut stalled = 0;
     for round in 0..MEET_ROUNDS {
         if res <= tol || q.len() >= MEET_BASIS || stalled >= stall {

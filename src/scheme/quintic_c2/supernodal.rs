@@ -780,7 +780,7 @@ mod tests {
             .expect("small");
             let met = |weights: &[f64]| {
                 let mut y = x.clone();
-                cholesky::meet_dropped(&unit, &f, &mut y, 1e-13, weights).0
+                cholesky::meet_dropped(&unit, &f, &mut y, 1e-13, weights, None).0
             };
             let (plain, own) = (met(&[1.0]), met(&cholesky::MEET_OWN_WEIGHTS));
             eprintln!("seed {seed}: before {before:.2e}, plain {plain:.2e}, weighted {own:.2e}");
@@ -816,6 +816,7 @@ mod tests {
             rounds: 300,
             fit: 0,
             meet_tol: 0.0,
+            meet_stall: None,
         };
         let plain = solve_near(&rows, n, &c, &target, tol, MAX_VALUES).expect("small");
         let signed_sol = solve_near_signed(&rows, n, &c, &target, tol, MAX_VALUES, Some(&sb), None)
@@ -898,6 +899,7 @@ mod tests {
                 rounds,
                 fit,
                 meet_tol: 0.0,
+                meet_stall: None,
             };
             let solve = |b: Option<cholesky::SignBox>| {
                 let (r, c, t) = (&sys.rows, &sys.c, &sys.target);
@@ -940,6 +942,7 @@ mod tests {
                 rounds: 0,
                 fit: 100,
                 meet_tol: 0.0,
+                meet_stall: None,
             };
             let (r, c, t) = (&sys.rows, &sys.c, &sys.target);
             let x = solve_near_signed(r, n, c, t, tol, MAX_VALUES, Some(&sb), None)
@@ -1012,6 +1015,7 @@ mod tests {
             rounds: 0,
             fit: 100,
             meet_tol,
+            meet_stall: None,
         }
     }
 
@@ -1187,7 +1191,8 @@ mod tests {
         let mut x: Vec<f64> = x0.iter().zip(&d[0]).map(|(a, b)| a + b).collect();
         let moved = unit.residual(&x, &mut r);
         assert!(moved > 100.0 * tol, "the near rows see the move: {moved:e}");
-        let (met, q) = cholesky::meet_dropped(&unit, &f, &mut x, tol, &cholesky::MEET_OWN_WEIGHTS);
+        let (met, q) =
+            cholesky::meet_dropped(&unit, &f, &mut x, tol, &cholesky::MEET_OWN_WEIGHTS, None);
         assert!(met <= tol, "{moved:e} -> {met:e}");
         assert!(!q.is_empty());
         let sb = fit_box(&sys, 0.0);

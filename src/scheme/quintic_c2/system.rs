@@ -207,6 +207,9 @@ pub struct System {
     /// The miss, relative to a group's scale, to which the meet after its split sign program
     /// meets the dropped rows (`QuinticOptions::joint_meet_tolerance`; 0 = the solve's).
     pub joint_meet_tolerance: f64,
+    /// The joint group's meet before the sign fit stops after this many rounds in a row that
+    /// did not lower its residual (`QuinticOptions::joint_meet_stall`; `None`: every round).
+    pub joint_meet_stall: Option<usize>,
     /// Whether the rows a group's sign fit leaves missed are met region by region
     /// (`QuinticOptions::joint_local_meet`, [`super::localmeet`]) instead of by its factor.
     pub joint_local_meet: bool,
@@ -364,6 +367,7 @@ pub fn assemble_with(tets: &[HullTet], np: u32, face_beta: FaceBeta) -> Result<S
         joint_sign_fit: 0,
         joint_sign_boundary: 1.0,
         joint_meet_tolerance: 0.0,
+        joint_meet_stall: None,
         joint_local_meet: false,
         precise_pivot: None,
         preset: None,
@@ -1834,6 +1838,7 @@ impl System {
             } else {
                 self.joint_meet_tolerance * g.scale
             },
+            meet_stall: self.joint_meet_stall,
         }
     }
 
