@@ -643,6 +643,19 @@ fn mixed_part(c: &apatch::complex::PatchComplex, i: usize) -> f64 {
     (hn - n * n.dot(hn)).length() / patch.gradient(v).length()
 }
 
+/// The rounded cylinder's scene (joint stars) with `extra` added to its `[scheme]`, built.
+fn rounded_cylinder_with(extra: &str) -> apatch::complex::PatchComplex {
+    let path = Path::new("scenes/paper1994/cylinder_rounded_quintic.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains("joint_stars = true"), "the scene changed");
+    let text = text.replace(
+        "joint_stars = true",
+        &format!("joint_stars = true\n{extra}"),
+    );
+    let scene = apatch::scene::parse(&text, path).unwrap();
+    apatch::scene::build_complex(&scene).unwrap()
+}
+
 /// The rounded cylinder's joint stars give its points a mixed part P ∇²F n of ~1–2.6 (session
 /// 67); held at two points by `hessian_column_points`, it is 0 there (to the solve's rounding)
 /// and the other points keep one, and the scene stays C2 and one-sheeted. None of its points is
@@ -650,17 +663,7 @@ fn mixed_part(c: &apatch::complex::PatchComplex, i: usize) -> f64 {
 /// `hessian_column_flat = 0.5` builds the free complex bit for bit.
 #[test]
 fn hessian_column_points_hold_the_mixed_part_where_asked() {
-    let path = Path::new("scenes/paper1994/cylinder_rounded_quintic.toml");
-    let text = std::fs::read_to_string(path).unwrap();
-    assert!(text.contains("joint_stars = true"), "the scene changed");
-    let build = |extra: &str| {
-        let text = text.replace(
-            "joint_stars = true",
-            &format!("joint_stars = true\n{extra}"),
-        );
-        let scene = apatch::scene::parse(&text, path).unwrap();
-        apatch::scene::build_complex(&scene).unwrap()
-    };
+    let build = rounded_cylinder_with;
     let free = build("");
     let held = build("hessian_column_points = [11, 44]");
     // Measured: 2.59 and 2.09 free; far above the held rows' rounding (~1e-9, as the bend's in
@@ -703,17 +706,7 @@ fn normal_bends(c: &apatch::complex::PatchComplex) -> Vec<f64> {
 /// for the signs there).
 #[test]
 fn held_normal_bend_takes_the_joint_stars_bend_away() {
-    let path = Path::new("scenes/paper1994/cylinder_rounded_quintic.toml");
-    let text = std::fs::read_to_string(path).unwrap();
-    assert!(text.contains("joint_stars = true"), "the scene changed");
-    let build = |mode: &str| {
-        let text = text.replace(
-            "joint_stars = true",
-            &format!("joint_stars = true\nhessian_normal = \"{mode}\""),
-        );
-        let scene = apatch::scene::parse(&text, path).unwrap();
-        apatch::scene::build_complex(&scene).unwrap()
-    };
+    let build = |mode: &str| rounded_cylinder_with(&format!("hessian_normal = \"{mode}\""));
     let largest = |b: &[f64]| b.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
     let free = build("free");
     let bends = normal_bends(&free);
