@@ -223,8 +223,8 @@ pub struct System {
     /// What [`Self::held`] holds, so that the hole repair's freed Hessians keep it too.
     pub hessian_normal: super::normalpart::HessianNormal,
     /// Points of T (sorted) whose whole normal column H n is held whatever
-    /// [`Self::hessian_normal`] says (exploration, `APATCH_HESSIAN_COLUMN_AT`): the points
-    /// where a first solve put an extreme mixed part.
+    /// [`Self::hessian_normal`] says: the flat points of `QuinticOptions::hessian_column_flat`,
+    /// those of `hessian_column_points` and of the exploration `APATCH_HESSIAN_COLUMN_AT`.
     pub column_points: Vec<u32>,
     /// The double-double factor's one drop threshold for groups beyond the in-house factor
     /// (`QuinticOptions::precise_pivot`; `None`: [`super::cholesky::PRECISE_PIVOT`], then
