@@ -23,6 +23,21 @@ struct FaceEntry {
     local: [u8; 3],
 }
 
+impl FaceEntry {
+    /// The face of patch number `patch` (vertex keys `keys`) opposite its local vertex
+    /// `opposite`.
+    fn new(keys: &[PointKey; 4], opposite: u8, patch: u32) -> FaceEntry {
+        let mut local: Vec<u8> = (0..4u8).filter(|&k| k != opposite).collect();
+        local.sort_by_key(|&k| keys[usize::from(k)]);
+        let local = [local[0], local[1], local[2]];
+        FaceEntry {
+            key: local.map(|k| keys[usize::from(k)]),
+            patch,
+            local,
+        }
+    }
+}
+
 /// The results of [`measure`].
 pub(super) struct FaceMeasures {
     pub stats: FaceStats,
@@ -59,16 +74,7 @@ pub(super) fn measure(evals: &[PatchEval<'_>], opts: &CheckOptions) -> FaceMeasu
         .enumerate()
         .flat_map_iter(|(pi, e)| {
             let keys = e.patch.tet.map(point_key);
-            (0..4u8).map(move |opposite| {
-                let mut local: Vec<u8> = (0..4u8).filter(|&k| k != opposite).collect();
-                local.sort_by_key(|&k| keys[usize::from(k)]);
-                let local = [local[0], local[1], local[2]];
-                FaceEntry {
-                    key: local.map(|k| keys[usize::from(k)]),
-                    patch: pi as u32,
-                    local,
-                }
-            })
+            (0..4u8).map(move |opposite| FaceEntry::new(&keys, opposite, pi as u32))
         })
         .collect();
     entries.par_sort_unstable_by(|a, b| a.key.cmp(&b.key).then(a.patch.cmp(&b.patch)));
@@ -143,19 +149,9 @@ pub(super) fn measure(evals: &[PatchEval<'_>], opts: &CheckOptions) -> FaceMeasu
 #[must_use]
 pub fn pair_jumps(a: &Patch, b: &Patch, opts: &CheckOptions) -> Option<[f64; 3]> {
     let (ka, kb) = (a.tet.map(point_key), b.tet.map(point_key));
-    let entry = |keys: &[PointKey; 4], opp: u8, patch: u32| {
-        let mut local: Vec<u8> = (0..4u8).filter(|&k| k != opp).collect();
-        local.sort_by_key(|&k| keys[usize::from(k)]);
-        let local = [local[0], local[1], local[2]];
-        FaceEntry {
-            key: local.map(|k| keys[usize::from(k)]),
-            patch,
-            local,
-        }
-    };
     let (fa, fb) = (0..4u8)
         .flat_map(|oa| (0..4u8).map(move |ob| (oa, ob)))
-        .map(|(oa, ob)| (entry(&ka, oa, 0), entry(&kb, ob, 1)))
+        .map(|(oa, ob)| (FaceEntry::new(&ka, oa, 0), FaceEntry::new(&kb, ob, 1)))
         .find(|(fa, fb)| fa.key == fb.key)?;
     let evals = [PatchEval::new(a, 0), PatchEval::new(b, 1)];
     let j = face_jumps(&evals, &fa, &fb, opts);

@@ -768,22 +768,27 @@ pub fn build_prepared(
         .map(|n| n.normalize().to_array())
         .collect();
     for (t, tet) in tets.iter().enumerate() {
-        complex.patches.push(Patch {
-            tet: tet.pts.map(|p| p.to_array()),
-            degree: system::N as u8,
-            weights: sys.weights(t, &value),
-            rational: Vec::new(),
-            sheet: SheetRule::Any,
-            role: tet.role,
-            element: tet.element,
-            // Face tetrahedra: a j-patch for the apex; edge tetrahedra: single sheeted between
-            // [p_i p_j] and [q s] (the shapes the cubic scheme promises too; `apatch check`
-            // samples both).
-            jvertex: (tet.role == crate::complex::Role::Face).then_some(3),
-            jedge: (tet.role == crate::complex::Role::Edge).then_some([0, 1]),
-        });
+        complex.patches.push(patch_of(tet, sys.weights(t, &value)));
     }
     Ok((complex, stats))
+}
+
+/// The patch of hull tetrahedron `tet` with its 56 `weights`.
+fn patch_of(tet: &system::HullTet, weights: Vec<f64>) -> Patch {
+    Patch {
+        tet: tet.pts.map(|p| p.to_array()),
+        degree: system::N as u8,
+        weights,
+        rational: Vec::new(),
+        sheet: SheetRule::Any,
+        role: tet.role,
+        element: tet.element,
+        // Face tetrahedra: a j-patch for the apex; edge tetrahedra: single sheeted between
+        // [p_i p_j] and [q s] (the shapes the cubic scheme promises too; `apatch check`
+        // samples both).
+        jvertex: (tet.role == crate::complex::Role::Face).then_some(3),
+        jedge: (tet.role == crate::complex::Role::Edge).then_some([0, 1]),
+    }
 }
 
 /// The points of T whose whole column H n is held: those flat to

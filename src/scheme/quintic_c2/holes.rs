@@ -297,24 +297,36 @@ pub(super) const SOFT_CONSISTENT: f64 = 1e-7;
 /// belongs to one tetrahedron only, in tetrahedron order.
 #[must_use]
 pub fn boundary_faces(tets: &[HullTet]) -> Vec<(u32, usize)> {
-    let mut users: HashMap<[u32; 3], u32> = HashMap::new();
-    let face = |t: &HullTet, opp: usize| {
-        let mut f = [0u32; 3];
-        for (c, k) in (0..4).filter(|&k| k != opp).enumerate() {
-            f[c] = t.gid[k];
-        }
-        f.sort_unstable();
-        f
-    };
-    for t in tets {
+    boundary_in(tets, &face_users(tets))
+}
+
+/// The face of `t` opposite its local vertex `opp`, as its sorted global vertex ids.
+fn tet_face(t: &HullTet, opp: usize) -> [u32; 3] {
+    let mut f = [0u32; 3];
+    for (c, k) in (0..4).filter(|&k| k != opp).enumerate() {
+        f[c] = t.gid[k];
+    }
+    f.sort_unstable();
+    f
+}
+
+/// The tetrahedra of `tets` that have each face.
+fn face_users(tets: &[HullTet]) -> HashMap<[u32; 3], Vec<u32>> {
+    let mut users: HashMap<[u32; 3], Vec<u32>> = HashMap::new();
+    for (k, t) in tets.iter().enumerate() {
         for opp in 0..4 {
-            *users.entry(face(t, opp)).or_insert(0) += 1;
+            users.entry(tet_face(t, opp)).or_default().push(k as u32);
         }
     }
+    users
+}
+
+/// [`boundary_faces`] with the faces' `users` ([`face_users`]) at hand.
+fn boundary_in(tets: &[HullTet], users: &HashMap<[u32; 3], Vec<u32>>) -> Vec<(u32, usize)> {
     let mut out = Vec::new();
     for (k, t) in tets.iter().enumerate() {
         for opp in 0..4 {
-            if users[&face(t, opp)] == 1 {
+            if users[&tet_face(t, opp)].len() == 1 {
                 out.push((k as u32, opp));
             }
         }
@@ -383,7 +395,8 @@ pub fn repair(
         ref pins,
     } = *plan;
     let np = sys.np;
-    let boundary = boundary_faces(tets);
+    let users = face_users(tets);
+    let boundary = boundary_in(tets, &users);
     let weights = |t: u32, value: &[f64]| -> Vec<f64> { sys.weights(t as usize, value) };
     let is_crossed = |&(t, opp): &(u32, usize), value: &[f64]| crossed(&weights(t, value), opp);
     let holes: Vec<(u32, usize)> = boundary
@@ -481,7 +494,8 @@ pub fn repair(
             eqs_of[s as usize].push(e as u32);
         }
     }
-    let across = neighbours(tets);
+    let across = neighbours(tets, &users);
+    drop(users);
     let mi = multi_indices(5);
     let only = only_tets();
     let modes = elevated_modes(pins);
@@ -726,26 +740,13 @@ struct Index<'a> {
 const NONE: u32 = u32::MAX;
 
 /// The tetrahedron across each face of each of `tets` (by local opposite vertex), [`NONE`]
-/// where the face is on the hull's boundary.
-fn neighbours(tets: &[HullTet]) -> Vec<[u32; 4]> {
-    let face = |t: &HullTet, opp: usize| {
-        let mut f = [0u32; 3];
-        for (c, k) in (0..4).filter(|&k| k != opp).enumerate() {
-            f[c] = t.gid[k];
-        }
-        f.sort_unstable();
-        f
-    };
-    let mut users: HashMap<[u32; 3], Vec<u32>> = HashMap::new();
-    for (k, t) in tets.iter().enumerate() {
-        for opp in 0..4 {
-            users.entry(face(t, opp)).or_default().push(k as u32);
-        }
-    }
+/// where no single other tetrahedron has the face (the hull's boundary); `users` from
+/// [`face_users`].
+fn neighbours(tets: &[HullTet], users: &HashMap<[u32; 3], Vec<u32>>) -> Vec<[u32; 4]> {
     tets.iter()
         .enumerate()
         .map(|(k, t)| {
-            std::array::from_fn(|opp| match users[&face(t, opp)].as_slice() {
+            std::array::from_fn(|opp| match users[&tet_face(t, opp)].as_slice() {
                 [a, b] => {
                     if *a == k as u32 {
                         *b
@@ -788,37 +789,27 @@ fn continuity_broken(
 ) -> Option<Broken> {
     let opts = crate::check::CheckOptions::default();
     let bound = [opts.jump_tolerance, opts.hessian_tolerance];
-    let patch = |k: u32, w: Vec<f64>| {
-        let t = &tets[k as usize];
-        crate::complex::Patch {
-            tet: t.pts.map(|p| p.to_array()),
-            degree: super::system::N as u8,
-            weights: w,
-            rational: Vec::new(),
-            sheet: crate::complex::SheetRule::Any,
-            role: t.role,
-            element: t.element,
-            jvertex: None,
-            jedge: None,
-        }
-    };
     let in_near: HashSet<u32> = near.iter().copied().collect();
-    let jumps = |k: u32, j: u32, value: &[f64]| {
-        let (a, b) = (patch(k, weights(k, value)), patch(j, weights(j, value)));
+    // The gradient and Hessian jumps across the face of `k` and `j` with these weights.
+    let jumps = |k: u32, wk: Vec<f64>, j: u32, wj: Vec<f64>| {
+        let a = super::patch_of(&tets[k as usize], wk);
+        let b = super::patch_of(&tets[j as usize], wj);
         crate::check::pair_jumps(&a, &b, &opts).map(|d| [d[1], d[2]])
     };
     near.iter()
         .flat_map(|&k| across[k as usize].iter().map(move |&j| (k, j)))
         .filter(|&(k, j)| j != NONE && (k < j || !in_near.contains(&j)))
-        .filter(|&(k, j)| {
-            weights(k, before) != weights(k, after) || weights(j, before) != weights(j, after)
-        })
         .find_map(|(k, j)| {
-            let now = jumps(k, j, after)?;
+            let (k_now, j_now) = (weights(k, after), weights(j, after));
+            let (k_was, j_was) = (weights(k, before), weights(j, before));
+            if k_now == k_was && j_now == j_was {
+                return None;
+            }
+            let now = jumps(k, k_now, j, j_now)?;
             if now.iter().zip(&bound).all(|(d, b)| d <= b) {
                 return None;
             }
-            let was = jumps(k, j, before)?;
+            let was = jumps(k, k_was, j, j_was)?;
             let grew = (0..2).any(|i| now[i].is_nan() || now[i] > bound[i].max(was[i]));
             grew.then_some(Broken {
                 face: (k, j),
@@ -1922,7 +1913,7 @@ mod tests {
             side: Side::Outer,
         };
         let tets = [tet([0, 1, 2, 3], a_pts), tet([0, 1, 2, 4], b_pts)];
-        let across = neighbours(&tets);
+        let across = neighbours(&tets, &face_users(&tets));
         assert_eq!(across, vec![[NONE, NONE, NONE, 1], [NONE, NONE, NONE, 0]]);
         // A's weights: a fixed pseudo-random sequence in [-1, 1].
         let mut seed = 12345_u64;
